@@ -1,0 +1,39 @@
+"""gearsym.derive -- from gear data and topology to the non-dimensional model (SI inside).
+
+Public entry points: :func:`load_target` (scene or topology file), :func:`derive_model`,
+:func:`emit` (generated code and audit pages) and :func:`fit_dead_zone`.
+"""
+
+__version__ = "0.1.0"
+
+from ._input import InputError
+from .backlash import (
+    DeadZone,
+    LinearContact,
+    PolynomialFit,
+    SmoothDeadZone,
+    dead_zone,
+    fit_dead_zone,
+)
+from .model import Model, derive_model
+from .scene import Features, Scene, load_scene, load_target, resolve_target
+from .topology import Topology, load_topology
+
+__all__ = [
+    "DeadZone",
+    "Features",
+    "InputError",
+    "LinearContact",
+    "Model",
+    "PolynomialFit",
+    "Scene",
+    "SmoothDeadZone",
+    "Topology",
+    "dead_zone",
+    "derive_model",
+    "fit_dead_zone",
+    "load_scene",
+    "load_target",
+    "load_topology",
+    "resolve_target",
+]

@@ -1,0 +1,260 @@
+"""Reading user input: TOML tables with typed, range-checked keys and one-line errors.
+
+Every mistake a user can make in a topology or scene file is reported as an
+:class:`InputError` whose text is one line naming the file, the key, the value
+and what is allowed.  Unknown keys are rejected with the nearest valid name.
+"""
+
+from __future__ import annotations
+
+import ast
+import difflib
+import keyword
+import math
+import operator
+import re
+import tomllib
+from collections.abc import Callable, Iterable
+from pathlib import Path
+from typing import Any
+
+__all__ = ["InputError", "Table", "load_toml", "nearest", "parse_expression"]
+
+
+class InputError(ValueError):
+    """A user input is wrong.  ``str(err)`` is one line: ``source: key: message``."""
+
+    def __init__(self, source: str, key: str, message: str):
+        self.source = source
+        self.key = key
+        self.message = message
+        where = f"{source}: {key}" if key else source
+        super().__init__(f"{where}: {message}")
+
+
+def nearest(name: str, allowed: Iterable[str]) -> str:
+    """Return ``" (did you mean 'x'?)"`` for the closest allowed name, or ``""``."""
+    close = difflib.get_close_matches(name, list(allowed), n=1, cutoff=0.5)
+    return f" (did you mean '{close[0]}'?)" if close else ""
+
+
+def load_toml(path: Path) -> dict[str, Any]:
+    """Parse a TOML file, turning I/O and syntax errors into :class:`InputError`."""
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise InputError(str(path), "", "file not found; give the path of a .toml file") from None
+    except OSError as err:
+        raise InputError(str(path), "", f"cannot be read ({err.strerror})") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise InputError(str(path), "", f"is not valid TOML: {err}") from None
+
+
+_MISSING = object()
+
+
+class Table:
+    """One TOML table being read: typed accessors, then :meth:`finish` rejects leftovers.
+
+    Parameters
+    ----------
+    data : dict
+        The parsed table.
+    source : str
+        The file name, used in messages.
+    prefix : str
+        Dotted path of this table inside the file (``"gear[2]"``), used in messages.
+    """
+
+    def __init__(self, data: Any, source: str, prefix: str = ""):
+        if not isinstance(data, dict):
+            raise InputError(source, prefix or "(top level)", f"must be a table, got {data!r}")
+        self.data = data
+        self.source = source
+        self.prefix = prefix
+        self._seen: set[str] = set()
+
+    def key(self, name: str) -> str:
+        return f"{self.prefix}.{name}" if self.prefix else name
+
+    def error(self, name: str, message: str) -> InputError:
+        return InputError(self.source, self.key(name), message)
+
+    def has(self, name: str) -> bool:
+        return name in self.data
+
+    def _get(self, name: str, default: Any) -> Any:
+        self._seen.add(name)
+        if name in self.data:
+            return self.data[name]
+        if default is _MISSING:
+            raise self.error(name, "is required but missing")
+        return default
+
+    def number(
+        self,
+        name: str,
+        default: Any = _MISSING,
+        *,
+        low: float | None = None,
+        high: float | None = None,
+        low_open: bool = False,
+        high_open: bool = False,
+    ) -> float:
+        """A finite real number in ``[low, high]`` (open ends as flagged)."""
+        value = self._get(name, default)
+        if value is None:
+            return value
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise self.error(name, f"must be a number, got {value!r}")
+        value = float(value)
+        if not math.isfinite(value):
+            raise self.error(name, f"must be finite, got {value!r}")
+        if low is not None and (value < low or (low_open and value == low)):
+            sign = ">" if low_open else ">="
+            raise self.error(name, f"must be {sign} {low:g}, got {value:g}")
+        if high is not None and (value > high or (high_open and value == high)):
+            sign = "<" if high_open else "<="
+            raise self.error(name, f"must be {sign} {high:g}, got {value:g}")
+        return value
+
+    def integer(self, name: str, default: Any = _MISSING, *, low: int | None = None,
+                high: int | None = None) -> int:
+        value = self._get(name, default)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise self.error(name, f"must be a whole number, got {value!r}")
+        if low is not None and value < low:
+            raise self.error(name, f"must be >= {low}, got {value}")
+        if high is not None and value > high:
+            raise self.error(name, f"must be <= {high}, got {value}")
+        return value
+
+    def string(self, name: str, default: Any = _MISSING, *,
+               choices: Iterable[str] | None = None) -> str:
+        value = self._get(name, default)
+        if value is None:
+            return value
+        if not isinstance(value, str):
+            raise self.error(name, f"must be a string, got {value!r}")
+        if choices is not None:
+            choices = list(choices)
+            if value not in choices:
+                raise self.error(
+                    name,
+                    f"'{value}' is not one of {', '.join(repr(c) for c in choices)}"
+                    + nearest(value, choices),
+                )
+        return value
+
+    def boolean(self, name: str, default: Any = _MISSING) -> bool:
+        value = self._get(name, default)
+        if not isinstance(value, bool):
+            raise self.error(name, f"must be true or false, got {value!r}")
+        return value
+
+    def numbers(self, name: str, default: Any = _MISSING, *, length: int | None = None,
+                low: float | None = None) -> tuple[float, ...]:
+        value = self._get(name, default)
+        if not isinstance(value, list | tuple) or not all(
+            isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+            for v in value
+        ):
+            raise self.error(name, f"must be a list of finite numbers, got {value!r}")
+        if length is not None and len(value) != length:
+            raise self.error(name, f"must have {length} entries, got {len(value)}")
+        if low is not None and any(v < low for v in value):
+            raise self.error(name, f"entries must be >= {low:g}, got {list(value)}")
+        return tuple(float(v) for v in value)
+
+    def table(self, name: str, default: Any = _MISSING) -> Table | None:
+        value = self._get(name, default)
+        if value is None:
+            return None
+        return Table(value, self.source, self.key(name))
+
+    def tables(self, name: str) -> list[Table]:
+        """An array of tables ``[[name]]`` (required, non-empty)."""
+        value = self._get(name, _MISSING)
+        if not isinstance(value, list) or not value:
+            raise self.error(name, "must be a non-empty array of tables ([[...]] entries)")
+        return [Table(v, self.source, f"{self.key(name)}[{i}]") for i, v in enumerate(value)]
+
+    def raw(self, name: str, default: Any = _MISSING) -> Any:
+        return self._get(name, default)
+
+    def finish(self, allowed_extra: Iterable[str] = ()) -> None:
+        """Reject any key that was not read (with the nearest valid name)."""
+        known = self._seen | set(allowed_extra)
+        for name in self.data:
+            if name not in known:
+                raise self.error(
+                    name,
+                    "unknown key" + nearest(name, known)
+                    + f"; allowed keys: {', '.join(sorted(known))}",
+                )
+
+
+_KEYWORD = re.compile(r"\b(?:" + "|".join(keyword.kwlist) + r")\b")
+
+_BINARY: dict[type, Callable[[float, float], float]] = {
+    ast.Add: operator.add,
+    ast.Sub: operator.sub,
+    ast.Mult: operator.mul,
+    ast.Div: operator.truediv,
+    ast.Pow: operator.pow,
+}
+
+
+def parse_expression(text: str, names: dict[str, float], *, source: str, key: str) -> float:
+    """Evaluate an arithmetic expression of named scene parameters, safely.
+
+    Only numbers, the given names, ``+ - * / **``, unary signs and parentheses are
+    allowed; nothing is executed.  ``"-lambda*f1"`` with ``lambda=0.1, f1=0.5`` gives -0.05.
+    """
+    if isinstance(text, bool):
+        raise InputError(source, key, f"must be a number or an expression, got {text!r}")
+    if isinstance(text, int | float):
+        return float(text)
+    if not isinstance(text, str):
+        raise InputError(source, key, f"must be a number or an expression, got {text!r}")
+    # Scene parameters may be named like Python keywords ("lambda"): rename before parsing.
+    mangled = _KEYWORD.sub(lambda mo: mo.group(0) + "__kw", text)
+    try:
+        tree = ast.parse(mangled, mode="eval")
+    except SyntaxError:
+        raise InputError(source, key, f"'{text}' is not an arithmetic expression") from None
+
+    def walk(node: ast.AST) -> float:
+        if isinstance(node, ast.Expression):
+            return walk(node.body)
+        if isinstance(node, ast.Constant) and isinstance(node.value, int | float) \
+                and not isinstance(node.value, bool):
+            return float(node.value)
+        if isinstance(node, ast.Name):
+            name = node.id.removesuffix("__kw") if node.id.endswith("__kw") else node.id
+            if name not in names:
+                raise InputError(
+                    source, key,
+                    f"'{name}' in '{text}' is not a scene parameter" + nearest(name, names)
+                    + f"; parameters: {', '.join(sorted(names))}",
+                )
+            return float(names[name])
+        if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):
+            value = walk(node.operand)
+            return -value if isinstance(node.op, ast.USub) else value
+        if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
+            try:
+                return _BINARY[type(node.op)](walk(node.left), walk(node.right))
+            except ZeroDivisionError:
+                raise InputError(source, key, f"'{text}' divides by zero") from None
+        raise InputError(
+            source, key,
+            f"'{text}' may use only numbers, scene parameters, + - * / ** and parentheses",
+        )
+
+    value = walk(tree)
+    if not math.isfinite(value):
+        raise InputError(source, key, f"'{text}' evaluates to {value}")
+    return value

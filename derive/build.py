@@ -1,0 +1,165 @@
+"""The derivation pipeline: targets -> models -> files, and the staleness check.
+
+``build_files(paths)`` derives each target (a scene, or a topology with its default scene)
+and returns the text of every file it owns, keyed by the path relative to the project
+root: ``generated/<name>.py`` and ``docs/derivation/<name>.md``, plus
+``docs/derivation.md`` when the shipped set is built.  ``check(root)`` rebuilds the
+shipped set in memory and lists every file that differs from what is on disk.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+from .audit import audit_page, index_page
+from .emit import emit_module, operation_count, write_atomic
+from .model import Model, derive_model
+from .scene import builtin_root, load_target
+
+__all__ = ["Built", "build_files", "check", "describe", "project_root", "shipped_targets",
+           "write_files"]
+
+
+def project_root() -> Path:
+    """The folder holding ``derive/``, ``generated/`` and ``docs/`` (the checkout)."""
+    return Path(__file__).resolve().parent.parent
+
+
+def shipped_targets() -> list[Path]:
+    """Built-in scenes, then built-in topologies, in name order."""
+    root = builtin_root()
+    return sorted(root.glob("*.toml")) + sorted((root / "topologies").glob("*.toml"))
+
+
+def _display(path: Path) -> str:
+    p = Path(path).resolve()
+    try:
+        return p.relative_to(project_root()).as_posix()
+    except ValueError:
+        return str(path)
+
+
+@dataclass(frozen=True)
+class Built:
+    models: tuple[Model, ...]
+    files: dict[str, str]
+
+
+def build_files(paths: list[Path], *, index: bool = False,
+                overrides: dict[str, float] | None = None) -> Built:
+    """Derive every target in ``paths``; return the models and the files' text."""
+    models, files = [], {}
+    for path in paths:
+        scene = load_target(path, overrides)
+        model = derive_model(scene)
+        command = f"gearsym derive {_display(path)}"
+        files[f"generated/{model.name}.py"] = emit_module(model, command)
+        files[f"docs/derivation/{model.name}.md"] = audit_page(model, command)
+        models.append(model)
+    names = [m.name for m in models]
+    if len(set(names)) != len(names):
+        dup = sorted({n for n in names if names.count(n) > 1})
+        raise ValueError(f"two targets derive to the same model name: {', '.join(dup)}")
+    if index:
+        files["docs/derivation.md"] = index_page(models, "gearsym derive")
+    return Built(tuple(models), files)
+
+
+def write_files(files: dict[str, str], root: Path) -> list[Path]:
+    written = []
+    for rel, text in files.items():
+        path = Path(root) / rel
+        write_atomic(path, text)
+        written.append(path)
+    return written
+
+
+def check(root: Path | None = None) -> list[str]:
+    """Files under ``root`` that differ from a fresh regeneration of the shipped set."""
+    root = Path(root) if root is not None else project_root()
+    built = build_files(shipped_targets(), index=True)
+    stale = []
+    for rel, text in built.files.items():
+        path = root / rel
+        if not path.exists():
+            stale.append(f"{rel} (missing)")
+        elif path.read_text(encoding="utf-8") != text:
+            stale.append(f"{rel} (differs)")
+    owned = set(built.files)
+    for folder, pattern in (("generated", "*.py"), ("docs/derivation", "*.md")):
+        for path in sorted((root / folder).glob(pattern)):
+            rel = path.relative_to(root).as_posix()
+            if rel in owned or path.name == "__init__.py":
+                continue
+            head = path.read_text(encoding="utf-8", errors="replace")[:400]
+            if "gearsym derive scenes/" in head:
+                stale.append(f"{rel} (left over: its shipped source no longer exists)")
+    return stale
+
+
+def describe(model: Model) -> dict:
+    """Every number of the non-dimensional equations, as plain JSON-ready data."""
+    values = dict(zip(model.parameter_names, model.defaults, strict=True))
+    coords = model.coordinates
+    feats = model.features
+    H = feats.stiffness_harmonics
+    kappa = {}
+    for i, ci in enumerate(coords):
+        for j, cj in enumerate(coords):
+            mean = values.get(f"kappa_{ci}_{cj}")
+            if mean is None:
+                continue
+            kappa[f"{ci}{cj}"] = {
+                "mean": mean,
+                "cos": [mean * values[f"kc_{cj}_{h}"] for h in range(1, H + 1)],
+                "sin": [mean * values[f"ks_{cj}_{h}"] for h in range(1, H + 1)],
+                "phase_rad": values.get(f"phi_{cj}", 0.0),
+                "frequency_ratio": str(model.frequency_ratios[j]),
+            }
+    xi = {f"{ci}{cj}": values[f"xi_{ci}_{cj}"] for ci in coords for cj in coords
+          if f"xi_{ci}_{cj}" in values}
+    te = {}
+    for c in coords:
+        amps = [v for k, v in values.items() if k.startswith(f"E_{c}_")]
+        if amps:
+            te[c] = {"amplitude": amps,
+                     "phase_rad": [v for k, v in values.items() if k.startswith(f"psi_{c}_")]}
+    b = feats.backlash
+    backlash = {"kind": b.kind, "valid_range": b.valid_range}
+    if b.kind == "polynomial":
+        backlash.update(order=b.order, fit_samples=b.samples,
+                        coefficients={str(k): c for k, c in zip(b.powers, b.coefficients,
+                                                                strict=True)},
+                        max_error_vs_dead_zone=b.max_error())
+    elif b.kind == "smooth":
+        backlash.update(width=b.width, max_error_vs_dead_zone=b.max_error())
+    return {
+        "name": model.name,
+        "scene": model.scene.name,
+        "source": _display(Path(model.scene.source)),
+        "inputs_sha256": model.inputs_hash,
+        "equation": "u_i'' + sum_j 2 xi_ij u_j' + sum_j kappa_ij(tau) g(u_j) = f_i + ebar_i''",
+        "states": list(model.states),
+        "parameters": values,
+        "omega": values["omega"],
+        "f": {c: values[f"f_{c}"] for c in coords},
+        "xi": xi,
+        "kappa": kappa,
+        "kappa_form": "kappa_ij(tau) = mean + sum_h cos_h cos(h(r w tau - phase)) + "
+                      "sin_h sin(h(r w tau - phase)), r = frequency_ratio, w = omega",
+        "transmission_error": te,
+        "transmission_error_form": "ebar_j(tau) = sum_h amplitude_h cos(h(r w tau - phase_j)"
+                                   " + phase_h)",
+        "backlash": backlash,
+        "features": feats.describe() | {"backlash": b.kind},
+        "scales": model.scales,
+        "operations": {"rhs": operation_count(model.rhs),
+                       "rhs_and_jacobian": operation_count(list(model.rhs)
+                                                           + list(model.jacobian))},
+    }
+
+
+def describe_json(models) -> str:
+    return json.dumps({m.name: describe(m) for m in models}, indent=2, sort_keys=False)

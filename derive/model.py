@@ -1,0 +1,249 @@
+"""The immutable non-dimensional Model of one scene.
+
+``derive_model(scene)`` runs the whole derivation (Newton -> reduced -> non-dimensional)
+and returns a :class:`Model`: first-order right-hand side ``dX/dtau = F(tau, X, p)`` and
+its state Jacobian as SymPy expressions, the ordered state and parameter names, the
+scene's parameter values, the scales, and the derivation objects for the audit.
+
+State order: the mesh coordinates ``u_1..u_m`` in mesh order, then their derivatives
+``du_1..du_m``.  Parameter order (only the ones the features need):
+
+1. ``omega`` -- excitation frequency of the reference mesh over ``omega_n``;
+2. ``f_<i>`` -- static load of each coordinate;
+3. ``xi_<i>_<j>`` -- damping coefficients (off-diagonal only with damping coupling);
+4. ``kappa_<i>_<j>`` -- mean stiffness coefficients ``K_ij`` (structural zeros omitted);
+5. ``kc_<j>_<h>``, ``ks_<j>_<h>`` -- stiffness harmonics of mesh j over its mean;
+6. ``phi_<j>`` -- stiffness/TE phase lag of mesh j (mesh phase on, non-reference meshes);
+7. ``E_<j>_<h>``, ``psi_<j>_<h>`` -- transmission-error harmonics over ``b_j``, and phases;
+8. backlash parameters (``g1, g3, ...`` or ``eps_g``).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from dataclasses import dataclass, field
+
+import sympy as sp
+
+from . import __version__
+from .equations import derive_equations
+from .nondim import NonDim, nondimensionalise
+from .scene import Features, Scene
+
+__all__ = ["Model", "Parameter", "derive_model"]
+
+
+@dataclass(frozen=True)
+class Parameter:
+    name: str
+    value: float
+    meaning: str
+    latex: str
+
+
+@dataclass(frozen=True)
+class Model:
+    """One scene's non-dimensional model (immutable)."""
+
+    name: str
+    scene: Scene
+    coordinates: tuple[str, ...]
+    states: tuple[str, ...]
+    parameters: tuple[Parameter, ...]
+    tau: sp.Symbol
+    state_symbols: tuple[sp.Symbol, ...]
+    parameter_symbols: tuple[sp.Symbol, ...]
+    rhs: tuple[sp.Expr, ...]
+    jacobian: sp.ImmutableMatrix
+    accelerations: tuple[sp.Expr, ...]
+    kappa_t: sp.ImmutableMatrix  # kappa_ij(tau) in parameter symbols
+    ebar: tuple[sp.Expr, ...]
+    nondim: NonDim
+    scales: dict
+    frequency_ratios: tuple[sp.Rational, ...]
+    inputs_hash: str
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def features(self) -> Features:
+        return self.scene.features
+
+    @property
+    def parameter_names(self) -> tuple[str, ...]:
+        return tuple(p.name for p in self.parameters)
+
+    @property
+    def defaults(self) -> tuple[float, ...]:
+        return tuple(p.value for p in self.parameters)
+
+    @property
+    def valid_range(self) -> float | None:
+        return self.features.backlash.valid_range
+
+
+def _inputs_hash(scene: Scene) -> str:
+    """sha256 of everything the generated files depend on: the input files' parsed
+    contents (scene and topology), the resolved parameters, the generator's version and
+    SymPy's (term order in the emitted code may change with SymPy)."""
+    import tomllib
+    from pathlib import Path
+
+    payload = {"gearsym": __version__, "sympy": sp.__version__,
+               "parameters": scene.parameters, "kind": scene.kind}
+    for key, path in (("scene", scene.source), ("topology", scene.topology.source)):
+        payload[key] = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    text = json.dumps(payload, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def derive_model(scene: Scene, name: str | None = None) -> Model:
+    """Derive the non-dimensional model of ``scene`` (see module docstring)."""
+    topo = scene.topology
+    feats = scene.features
+    eq = derive_equations(topo)
+    nd = nondimensionalise(topo, scene.damping_ratio, eq)
+    meshes = topo.meshes
+    m = len(meshes)
+    coords = tuple(me.coordinate for me in meshes)
+    tau = sp.Symbol("tau", real=True)
+    u = tuple(sp.Symbol(c, real=True) for c in coords)
+    du = tuple(sp.Symbol(f"d{c}", real=True) for c in coords)
+    ratios = topo.mesh_frequency_ratios()
+    freq = tuple(sp.Rational(ratios[me.id].numerator, ratios[me.id].denominator)
+                 for me in meshes)
+
+    params: list[Parameter] = []
+
+    def param(name: str, value: float, meaning: str, latex: str) -> sp.Symbol:
+        if not math.isfinite(value):
+            raise ValueError(f"parameter {name} = {value} is not finite")
+        params.append(Parameter(name, float(value), meaning, latex))
+        return sp.Symbol(name, real=True)
+
+    omega = param("omega", scene.omega, "excitation (mesh) frequency of the reference mesh "
+                  "over omega_n", r"\bar\omega")
+    # Static loads.
+    if scene.loads is not None:
+        f_values = [scene.loads[c] for c in coords]
+        f_meaning = "static load (from the scene's [loads])"
+    else:
+        f_values = [nd.value(nd.load[i]) for i in range(m)]
+        f_meaning = "static load (from the topology's torques)"
+    f = tuple(param(f"f_{c}", f_values[i], f_meaning, f"f_{{{c}}}") for i, c in enumerate(coords))
+
+    xi = {}
+    for i in range(m):
+        for j in range(m):
+            if nd.xi[i, j] == 0 or (i != j and not feats.damping_coupling):
+                continue
+            xi[i, j] = param(f"xi_{coords[i]}_{coords[j]}", nd.value(nd.xi[i, j]),
+                             f"damping coefficient of d{coords[j]} in the {coords[i]} equation",
+                             rf"\xi_{{{coords[i]}{coords[j]}}}")
+    kappa = {}
+    for i in range(m):
+        for j in range(m):
+            if nd.kappa[i, j] == 0:
+                continue
+            kappa[i, j] = param(f"kappa_{coords[i]}_{coords[j]}", nd.value(nd.kappa[i, j]),
+                                f"mean stiffness coefficient of g({coords[j]}) in the "
+                                f"{coords[i]} equation", rf"K_{{{coords[i]}{coords[j]}}}")
+    H = feats.stiffness_harmonics
+    kc, ks = {}, {}
+    for j, me in enumerate(meshes):
+        cs, ss = me.stiffness.normalised(H)
+        for h in range(1, H + 1):
+            kc[j, h] = param(f"kc_{coords[j]}_{h}", cs[h - 1],
+                             f"cosine stiffness harmonic {h} of mesh {me.id} over its mean",
+                             rf"\alpha_{{{coords[j]},{h}}}")
+            ks[j, h] = param(f"ks_{coords[j]}_{h}", ss[h - 1],
+                             f"sine stiffness harmonic {h} of mesh {me.id} over its mean",
+                             rf"\beta_{{{coords[j]},{h}}}")
+    phi = {}
+    if feats.mesh_phase:
+        for j, me in enumerate(meshes[1:], start=1):
+            phi[j] = param(f"phi_{coords[j]}", me.phase,
+                           f"stiffness/TE phase lag of mesh {me.id}, rad ({me.phase_source})",
+                           rf"\varphi_{{{coords[j]}}}")
+    te_amp, te_phase = {}, {}
+    if feats.transmission_error:
+        for j, me in enumerate(meshes):
+            te = me.transmission_error
+            if not any(a != 0 for a in te.amplitudes):
+                continue
+            for h, (a, ph) in enumerate(zip(te.amplitudes, te.phases, strict=True), start=1):
+                te_amp[j, h] = param(f"E_{coords[j]}_{h}", a / me.half_backlash,
+                                     f"transmission-error harmonic {h} of mesh {me.id} over "
+                                     "its half backlash", rf"E_{{{coords[j]},{h}}}")
+                te_phase[j, h] = param(f"psi_{coords[j]}_{h}", ph,
+                                       f"transmission-error phase {h} of mesh {me.id}, rad",
+                                       rf"\psi_{{{coords[j]},{h}}}")
+    backlash_params = {name: param(name, value, meaning, _latex_backlash(name))
+                       for name, value, meaning in feats.backlash.parameters()}
+    del backlash_params  # the expression refers to them by name
+
+    # Assemble the non-dimensional equations.
+    phase_arg = [freq[j] * omega * tau - phi.get(j, 0) for j in range(m)]
+    khat = [1 + sum(kc[j, h] * sp.cos(h * phase_arg[j]) + ks[j, h] * sp.sin(h * phase_arg[j])
+                    for h in range(1, H + 1)) for j in range(m)]
+    ebar = tuple(sum((te_amp[j, h] * sp.cos(h * phase_arg[j] + te_phase[j, h])
+                      for (jj, h) in te_amp if jj == j), sp.Integer(0)) for j in range(m))
+    gexpr = [feats.backlash.expression(u[j]) for j in range(m)]
+    kappa_t = sp.ImmutableMatrix(m, m, lambda i, j: kappa[i, j] * khat[j]
+                                 if (i, j) in kappa else 0)
+    acc = tuple(
+        f[i] + sp.diff(ebar[i], tau, 2)
+        - sum(2 * xi[i, j] * du[j] for j in range(m) if (i, j) in xi)
+        - sum(kappa_t[i, j] * gexpr[j] for j in range(m) if (i, j) in kappa)
+        for i in range(m)
+    )
+    states = coords + tuple(f"d{c}" for c in coords)
+    state_symbols = u + du
+    rhs = du + acc
+    jac = sp.ImmutableMatrix(rhs).jacobian(state_symbols)
+
+    names = [p.name for p in params]
+    known = set(state_symbols) | {sp.Symbol(n, real=True) for n in names} | {tau}
+    stray = set().union(*(e.free_symbols for e in rhs)) - known
+    if stray:
+        raise AssertionError(f"right-hand side uses undeclared symbols {sorted(map(str, stray))}")
+    clash = set(names) & set(states)
+    if clash or len(set(names)) != len(names):
+        raise ValueError(f"name clash between states and parameters: {sorted(clash)}")
+
+    om = nd.value(nd.omega_n_expr)
+    scales = {
+        "omega_n_rad_per_s": om,
+        "time_unit_s": 1.0 / om,
+        "half_backlash_m": {me.coordinate: me.half_backlash for me in meshes},
+        "mean_stiffness_N_per_m": {me.coordinate: me.stiffness.mean for me in meshes},
+        "damping_N_s_per_m": {me.coordinate: nd.value(nd.damping_expr[j])
+                              for j, me in enumerate(meshes)},
+        "mesh_frequency_ratio": {me.coordinate: str(freq[j]) for j, me in enumerate(meshes)},
+    }
+    return Model(
+        name=name or scene.name.replace("-", "_"),
+        scene=scene,
+        coordinates=coords,
+        states=states,
+        parameters=tuple(params),
+        tau=tau,
+        state_symbols=state_symbols,
+        parameter_symbols=tuple(sp.Symbol(n, real=True) for n in names),
+        rhs=tuple(rhs),
+        jacobian=jac,
+        accelerations=acc,
+        kappa_t=kappa_t,
+        ebar=ebar,
+        nondim=nd,
+        scales=scales,
+        frequency_ratios=freq,
+        inputs_hash=_inputs_hash(scene),
+    )
+
+
+def _latex_backlash(name: str) -> str:
+    if name == "eps_g":
+        return r"\varepsilon_g"
+    return f"a_{{{name[1:]}}}"

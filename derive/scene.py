@@ -1,0 +1,251 @@
+"""Scenes: one analysis set-up -- a topology, the model features and the parameter values.
+
+A scene names the features the model must carry; the derivation emits only their terms:
+
+* ``stiffness_harmonics`` -- how many harmonics of each mesh stiffness to keep (0 gives
+  constant stiffness and no time-varying stiffness code);
+* ``backlash`` -- ``linear``, ``dead-zone``, ``smooth`` or ``polynomial`` (with
+  ``backlash_order``, ``backlash_range``, ``backlash_step``; or ``backlash_width``);
+* ``transmission_error``, ``mesh_phase``, ``damping_coupling`` -- on or off.
+
+``[parameters]`` holds named numbers: ``omega`` (the non-dimensional excitation
+frequency of the reference mesh, required), ``damping_ratio`` (required) and any others
+that ``[loads]`` uses.  ``[loads]`` gives the non-dimensional static load ``f_i`` of each
+mesh coordinate as a number or an arithmetic expression of the parameters (for the
+reference study ``u = "f1"`` and ``v = "-lambda*f1"``).  Without ``[loads]`` the loads
+come from the topology's torques.
+
+A topology file may be derived on its own: it then stands for a default scene with every
+feature on, 3 harmonics, the reference study's backlash polynomial, and ``omega`` and the
+damping ratio from its ``[operating]`` table.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ._input import InputError, Table, load_toml, parse_expression
+from .backlash import (
+    Backlash,
+    DeadZone,
+    LinearContact,
+    SmoothDeadZone,
+    fit_dead_zone,
+)
+from .topology import Topology, load_topology, parse_topology
+
+__all__ = ["Features", "Scene", "builtin_root", "load_scene", "load_target", "resolve_target"]
+
+
+def builtin_root() -> Path:
+    """Folder of the built-in scenes and topologies (``scenes/`` of the package)."""
+    from gearsym import scenes
+
+    return Path(scenes.__file__).parent
+
+
+@dataclass(frozen=True)
+class Features:
+    """Which terms the model carries."""
+
+    stiffness_harmonics: int = 3
+    backlash: Backlash = field(default_factory=lambda: fit_dead_zone())
+    transmission_error: bool = True
+    mesh_phase: bool = True
+    damping_coupling: bool = True
+
+    def describe(self) -> dict:
+        return {
+            "stiffness_harmonics": self.stiffness_harmonics,
+            "backlash": self.backlash.describe(),
+            "transmission_error": self.transmission_error,
+            "mesh_phase": self.mesh_phase,
+            "damping_coupling": self.damping_coupling,
+        }
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A resolved scene: everything the derivation needs, validated.
+
+    ``loads`` maps each mesh coordinate to its non-dimensional static load, or is None
+    when the loads come from the topology's torques.
+    """
+
+    name: str
+    description: str
+    topology: Topology
+    features: Features
+    parameters: dict[str, float]
+    loads: dict[str, float] | None
+    load_expressions: dict[str, str] | None
+    source: str
+    kind: str = "scene"  # "scene" or "topology" (a topology derived with default features)
+
+    @property
+    def omega(self) -> float:
+        return self.parameters["omega"]
+
+    @property
+    def damping_ratio(self) -> float:
+        return self.parameters["damping_ratio"]
+
+
+def _features(t: Table | None) -> Features:
+    if t is None:
+        return Features()
+    harmonics = t.integer("stiffness_harmonics", 3, low=0, high=64)
+    kind = t.string("backlash", "polynomial",
+                    choices=("linear", "dead-zone", "smooth", "polynomial"))
+    backlash: Backlash
+    if kind == "polynomial":
+        order = t.integer("backlash_order", 7, low=1, high=31)
+        if order % 2 == 0:
+            raise t.error("backlash_order", f"must be odd (the dead zone is odd), got {order}")
+        fit_range = t.number("backlash_range", 3.0, low=1.0, low_open=True, high=100.0)
+        step = t.number("backlash_step", 0.01, low=0.0)
+        try:
+            backlash = fit_dead_zone(order, fit_range, step if step > 0 else None)
+        except ValueError as err:
+            raise t.error("backlash_step", str(err)) from None
+    elif kind == "smooth":
+        backlash = SmoothDeadZone(t.number("backlash_width", 0.05, low=0, low_open=True,
+                                           high=1.0))
+    elif kind == "dead-zone":
+        backlash = DeadZone()
+    else:
+        backlash = LinearContact()
+    features = Features(
+        stiffness_harmonics=harmonics,
+        backlash=backlash,
+        transmission_error=t.boolean("transmission_error", True),
+        mesh_phase=t.boolean("mesh_phase", True),
+        damping_coupling=t.boolean("damping_coupling", True),
+    )
+    t.finish()
+    return features
+
+
+def resolve_target(name: str, *, kind: str | None = None) -> Path:
+    """A path, or the name of a built-in scene or topology, to a file path."""
+    path = Path(name)
+    if path.suffix == ".toml" or path.exists():
+        return path
+    root = builtin_root()
+    candidates = []
+    if kind in (None, "scene"):
+        candidates.append(root / f"{name}.toml")
+    if kind in (None, "topology"):
+        candidates.append(root / "topologies" / f"{name}.toml")
+    for c in candidates:
+        if c.exists():
+            return c
+    known = sorted(p.stem for p in root.glob("*.toml")) + sorted(
+        p.stem for p in (root / "topologies").glob("*.toml"))
+    from ._input import nearest
+
+    raise InputError(name, "", "is neither a file nor a built-in scene or topology"
+                     + nearest(name, known) + f"; built-in: {', '.join(known)}")
+
+
+def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> Scene:
+    """Read and validate a scene file (``overrides`` replace ``[parameters]`` values)."""
+    path = Path(path)
+    data = load_toml(path)
+    source = str(path)
+    top = Table(data, source)
+    head = top.table("scene")
+    name = head.string("name")
+    description = head.string("description", "")
+    topo_ref = head.string("topology")
+    head.finish()
+    topo_path = path.parent / topo_ref
+    if not topo_path.exists():
+        try:
+            topo_path = resolve_target(topo_ref, kind="topology")
+        except InputError:
+            raise head.error("topology", f"'{topo_ref}' is neither a file next to the scene "
+                                         "nor a built-in topology") from None
+    topology = load_topology(topo_path)
+    features = _features(top.table("features", None))
+
+    pt = top.table("parameters")
+    parameters: dict[str, float] = {}
+    for key in pt.data:
+        parameters[key] = pt.number(key)
+    pt.finish()
+    for required in ("omega", "damping_ratio"):
+        if required not in parameters:
+            raise pt.error(required, "is required but missing")
+    for key, value in (overrides or {}).items():
+        if key not in parameters:
+            from ._input import nearest
+
+            raise InputError(source, f"parameters.{key}", "cannot be set: not a parameter of "
+                             "this scene" + nearest(key, parameters))
+        parameters[key] = float(value)
+    _check_parameters(pt, parameters)
+
+    loads = expressions = None
+    lt = top.table("loads", None)
+    if lt is not None:
+        coords = [m.coordinate for m in topology.meshes]
+        loads, expressions = {}, {}
+        for key in lt.data:
+            if key not in coords:
+                from ._input import nearest
+
+                raise lt.error(key, "is not a mesh coordinate of topology "
+                                    f"'{topology.name}'" + nearest(key, coords)
+                                    + f"; coordinates: {', '.join(coords)}")
+        for c in coords:
+            raw = lt.raw(c)
+            loads[c] = parse_expression(raw, parameters, source=source, key=lt.key(c))
+            expressions[c] = str(raw)
+        lt.finish()
+    elif not topology.torques:
+        raise InputError(source, "loads", "is missing and the topology has no [[torque]]; "
+                                          "give the non-dimensional load of every coordinate")
+    top.finish()
+    return Scene(name, description, topology, features, parameters, loads, expressions, source)
+
+
+def _check_parameters(t: Table, parameters: dict[str, float]) -> None:
+    if not parameters["omega"] > 0:
+        raise t.error("omega", f"must be > 0, got {parameters['omega']:g}")
+    if not 0 <= parameters["damping_ratio"] <= 1:
+        raise t.error("damping_ratio", f"must be in [0, 1], got {parameters['damping_ratio']:g}")
+
+
+def load_target(path: Path | str, overrides: dict[str, float] | None = None) -> Scene:
+    """A scene file, or a topology file wrapped in its default scene."""
+    path = Path(path)
+    data = load_toml(path)
+    if "topology" in data and "scene" not in data:
+        topology = parse_topology(data, str(path))
+        if topology.operating is None:
+            raise InputError(str(path), "operating", "a topology derived on its own needs an "
+                             "[operating] table (gear, speed_rpm, damping_ratio) to set omega "
+                             "and the damping; or derive a scene that uses it")
+        if not topology.torques:
+            raise InputError(str(path), "torque", "a topology derived on its own needs "
+                             "[[torque]] entries for its loads; or derive a scene that uses it")
+        from .nondim import natural_frequency
+
+        omega = topology.reference_mesh_frequency() / natural_frequency(topology)
+        parameters = {"omega": omega, "damping_ratio": topology.operating.damping_ratio}
+        for key, value in (overrides or {}).items():
+            if key not in parameters:
+                raise InputError(str(path), key, "cannot be set on a topology; parameters: "
+                                 "omega, damping_ratio")
+            parameters[key] = float(value)
+        if not math.isfinite(omega):
+            raise InputError(str(path), "operating", "gives a non-finite omega")
+        return Scene(topology.name, topology.description, topology, Features(), parameters,
+                     None, None, str(path), kind="topology")
+    if "scene" not in data:
+        raise InputError(str(path), "", "is neither a scene (no [scene] table) nor a topology "
+                                        "(no [topology] table)")
+    return load_scene(path, overrides)

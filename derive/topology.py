@@ -1,0 +1,370 @@
+"""Gear-train topology as data: gears, meshes, external torques, operating point.
+
+A topology file is TOML with unit-suffixed keys (``_mm``, ``_deg``, ``_um``, ``_Nm``,
+``_kg_m2``, ``_N_per_m``, ``_Pa``, ``_kg_m3``, ``_rpm``); everything is converted to SI
+(m, rad, N, kg, s) on load and validated.  See ``docs/user-guide.md`` for the full list
+of keys.  Each rotating body is one gear; inertia attached to a gear (a flywheel, a
+coupling) is lumped with it.  Every rotation and torque is counted positive in the
+gear's own operating direction: a driving torque is positive, a load torque negative.  The meshes must form a tree over the gears (every gear
+reachable, no closed loop), so that the ``m`` mesh coordinates and one rigid-body
+rotation describe the ``m + 1`` gears exactly.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from fractions import Fraction
+from pathlib import Path
+
+from ._input import InputError, Table, load_toml, nearest
+from .geometry import GearGeometry, PairGeometry, gear_geometry, pair_geometry
+from .stiffness import MeshStiffness, contact_line_stiffness
+
+__all__ = ["Gear", "Material", "Mesh", "Operating", "Topology", "TransmissionError",
+           "load_topology", "parse_topology"]
+
+_IDENT = re.compile(r"^[A-Za-z][A-Za-z0-9]*$")
+# Names the generated code uses itself; coordinates may not take them.
+_RESERVED = {"tau", "x", "p", "np", "ca", "omega", "out", "jac", "rhs"}
+
+
+@dataclass(frozen=True)
+class Material:
+    name: str
+    youngs_modulus: float  # Pa
+    poisson_ratio: float
+    density: float  # kg/m^3
+
+
+@dataclass(frozen=True)
+class Gear:
+    """One rotating body: a helical gear and any inertia lumped with it (SI units)."""
+
+    id: str
+    teeth: int
+    normal_module: float
+    normal_pressure_angle: float
+    helix_angle: float
+    face_width: float
+    profile_shift: float
+    material: Material
+    bore_radius: float
+    inertia_given: float | None
+    attached_inertia: float
+    geometry: GearGeometry
+
+    @property
+    def blank_inertia(self) -> float:
+        """Solid cylinder of pitch radius r with a bore: ``rho pi b (r^4 - r_bore^4) / 2``."""
+        r, rb = self.geometry.pitch_radius, self.bore_radius
+        return 0.5 * self.material.density * math.pi * self.face_width * (r**4 - rb**4)
+
+    @property
+    def gear_inertia(self) -> float:
+        return self.inertia_given if self.inertia_given is not None else self.blank_inertia
+
+    @property
+    def inertia(self) -> float:
+        """Total polar moment of inertia of the body, kg m^2."""
+        return self.gear_inertia + self.attached_inertia
+
+    @property
+    def base_radius(self) -> float:
+        return self.geometry.base_radius
+
+
+@dataclass(frozen=True)
+class TransmissionError:
+    """Composite transmission error ``e(t) = sum_h a_h cos(h we t + phase_h)`` (m, rad)."""
+
+    amplitudes: tuple[float, ...] = ()
+    phases: tuple[float, ...] = ()
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """One gear pair.  ``driver`` pushes ``driven``; the coordinate is positive when the
+    driver's working flanks are loaded (forward meshing)."""
+
+    id: str
+    driver: str
+    driven: str
+    coordinate: str
+    half_backlash: float
+    stiffness: MeshStiffness
+    transmission_error: TransmissionError
+    phase: float  # stiffness/TE phase lag relative to the reference mesh, rad
+    phase_source: str
+    pair: PairGeometry
+
+
+@dataclass(frozen=True)
+class Operating:
+    gear: str
+    speed: float  # rad/s
+    damping_ratio: float
+
+
+@dataclass(frozen=True)
+class Topology:
+    name: str
+    description: str
+    gears: tuple[Gear, ...]
+    meshes: tuple[Mesh, ...]
+    torques: dict[str, float] = field(default_factory=dict)  # N m, on gears
+    operating: Operating | None = None
+    source: str = ""
+
+    def gear(self, gear_id: str) -> Gear:
+        return next(g for g in self.gears if g.id == gear_id)
+
+    @property
+    def reference(self) -> Mesh:
+        """The mesh whose natural frequency and time origin set the scales (the first)."""
+        return self.meshes[0]
+
+    def speed_ratios(self, gear_id: str) -> dict[str, Fraction]:
+        """|w_gear| / |w_(gear_id)| for every gear, exact, from the mesh tree.
+
+        Across a mesh ``|w_driven| = |w_driver| z_driver / z_driven``.
+        """
+        speed = {gear_id: Fraction(1)}
+        pending = list(self.meshes)
+        while pending:
+            for m in list(pending):
+                zd, zn = self.gear(m.driver).teeth, self.gear(m.driven).teeth
+                if m.driver in speed:
+                    speed[m.driven] = speed[m.driver] * Fraction(zd, zn)
+                elif m.driven in speed:
+                    speed[m.driver] = speed[m.driven] * Fraction(zn, zd)
+                else:
+                    continue
+                pending.remove(m)
+        return speed
+
+    def mesh_frequency_ratios(self) -> dict[str, Fraction]:
+        """Mesh frequency ``z_driver |w_driver|`` of each mesh over the reference mesh's."""
+        ref = self.reference
+        speed = self.speed_ratios(ref.driver)
+        f_ref = self.gear(ref.driver).teeth * speed[ref.driver]
+        return {m.id: self.gear(m.driver).teeth * speed[m.driver] / f_ref for m in self.meshes}
+
+    def reference_mesh_frequency(self) -> float | None:
+        """Mesh frequency of the reference mesh at the operating speed, rad/s."""
+        if self.operating is None:
+            return None
+        ref = self.reference
+        speed = self.speed_ratios(self.operating.gear)
+        return float(self.gear(ref.driver).teeth * speed[ref.driver]) * self.operating.speed
+
+
+def _ident(t: Table, name: str) -> str:
+    value = t.string(name)
+    if not _IDENT.match(value):
+        raise t.error(name, f"'{value}' must be a name of letters and digits starting with a "
+                            "letter (it becomes a Python identifier)")
+    return value
+
+
+def _material(t: Table, name: str) -> Material:
+    return Material(
+        name=name,
+        youngs_modulus=t.number("youngs_modulus_Pa", low=0, low_open=True),
+        poisson_ratio=t.number("poisson_ratio", low=0, high=0.5, high_open=True),
+        density=t.number("density_kg_m3", low=0, low_open=True),
+    )
+
+
+_STEEL = Material("steel", 2.06e11, 0.3, 7850.0)
+
+
+def _gear(t: Table, materials: dict[str, Material]) -> Gear:
+    gid = _ident(t, "id")
+    teeth = t.integer("teeth", low=5)
+    mn = t.number("normal_module_mm", low=0, low_open=True) * 1e-3
+    alpha_n = math.radians(t.number("normal_pressure_angle_deg", 20.0, low=10.0, high=35.0))
+    beta = math.radians(t.number("helix_angle_deg", 0.0, low=-45.0, high=45.0))
+    width = t.number("face_width_mm", low=0, low_open=True) * 1e-3
+    shift = t.number("profile_shift", 0.0, low=-1.0, high=1.5)
+    mat_name = t.string("material", "steel")
+    if mat_name not in materials:
+        raise t.error("material", f"'{mat_name}' is not defined" + nearest(mat_name, materials)
+                      + f"; materials: {', '.join(sorted(materials))}")
+    geometry = gear_geometry(teeth, mn, alpha_n, beta, shift)
+    bore = t.number("bore_radius_mm", 0.0, low=0.0) * 1e-3
+    if bore >= geometry.root_radius:
+        raise t.error("bore_radius_mm", f"{bore * 1e3:g} mm must be below the root radius "
+                                        f"{geometry.root_radius * 1e3:.3f} mm")
+    inertia = t.number("inertia_kg_m2", None, low=0, low_open=True)
+    attached = t.number("attached_inertia_kg_m2", 0.0, low=0.0)
+    t.finish()
+    return Gear(gid, teeth, mn, alpha_n, beta, width, shift, materials[mat_name], bore,
+                inertia, attached, geometry)
+
+
+def _stiffness(t: Table, pair: PairGeometry) -> MeshStiffness:
+    source = t.string("source", choices=("harmonics", "contact-line"))
+    mean = t.number("mean_N_per_m", low=0, low_open=True)
+    if source == "harmonics":
+        cos = t.numbers("cos_N_per_m", [])
+        sin = t.numbers("sin_N_per_m", [])
+        if len(cos) != len(sin):
+            raise t.error("sin_N_per_m", f"needs as many entries as cos_N_per_m ({len(cos)})")
+        t.finish()
+        return MeshStiffness(mean, cos, sin, "harmonics")
+    harmonics = t.integer("harmonics", 10, low=0, high=64)
+    t.finish()
+    return contact_line_stiffness(mean, pair.transverse_contact_ratio,
+                                  pair.axial_contact_ratio, harmonics)
+
+
+def _transmission_error(t: Table | None) -> TransmissionError:
+    if t is None:
+        return TransmissionError()
+    amps = t.numbers("amplitude_um", low=0.0)
+    phases = t.numbers("phase_deg", [0.0] * len(amps), length=len(amps))
+    t.finish()
+    return TransmissionError(tuple(a * 1e-6 for a in amps), tuple(math.radians(p)
+                                                                   for p in phases))
+
+
+def parse_topology(data: dict, source: str) -> Topology:
+    """Build and validate a :class:`Topology` from parsed TOML ``data``."""
+    top = Table(data, source)
+    head = top.table("topology")
+    name = head.string("name")
+    description = head.string("description", "")
+    head.finish()
+
+    materials = {"steel": _STEEL}
+    mats = top.table("materials", {})
+    for mname in list(mats.data):
+        materials[mname] = _material(mats.table(mname), mname)
+    mats.finish()
+
+    gears: list[Gear] = []
+    for gt in top.tables("gear"):
+        gear = _gear(gt, materials)
+        if any(g.id == gear.id for g in gears):
+            raise gt.error("id", f"gear '{gear.id}' is defined twice")
+        gears.append(gear)
+    by_id = {g.id: g for g in gears}
+
+    meshes: list[Mesh] = []
+    layout: dict[str, tuple[Table, float]] = {}
+    for mt in top.tables("mesh"):
+        mid = _ident(mt, "id")
+        ends = []
+        for end in ("driver", "driven"):
+            gid = mt.string(end)
+            if gid not in by_id:
+                raise mt.error(end, f"names unknown gear '{gid}'" + nearest(gid, by_id)
+                               + f"; gears: {', '.join(by_id)}")
+            ends.append(gid)
+        if ends[0] == ends[1]:
+            raise mt.error("driven", f"a gear cannot mesh with itself ('{ends[0]}')")
+        g1, g2 = by_id[ends[0]], by_id[ends[1]]
+        try:
+            pair = pair_geometry(g1.geometry, g2.geometry, min(g1.face_width, g2.face_width))
+        except ValueError as err:
+            raise mt.error("driven", f"'{ends[0]}' and '{ends[1]}' cannot mesh: {err}") from None
+        if pair.transverse_contact_ratio < 1.0:
+            raise mt.error("driven", f"transverse contact ratio {pair.transverse_contact_ratio:.3f}"
+                                     " is below 1: the pair cannot transmit motion continuously")
+        coordinate = _ident(mt, "coordinate")
+        if coordinate in _RESERVED:
+            raise mt.error("coordinate", f"'{coordinate}' is reserved; avoid "
+                                         f"{', '.join(sorted(_RESERVED))}")
+        backlash = mt.number("half_backlash_um", low=0, low_open=True) * 1e-6
+        stiffness = _stiffness(mt.table("stiffness"), pair)
+        te = _transmission_error(mt.table("transmission_error", None))
+        phase, phase_source = 0.0, "reference"
+        if mt.has("stiffness_phase_deg") and mt.has("layout_angle_deg"):
+            raise mt.error("layout_angle_deg", "give either stiffness_phase_deg or "
+                                               "layout_angle_deg, not both")
+        if mt.has("stiffness_phase_deg"):
+            phase = math.radians(mt.number("stiffness_phase_deg"))
+            phase_source = "given"
+        if mt.has("layout_angle_deg"):
+            layout[mid] = (mt, mt.number("layout_angle_deg", low=-360.0, high=360.0))
+        mt.finish()
+        for other in meshes:
+            if other.id == mid:
+                raise mt.error("id", f"mesh '{mid}' is defined twice")
+            if other.coordinate == coordinate:
+                raise mt.error("coordinate", f"'{coordinate}' is already used by mesh "
+                                             f"'{other.id}'")
+            if {other.driver, other.driven} == set(ends):
+                raise mt.error("driven", f"gears '{ends[0]}' and '{ends[1]}' already mesh in "
+                                         f"'{other.id}'")
+        meshes.append(Mesh(mid, ends[0], ends[1], coordinate, backlash, stiffness, te, phase,
+                           phase_source, pair))
+
+    # Layout phase: a mesh sharing a gear with the reference mesh, whose pinion centre sits
+    # an angle psi further round that gear, sees the same tooth pass psi / w later: a lag of
+    # z psi teeth, i.e. 2 pi delta with delta the fractional part of z psi / 2 pi.
+    ref = meshes[0]
+    for i, m in enumerate(meshes):
+        if m.id not in layout:
+            continue
+        mt, angle = layout[m.id]
+        common = {m.driver, m.driven} & {ref.driver, ref.driven}
+        if i == 0 or not common:
+            raise mt.error("layout_angle_deg", "needs a mesh that shares a gear with the "
+                                               f"reference mesh '{ref.id}' (the first mesh)")
+        z = by_id[sorted(common)[0]].teeth
+        teeth_spanned = z * angle / 360.0
+        delta = teeth_spanned - math.floor(teeth_spanned)
+        meshes[i] = Mesh(m.id, m.driver, m.driven, m.coordinate, m.half_backlash, m.stiffness,
+                         m.transmission_error, 2.0 * math.pi * delta,
+                         f"layout: {angle:g} deg on gear '{sorted(common)[0]}' spans "
+                         f"{teeth_spanned:.4f} teeth, delta = {delta:.4f}", m.pair)
+
+    _check_tree(top, gears, meshes)
+
+    torques: dict[str, float] = {}
+    for tt in top.tables("torque") if top.has("torque") else []:
+        gid = tt.string("gear")
+        if gid not in by_id:
+            raise tt.error("gear", f"names unknown gear '{gid}'" + nearest(gid, by_id))
+        torques[gid] = torques.get(gid, 0.0) + tt.number("torque_Nm")
+        tt.finish()
+
+    operating = None
+    ot = top.table("operating", None)
+    if ot is not None:
+        gid = ot.string("gear")
+        if gid not in by_id:
+            raise ot.error("gear", f"names unknown gear '{gid}'" + nearest(gid, by_id))
+        operating = Operating(gid, ot.number("speed_rpm", low=0, low_open=True) * math.pi / 30,
+                              ot.number("damping_ratio", low=0.0, high=1.0))
+        ot.finish()
+    top.finish()
+    return Topology(name, description, tuple(gears), tuple(meshes), torques, operating, source)
+
+
+def _check_tree(top: Table, gears: list[Gear], meshes: list[Mesh]) -> None:
+    if len(meshes) != len(gears) - 1:
+        raise top.error("mesh", f"{len(gears)} gears need exactly {len(gears) - 1} meshes "
+                                f"(a tree), got {len(meshes)}; closed gear loops are not "
+                                "supported")
+    reached = {meshes[0].driver}
+    changed = True
+    while changed:
+        changed = False
+        for m in meshes:
+            if (m.driver in reached) != (m.driven in reached):
+                reached |= {m.driver, m.driven}
+                changed = True
+    lost = [g.id for g in gears if g.id not in reached]
+    if lost:
+        raise top.error("mesh", f"gear(s) {', '.join(lost)} are not connected to the others "
+                                "by any mesh")
+
+
+def load_topology(path: Path | str) -> Topology:
+    """Read and validate a topology TOML file."""
+    path = Path(path)
+    return parse_topology(load_toml(path), str(path))
