@@ -120,8 +120,9 @@ class Table:
             raise self.error(name, f"must be {sign} {high:g}, got {value:g}")
         return value
 
-    def integer(self, name: str, default: Any = _MISSING, *, low: int | None = None,
-                high: int | None = None) -> int:
+    def integer(
+        self, name: str, default: Any = _MISSING, *, low: int | None = None, high: int | None = None
+    ) -> int:
         value = self._get(name, default)
         if isinstance(value, bool) or not isinstance(value, int):
             raise self.error(name, f"must be a whole number, got {value!r}")
@@ -131,8 +132,9 @@ class Table:
             raise self.error(name, f"must be <= {high}, got {value}")
         return value
 
-    def string(self, name: str, default: Any = _MISSING, *,
-               choices: Iterable[str] | None = None) -> str:
+    def string(
+        self, name: str, default: Any = _MISSING, *, choices: Iterable[str] | None = None
+    ) -> str:
         value = self._get(name, default)
         if value is None:
             return value
@@ -154,8 +156,14 @@ class Table:
             raise self.error(name, f"must be true or false, got {value!r}")
         return value
 
-    def numbers(self, name: str, default: Any = _MISSING, *, length: int | None = None,
-                low: float | None = None) -> tuple[float, ...]:
+    def numbers(
+        self,
+        name: str,
+        default: Any = _MISSING,
+        *,
+        length: int | None = None,
+        low: float | None = None,
+    ) -> tuple[float, ...]:
         value = self._get(name, default)
         if not isinstance(value, list | tuple) or not all(
             isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
@@ -191,7 +199,8 @@ class Table:
             if name not in known:
                 raise self.error(
                     name,
-                    "unknown key" + nearest(name, known)
+                    "unknown key"
+                    + nearest(name, known)
                     + f"; allowed keys: {', '.join(sorted(known))}",
                 )
 
@@ -229,15 +238,20 @@ def parse_expression(text: str, names: dict[str, float], *, source: str, key: st
     def walk(node: ast.AST) -> float:
         if isinstance(node, ast.Expression):
             return walk(node.body)
-        if isinstance(node, ast.Constant) and isinstance(node.value, int | float) \
-                and not isinstance(node.value, bool):
+        if (
+            isinstance(node, ast.Constant)
+            and isinstance(node.value, int | float)
+            and not isinstance(node.value, bool)
+        ):
             return float(node.value)
         if isinstance(node, ast.Name):
             name = node.id.removesuffix("__kw") if node.id.endswith("__kw") else node.id
             if name not in names:
                 raise InputError(
-                    source, key,
-                    f"'{name}' in '{text}' is not a scene parameter" + nearest(name, names)
+                    source,
+                    key,
+                    f"'{name}' in '{text}' is not a scene parameter"
+                    + nearest(name, names)
                     + f"; parameters: {', '.join(sorted(names))}",
                 )
             return float(names[name])
@@ -250,7 +264,8 @@ def parse_expression(text: str, names: dict[str, float], *, source: str, key: st
             except ZeroDivisionError:
                 raise InputError(source, key, f"'{text}' divides by zero") from None
         raise InputError(
-            source, key,
+            source,
+            key,
             f"'{text}' may use only numbers, scene parameters, + - * / ** and parentheses",
         )
 

@@ -73,14 +73,21 @@ class Backlash:
         return np.broadcast_to(f(np.asarray(x, dtype=float)), np.shape(x)).astype(float)
 
     def max_error(self, samples: int = 20001) -> float:
-        """max |g(x) - dead zone(x)| over the valid range (or [-3, 3] if unbounded)."""
+        """max |g(x) - dead zone(x)| over the valid range (or [-3, 3] if unbounded).
+
+        The dead zone's corners at x = +-1, where the error of a smooth model peaks with a
+        kink, are sampled exactly.
+        """
         a = self.valid_range if self.valid_range is not None else 3.0
-        x = np.linspace(-a, a, samples)
+        x = np.union1d(np.linspace(-a, a, samples), [-1.0, 1.0])
         return float(np.max(np.abs(self.evaluate(x) - dead_zone(x))))
 
     def describe(self) -> dict:
-        return {"kind": self.kind, "valid_range": self.valid_range,
-                "parameters": {n: v for n, v, _ in self.parameters()}}
+        return {
+            "kind": self.kind,
+            "valid_range": self.valid_range,
+            "parameters": {n: v for n, v, _ in self.parameters()},
+        }
 
 
 @dataclass(frozen=True)
@@ -108,7 +115,7 @@ class SmoothDeadZone(Backlash):
     """Regularised dead zone ``x - (sqrt((x+1)^2 + e^2) - sqrt((x-1)^2 + e^2)) / 2``.
 
     Its largest deviation from the dead zone is ``e/2`` (at ``x = 0`` the error is 0; at
-    ``x = +-1`` it is ``(sqrt(4 + e^2) - 2 + e) / 2 ~ e / 2``).
+    ``x = +-1`` it is ``(e + 2 - sqrt(4 + e^2)) / 2 ~ e / 2``).
     """
 
     kind = "smooth"
@@ -161,8 +168,10 @@ class PolynomialFit(Backlash):
         return tuple(range(1, self.order + 1, 2))
 
     def parameters(self):
-        return tuple((f"g{k}", c, f"coefficient of x^{k} in the backlash polynomial")
-                     for k, c in zip(self.powers, self.coefficients, strict=True))
+        return tuple(
+            (f"g{k}", c, f"coefficient of x^{k} in the backlash polynomial")
+            for k, c in zip(self.powers, self.coefficients, strict=True)
+        )
 
     def expression(self, x):
         # Horner form in x^2: x (a1 + x^2 (a3 + x^2 (a5 + ...))) -- fewest operations.
@@ -181,8 +190,9 @@ BACKLASH_MODELS = {
 }
 
 
-def fit_dead_zone(order: int = 7, fit_range: float = 3.0, step: float | None = 0.01
-                  ) -> PolynomialFit:
+def fit_dead_zone(
+    order: int = 7, fit_range: float = 3.0, step: float | None = 0.01
+) -> PolynomialFit:
     """Least-squares odd polynomial fit of the unit dead zone on ``[-A, A]``.
 
     Minimises ``sum_i (p(x_i) - dz(x_i))^2`` over ``x_i = -A, -A + h, ..., A`` (``step=h``),
@@ -204,8 +214,9 @@ def fit_dead_zone(order: int = 7, fit_range: float = 3.0, step: float | None = 0
         # right side int_{1/A}^{1} t^i (A t - 1) dt.
         s = 1.0 / fit_range
         gram = 1.0 / (powers[:, None] + powers[None, :] + 1.0)
-        rhs = (fit_range * (1.0 - s ** (powers + 2)) / (powers + 2)
-               - (1.0 - s ** (powers + 1)) / (powers + 1))
+        rhs = fit_range * (1.0 - s ** (powers + 2)) / (powers + 2) - (1.0 - s ** (powers + 1)) / (
+            powers + 1
+        )
         scaled = np.linalg.solve(gram, rhs)
         samples = None
     else:
@@ -213,11 +224,17 @@ def fit_dead_zone(order: int = 7, fit_range: float = 3.0, step: float | None = 0
             raise ValueError(f"step must be > 0, got {step}")
         samples = int(round(2.0 * fit_range / step)) + 1
         if samples <= len(powers):
-            raise ValueError(f"step {step} leaves {samples} samples for {len(powers)} "
-                             "coefficients; use a smaller step")
+            raise ValueError(
+                f"step {step} leaves {samples} samples for {len(powers)} "
+                "coefficients; use a smaller step"
+            )
         x = np.linspace(-fit_range, fit_range, samples)
         basis = (x[:, None] / fit_range) ** powers[None, :]
         scaled = np.linalg.lstsq(basis, dead_zone(x), rcond=None)[0]
-    coefficients = scaled / fit_range ** powers
-    return PolynomialFit(order=order, fit_range=float(fit_range), samples=samples,
-                         coefficients=tuple(float(c) for c in coefficients))
+    coefficients = scaled / fit_range**powers
+    return PolynomialFit(
+        order=order,
+        fit_range=float(fit_range),
+        samples=samples,
+        coefficients=tuple(float(c) for c in coefficients),
+    )

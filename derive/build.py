@@ -18,8 +18,16 @@ from .emit import emit_module, operation_count, write_atomic
 from .model import Model, derive_model
 from .scene import builtin_root, load_target
 
-__all__ = ["Built", "build_files", "check", "describe", "project_root", "shipped_targets",
-           "write_files"]
+__all__ = [
+    "Built",
+    "build_files",
+    "check",
+    "describe",
+    "display_path",
+    "project_root",
+    "shipped_targets",
+    "write_files",
+]
 
 
 def project_root() -> Path:
@@ -33,7 +41,8 @@ def shipped_targets() -> list[Path]:
     return sorted(root.glob("*.toml")) + sorted((root / "topologies").glob("*.toml"))
 
 
-def _display(path: Path) -> str:
+def display_path(path: Path | str) -> str:
+    """``path`` relative to the project root when inside it, else as given."""
     p = Path(path).resolve()
     try:
         return p.relative_to(project_root()).as_posix()
@@ -47,14 +56,15 @@ class Built:
     files: dict[str, str]
 
 
-def build_files(paths: list[Path], *, index: bool = False,
-                overrides: dict[str, float] | None = None) -> Built:
+def build_files(
+    paths: list[Path], *, index: bool = False, overrides: dict[str, float] | None = None
+) -> Built:
     """Derive every target in ``paths``; return the models and the files' text."""
     models, files = [], {}
     for path in paths:
         scene = load_target(path, overrides)
         model = derive_model(scene)
-        command = f"gearsym derive {_display(path)}"
+        command = f"gearsym derive {display_path(path)}"
         files[f"generated/{model.name}.py"] = emit_module(model, command)
         files[f"docs/derivation/{model.name}.md"] = audit_page(model, command)
         models.append(model)
@@ -106,7 +116,7 @@ def describe(model: Model) -> dict:
     feats = model.features
     H = feats.stiffness_harmonics
     kappa = {}
-    for i, ci in enumerate(coords):
+    for ci in coords:
         for j, cj in enumerate(coords):
             mean = values.get(f"kappa_{ci}_{cj}")
             if mean is None:
@@ -118,27 +128,35 @@ def describe(model: Model) -> dict:
                 "phase_rad": values.get(f"phi_{cj}", 0.0),
                 "frequency_ratio": str(model.frequency_ratios[j]),
             }
-    xi = {f"{ci}{cj}": values[f"xi_{ci}_{cj}"] for ci in coords for cj in coords
-          if f"xi_{ci}_{cj}" in values}
+    xi = {
+        f"{ci}{cj}": values[f"xi_{ci}_{cj}"]
+        for ci in coords
+        for cj in coords
+        if f"xi_{ci}_{cj}" in values
+    }
     te = {}
     for c in coords:
         amps = [v for k, v in values.items() if k.startswith(f"E_{c}_")]
         if amps:
-            te[c] = {"amplitude": amps,
-                     "phase_rad": [v for k, v in values.items() if k.startswith(f"psi_{c}_")]}
+            te[c] = {
+                "amplitude": amps,
+                "phase_rad": [v for k, v in values.items() if k.startswith(f"psi_{c}_")],
+            }
     b = feats.backlash
     backlash = {"kind": b.kind, "valid_range": b.valid_range}
     if b.kind == "polynomial":
-        backlash.update(order=b.order, fit_samples=b.samples,
-                        coefficients={str(k): c for k, c in zip(b.powers, b.coefficients,
-                                                                strict=True)},
-                        max_error_vs_dead_zone=b.max_error())
+        backlash.update(
+            order=b.order,
+            fit_samples=b.samples,
+            coefficients={str(k): c for k, c in zip(b.powers, b.coefficients, strict=True)},
+            max_error_vs_dead_zone=b.max_error(),
+        )
     elif b.kind == "smooth":
         backlash.update(width=b.width, max_error_vs_dead_zone=b.max_error())
     return {
         "name": model.name,
         "scene": model.scene.name,
-        "source": _display(Path(model.scene.source)),
+        "source": display_path(Path(model.scene.source)),
         "inputs_sha256": model.inputs_hash,
         "equation": "u_i'' + sum_j 2 xi_ij u_j' + sum_j kappa_ij(tau) g(u_j) = f_i + ebar_i''",
         "states": list(model.states),
@@ -148,16 +166,17 @@ def describe(model: Model) -> dict:
         "xi": xi,
         "kappa": kappa,
         "kappa_form": "kappa_ij(tau) = mean + sum_h cos_h cos(h(r w tau - phase)) + "
-                      "sin_h sin(h(r w tau - phase)), r = frequency_ratio, w = omega",
+        "sin_h sin(h(r w tau - phase)), r = frequency_ratio, w = omega",
         "transmission_error": te,
         "transmission_error_form": "ebar_j(tau) = sum_h amplitude_h cos(h(r w tau - phase_j)"
-                                   " + phase_h)",
+        " + phase_h)",
         "backlash": backlash,
         "features": feats.describe() | {"backlash": b.kind},
         "scales": model.scales,
-        "operations": {"rhs": operation_count(model.rhs),
-                       "rhs_and_jacobian": operation_count(list(model.rhs)
-                                                           + list(model.jacobian))},
+        "operations": {
+            "rhs": operation_count(model.rhs),
+            "rhs_and_jacobian": operation_count(list(model.rhs) + list(model.jacobian)),
+        },
     }
 
 

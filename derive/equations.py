@@ -91,21 +91,25 @@ def derive_equations(topology: Topology) -> Equations:
     cb = [sp.cos(bb) for bb in beta_b]
 
     newton = tuple(
-        sp.Eq(inertia[kk] * theta[kk].diff(t, 2),
-              torque[kk] - sum(cb[i] * A[i, kk] * F[i] for i in range(len(meshes))))
+        sp.Eq(
+            inertia[kk] * theta[kk].diff(t, 2),
+            torque[kk] - sum(cb[i] * A[i, kk] * F[i] for i in range(len(meshes))),
+        )
         for kk in range(len(gears))
     )
-    kinematic = [cb[i] * sum(A[i, kk] * theta[kk] for kk in range(len(gears)))
-                 for i in range(len(meshes))]
+    kinematic = [
+        cb[i] * sum(A[i, kk] * theta[kk] for kk in range(len(gears))) for i in range(len(meshes))
+    ]
     deflection = tuple(sp.Eq(x[i], kinematic[i] + e[i]) for i in range(len(meshes)))
     force_law = tuple(
-        sp.Eq(F[i], k[i] * b[i] * g(x[i] / b[i]) + c[i] * x[i].diff(t))
-        for i in range(len(meshes))
+        sp.Eq(F[i], k[i] * b[i] * g(x[i] / b[i]) + c[i] * x[i].diff(t)) for i in range(len(meshes))
     )
 
     # x_i'' with theta'' from Newton's law.
-    accel = {theta[kk].diff(t, 2): sp.solve(newton[kk], theta[kk].diff(t, 2))[0]
-             for kk in range(len(gears))}
+    accel = {
+        theta[kk].diff(t, 2): sp.solve(newton[kk], theta[kk].diff(t, 2))[0]
+        for kk in range(len(gears))
+    }
     substituted = tuple(
         sp.Eq(x[i].diff(t, 2), sp.expand(deflection[i].rhs.diff(t, 2).subs(accel)))
         for i in range(len(meshes))
@@ -113,8 +117,7 @@ def derive_equations(topology: Topology) -> Equations:
 
     # Read the compliance W_ij = -d(x_i'')/dF_j and the load off the substituted form,
     # then check them against the closed form C A I^-1 A^T C and that nothing is left.
-    W = sp.ImmutableMatrix(len(meshes), len(meshes),
-                           lambda i, j: -substituted[i].rhs.diff(F[j]))
+    W = sp.ImmutableMatrix(len(meshes), len(meshes), lambda i, j: -substituted[i].rhs.diff(F[j]))
     Iinv = sp.diag(*[1 / ii for ii in inertia])
     C = sp.diag(*cb)
     W_closed = C * A * Iinv * A.T * C
@@ -130,14 +133,35 @@ def derive_equations(topology: Topology) -> Equations:
         load.append(rest)
 
     reduced = tuple(
-        sp.Eq(x[i].diff(t, 2) + sum(W[i, j] * F[j] for j in range(len(meshes))),
-              load[i] + e[i].diff(t, 2))
+        sp.Eq(
+            x[i].diff(t, 2) + sum(W[i, j] * F[j] for j in range(len(meshes))),
+            load[i] + e[i].diff(t, 2),
+        )
         for i in range(len(meshes))
     )
     return Equations(
-        t=t, gears=gears, meshes=meshes, theta=theta, inertia=inertia, torque=torque,
-        base_radius=radius, beta_b=beta_b, half_backlash=b, mean_stiffness=km, damping=c,
-        stiffness=k, te=e, force=F, x=x, g=g, incidence=A, newton=newton,
-        deflection=deflection, force_law=force_law, substituted=substituted,
-        compliance=sp.ImmutableMatrix(W), load=tuple(load), reduced=reduced,
+        t=t,
+        gears=gears,
+        meshes=meshes,
+        theta=theta,
+        inertia=inertia,
+        torque=torque,
+        base_radius=radius,
+        beta_b=beta_b,
+        half_backlash=b,
+        mean_stiffness=km,
+        damping=c,
+        stiffness=k,
+        te=e,
+        force=F,
+        x=x,
+        g=g,
+        incidence=A,
+        newton=newton,
+        deflection=deflection,
+        force_law=force_law,
+        substituted=substituted,
+        compliance=sp.ImmutableMatrix(W),
+        load=tuple(load),
+        reduced=reduced,
     )

@@ -110,14 +110,19 @@ def pair_geometry(driver: GearGeometry, driven: GearGeometry, face_width: float)
     ``eps_alpha = g_alpha / p_bt``, ``eps_beta = b sin(beta) / (pi mn)`` (ISO 21771).
     """
     if (driver.normal_module, driver.normal_pressure_angle, abs(driver.helix_angle)) != (
-        driven.normal_module, driven.normal_pressure_angle, abs(driven.helix_angle)
+        driven.normal_module,
+        driven.normal_pressure_angle,
+        abs(driven.helix_angle),
     ):
-        raise ValueError("the two gears of a pair need the same normal module, pressure "
-                         "angle and helix angle magnitude")
+        raise ValueError(
+            "the two gears of a pair need the same normal module, pressure "
+            "angle and helix angle magnitude"
+        )
     alpha_t = driver.transverse_pressure_angle
     shift = driver.profile_shift + driven.profile_shift
     inv_wt = involute(alpha_t) + 2.0 * math.tan(driver.normal_pressure_angle) * shift / (
-        driver.teeth + driven.teeth)
+        driver.teeth + driven.teeth
+    )
     alpha_wt = alpha_t if shift == 0.0 else _inverse_involute(inv_wt)
     a_w = (driver.pitch_radius + driven.pitch_radius) * math.cos(alpha_t) / math.cos(alpha_wt)
     g_alpha = (
@@ -135,6 +140,7 @@ def pair_geometry(driver: GearGeometry, driven: GearGeometry, face_width: float)
         path_of_contact=g_alpha,
         transverse_base_pitch=p_bt,
         transverse_contact_ratio=g_alpha / p_bt,
-        axial_contact_ratio=face_width * math.sin(abs(driver.helix_angle))
+        axial_contact_ratio=face_width
+        * math.sin(abs(driver.helix_angle))
         / (math.pi * driver.normal_module),
     )

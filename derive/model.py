@@ -90,8 +90,12 @@ def _inputs_hash(scene: Scene) -> str:
     import tomllib
     from pathlib import Path
 
-    payload = {"gearsym": __version__, "sympy": sp.__version__,
-               "parameters": scene.parameters, "kind": scene.kind}
+    payload = {
+        "gearsym": __version__,
+        "sympy": sp.__version__,
+        "parameters": scene.parameters,
+        "kind": scene.kind,
+    }
     for key, path in (("scene", scene.source), ("topology", scene.topology.source)):
         payload[key] = tomllib.loads(Path(path).read_text(encoding="utf-8"))
     text = json.dumps(payload, sort_keys=True, default=str)
@@ -111,8 +115,7 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
     u = tuple(sp.Symbol(c, real=True) for c in coords)
     du = tuple(sp.Symbol(f"d{c}", real=True) for c in coords)
     ratios = topo.mesh_frequency_ratios()
-    freq = tuple(sp.Rational(ratios[me.id].numerator, ratios[me.id].denominator)
-                 for me in meshes)
+    freq = tuple(sp.Rational(ratios[me.id].numerator, ratios[me.id].denominator) for me in meshes)
 
     params: list[Parameter] = []
 
@@ -122,8 +125,12 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
         params.append(Parameter(name, float(value), meaning, latex))
         return sp.Symbol(name, real=True)
 
-    omega = param("omega", scene.omega, "excitation (mesh) frequency of the reference mesh "
-                  "over omega_n", r"\bar\omega")
+    omega = param(
+        "omega",
+        scene.omega,
+        "excitation (mesh) frequency of the reference mesh over omega_n",
+        r"\bar\omega",
+    )
     # Static loads.
     if scene.loads is not None:
         f_values = [scene.loads[c] for c in coords]
@@ -138,34 +145,49 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
         for j in range(m):
             if nd.xi[i, j] == 0 or (i != j and not feats.damping_coupling):
                 continue
-            xi[i, j] = param(f"xi_{coords[i]}_{coords[j]}", nd.value(nd.xi[i, j]),
-                             f"damping coefficient of d{coords[j]} in the {coords[i]} equation",
-                             rf"\xi_{{{coords[i]}{coords[j]}}}")
+            xi[i, j] = param(
+                f"xi_{coords[i]}_{coords[j]}",
+                nd.value(nd.xi[i, j]),
+                f"damping coefficient of d{coords[j]} in the {coords[i]} equation",
+                rf"\xi_{{{coords[i]}{coords[j]}}}",
+            )
     kappa = {}
     for i in range(m):
         for j in range(m):
             if nd.kappa[i, j] == 0:
                 continue
-            kappa[i, j] = param(f"kappa_{coords[i]}_{coords[j]}", nd.value(nd.kappa[i, j]),
-                                f"mean stiffness coefficient of g({coords[j]}) in the "
-                                f"{coords[i]} equation", rf"K_{{{coords[i]}{coords[j]}}}")
+            kappa[i, j] = param(
+                f"kappa_{coords[i]}_{coords[j]}",
+                nd.value(nd.kappa[i, j]),
+                f"mean stiffness coefficient of g({coords[j]}) in the {coords[i]} equation",
+                rf"K_{{{coords[i]}{coords[j]}}}",
+            )
     H = feats.stiffness_harmonics
     kc, ks = {}, {}
     for j, me in enumerate(meshes):
         cs, ss = me.stiffness.normalised(H)
         for h in range(1, H + 1):
-            kc[j, h] = param(f"kc_{coords[j]}_{h}", cs[h - 1],
-                             f"cosine stiffness harmonic {h} of mesh {me.id} over its mean",
-                             rf"\alpha_{{{coords[j]},{h}}}")
-            ks[j, h] = param(f"ks_{coords[j]}_{h}", ss[h - 1],
-                             f"sine stiffness harmonic {h} of mesh {me.id} over its mean",
-                             rf"\beta_{{{coords[j]},{h}}}")
+            kc[j, h] = param(
+                f"kc_{coords[j]}_{h}",
+                cs[h - 1],
+                f"cosine stiffness harmonic {h} of mesh {me.id} over its mean",
+                rf"\alpha_{{{coords[j]},{h}}}",
+            )
+            ks[j, h] = param(
+                f"ks_{coords[j]}_{h}",
+                ss[h - 1],
+                f"sine stiffness harmonic {h} of mesh {me.id} over its mean",
+                rf"\beta_{{{coords[j]},{h}}}",
+            )
     phi = {}
     if feats.mesh_phase:
         for j, me in enumerate(meshes[1:], start=1):
-            phi[j] = param(f"phi_{coords[j]}", me.phase,
-                           f"stiffness/TE phase lag of mesh {me.id}, rad ({me.phase_source})",
-                           rf"\varphi_{{{coords[j]}}}")
+            phi[j] = param(
+                f"phi_{coords[j]}",
+                me.phase,
+                f"stiffness/TE phase lag of mesh {me.id}, rad ({me.phase_source})",
+                rf"\varphi_{{{coords[j]}}}",
+            )
     te_amp, te_phase = {}, {}
     if feats.transmission_error:
         for j, me in enumerate(meshes):
@@ -173,27 +195,50 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
             if not any(a != 0 for a in te.amplitudes):
                 continue
             for h, (a, ph) in enumerate(zip(te.amplitudes, te.phases, strict=True), start=1):
-                te_amp[j, h] = param(f"E_{coords[j]}_{h}", a / me.half_backlash,
-                                     f"transmission-error harmonic {h} of mesh {me.id} over "
-                                     "its half backlash", rf"E_{{{coords[j]},{h}}}")
-                te_phase[j, h] = param(f"psi_{coords[j]}_{h}", ph,
-                                       f"transmission-error phase {h} of mesh {me.id}, rad",
-                                       rf"\psi_{{{coords[j]},{h}}}")
-    backlash_params = {name: param(name, value, meaning, _latex_backlash(name))
-                       for name, value, meaning in feats.backlash.parameters()}
+                te_amp[j, h] = param(
+                    f"E_{coords[j]}_{h}",
+                    a / me.half_backlash,
+                    f"transmission-error harmonic {h} of mesh {me.id} over its half backlash",
+                    rf"E_{{{coords[j]},{h}}}",
+                )
+                te_phase[j, h] = param(
+                    f"psi_{coords[j]}_{h}",
+                    ph,
+                    f"transmission-error phase {h} of mesh {me.id}, rad",
+                    rf"\psi_{{{coords[j]},{h}}}",
+                )
+    backlash_params = {
+        name: param(name, value, meaning, _latex_backlash(name))
+        for name, value, meaning in feats.backlash.parameters()
+    }
     del backlash_params  # the expression refers to them by name
 
     # Assemble the non-dimensional equations.
     phase_arg = [freq[j] * omega * tau - phi.get(j, 0) for j in range(m)]
-    khat = [1 + sum(kc[j, h] * sp.cos(h * phase_arg[j]) + ks[j, h] * sp.sin(h * phase_arg[j])
-                    for h in range(1, H + 1)) for j in range(m)]
-    ebar = tuple(sum((te_amp[j, h] * sp.cos(h * phase_arg[j] + te_phase[j, h])
-                      for (jj, h) in te_amp if jj == j), sp.Integer(0)) for j in range(m))
+    khat = [
+        1
+        + sum(
+            kc[j, h] * sp.cos(h * phase_arg[j]) + ks[j, h] * sp.sin(h * phase_arg[j])
+            for h in range(1, H + 1)
+        )
+        for j in range(m)
+    ]
+    ebar = tuple(
+        sum(
+            (
+                te_amp[j, h] * sp.cos(h * phase_arg[j] + te_phase[j, h])
+                for (jj, h) in te_amp
+                if jj == j
+            ),
+            sp.Integer(0),
+        )
+        for j in range(m)
+    )
     gexpr = [feats.backlash.expression(u[j]) for j in range(m)]
-    kappa_t = sp.ImmutableMatrix(m, m, lambda i, j: kappa[i, j] * khat[j]
-                                 if (i, j) in kappa else 0)
+    kappa_t = sp.ImmutableMatrix(m, m, lambda i, j: kappa[i, j] * khat[j] if (i, j) in kappa else 0)
     acc = tuple(
-        f[i] + sp.diff(ebar[i], tau, 2)
+        f[i]
+        + sp.diff(ebar[i], tau, 2)
         - sum(2 * xi[i, j] * du[j] for j in range(m) if (i, j) in xi)
         - sum(kappa_t[i, j] * gexpr[j] for j in range(m) if (i, j) in kappa)
         for i in range(m)
@@ -218,8 +263,9 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
         "time_unit_s": 1.0 / om,
         "half_backlash_m": {me.coordinate: me.half_backlash for me in meshes},
         "mean_stiffness_N_per_m": {me.coordinate: me.stiffness.mean for me in meshes},
-        "damping_N_s_per_m": {me.coordinate: nd.value(nd.damping_expr[j])
-                              for j, me in enumerate(meshes)},
+        "damping_N_s_per_m": {
+            me.coordinate: nd.value(nd.damping_expr[j]) for j, me in enumerate(meshes)
+        },
         "mesh_frequency_ratio": {me.coordinate: str(freq[j]) for j, me in enumerate(meshes)},
     }
     return Model(

@@ -49,8 +49,9 @@ class NonDim:
         return float(sp.sympify(expr).subs(self.values).evalf(17))
 
 
-def nondimensionalise(topology: Topology, damping_ratio: float = 0.0,
-                      equations: Equations | None = None) -> NonDim:
+def nondimensionalise(
+    topology: Topology, damping_ratio: float = 0.0, equations: Equations | None = None
+) -> NonDim:
     """Closed-form scales and coefficients of ``topology`` (module docstring)."""
     eq = equations if equations is not None else derive_equations(topology)
     W = eq.compliance
@@ -67,10 +68,12 @@ def nondimensionalise(topology: Topology, damping_ratio: float = 0.0,
         expr = sp.factor(sp.simplify(expr))
         return expr.replace(lambda e: isinstance(e, sp.Abs), lambda e: e.args[0])
 
-    kappa = sp.ImmutableMatrix(m, m, lambda i, j: simplify(
-        W[i, j] * b[j] * km[j] / (b[i] * omega_n_expr**2)))
-    xi = sp.ImmutableMatrix(m, m, lambda i, j: simplify(
-        W[i, j] * damping[j] * b[j] / (2 * b[i] * omega_n_expr)))
+    kappa = sp.ImmutableMatrix(
+        m, m, lambda i, j: simplify(W[i, j] * b[j] * km[j] / (b[i] * omega_n_expr**2))
+    )
+    xi = sp.ImmutableMatrix(
+        m, m, lambda i, j: simplify(W[i, j] * damping[j] * b[j] / (2 * b[i] * omega_n_expr))
+    )
     load = tuple(simplify(eq.load[i] / (b[i] * omega_n_expr**2)) for i in range(m))
 
     values: dict[sp.Symbol, float] = {zeta: float(damping_ratio)}

@@ -26,7 +26,7 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ._input import InputError, Table, load_toml, parse_expression
+from ._input import InputError, Table, load_toml, nearest, parse_expression
 from .backlash import (
     Backlash,
     DeadZone,
@@ -97,8 +97,9 @@ def _features(t: Table | None) -> Features:
     if t is None:
         return Features()
     harmonics = t.integer("stiffness_harmonics", 3, low=0, high=64)
-    kind = t.string("backlash", "polynomial",
-                    choices=("linear", "dead-zone", "smooth", "polynomial"))
+    kind = t.string(
+        "backlash", "polynomial", choices=("linear", "dead-zone", "smooth", "polynomial")
+    )
     backlash: Backlash
     if kind == "polynomial":
         order = t.integer("backlash_order", 7, low=1, high=31)
@@ -111,8 +112,7 @@ def _features(t: Table | None) -> Features:
         except ValueError as err:
             raise t.error("backlash_step", str(err)) from None
     elif kind == "smooth":
-        backlash = SmoothDeadZone(t.number("backlash_width", 0.05, low=0, low_open=True,
-                                           high=1.0))
+        backlash = SmoothDeadZone(t.number("backlash_width", 0.05, low=0, low_open=True, high=1.0))
     elif kind == "dead-zone":
         backlash = DeadZone()
     else:
@@ -143,11 +143,15 @@ def resolve_target(name: str, *, kind: str | None = None) -> Path:
         if c.exists():
             return c
     known = sorted(p.stem for p in root.glob("*.toml")) + sorted(
-        p.stem for p in (root / "topologies").glob("*.toml"))
-    from ._input import nearest
-
-    raise InputError(name, "", "is neither a file nor a built-in scene or topology"
-                     + nearest(name, known) + f"; built-in: {', '.join(known)}")
+        p.stem for p in (root / "topologies").glob("*.toml")
+    )
+    raise InputError(
+        name,
+        "",
+        "is neither a file nor a built-in scene or topology"
+        + nearest(name, known)
+        + f"; built-in: {', '.join(known)}",
+    )
 
 
 def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> Scene:
@@ -163,11 +167,17 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
     head.finish()
     topo_path = path.parent / topo_ref
     if not topo_path.exists():
-        try:
-            topo_path = resolve_target(topo_ref, kind="topology")
-        except InputError:
-            raise head.error("topology", f"'{topo_ref}' is neither a file next to the scene "
-                                         "nor a built-in topology") from None
+        builtin = builtin_root() / "topologies" / f"{topo_ref}.toml"
+        if not builtin.exists():
+            known = sorted(p.stem for p in (builtin_root() / "topologies").glob("*.toml"))
+            raise head.error(
+                "topology",
+                f"'{topo_ref}' is neither a file next to the scene "
+                "nor a built-in topology"
+                + nearest(topo_ref, known)
+                + f"; built-in: {', '.join(known)}",
+            )
+        topo_path = builtin
     topology = load_topology(topo_path)
     features = _features(top.table("features", None))
 
@@ -181,10 +191,11 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
             raise pt.error(required, "is required but missing")
     for key, value in (overrides or {}).items():
         if key not in parameters:
-            from ._input import nearest
-
-            raise InputError(source, f"parameters.{key}", "cannot be set: not a parameter of "
-                             "this scene" + nearest(key, parameters))
+            raise InputError(
+                source,
+                f"parameters.{key}",
+                "cannot be set: not a parameter of this scene" + nearest(key, parameters),
+            )
         parameters[key] = float(value)
     _check_parameters(pt, parameters)
 
@@ -195,19 +206,25 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
         loads, expressions = {}, {}
         for key in lt.data:
             if key not in coords:
-                from ._input import nearest
-
-                raise lt.error(key, "is not a mesh coordinate of topology "
-                                    f"'{topology.name}'" + nearest(key, coords)
-                                    + f"; coordinates: {', '.join(coords)}")
+                raise lt.error(
+                    key,
+                    "is not a mesh coordinate of topology "
+                    f"'{topology.name}'"
+                    + nearest(key, coords)
+                    + f"; coordinates: {', '.join(coords)}",
+                )
         for c in coords:
             raw = lt.raw(c)
             loads[c] = parse_expression(raw, parameters, source=source, key=lt.key(c))
             expressions[c] = str(raw)
         lt.finish()
     elif not topology.torques:
-        raise InputError(source, "loads", "is missing and the topology has no [[torque]]; "
-                                          "give the non-dimensional load of every coordinate")
+        raise InputError(
+            source,
+            "loads",
+            "is missing and the topology has no [[torque]]; "
+            "give the non-dimensional load of every coordinate",
+        )
     top.finish()
     return Scene(name, description, topology, features, parameters, loads, expressions, source)
 
@@ -226,26 +243,47 @@ def load_target(path: Path | str, overrides: dict[str, float] | None = None) -> 
     if "topology" in data and "scene" not in data:
         topology = parse_topology(data, str(path))
         if topology.operating is None:
-            raise InputError(str(path), "operating", "a topology derived on its own needs an "
-                             "[operating] table (gear, speed_rpm, damping_ratio) to set omega "
-                             "and the damping; or derive a scene that uses it")
+            raise InputError(
+                str(path),
+                "operating",
+                "a topology derived on its own needs an "
+                "[operating] table (gear, speed_rpm, damping_ratio) to set omega "
+                "and the damping; or derive a scene that uses it",
+            )
         if not topology.torques:
-            raise InputError(str(path), "torque", "a topology derived on its own needs "
-                             "[[torque]] entries for its loads; or derive a scene that uses it")
+            raise InputError(
+                str(path),
+                "torque",
+                "a topology derived on its own needs "
+                "[[torque]] entries for its loads; or derive a scene that uses it",
+            )
         from .nondim import natural_frequency
 
         omega = topology.reference_mesh_frequency() / natural_frequency(topology)
         parameters = {"omega": omega, "damping_ratio": topology.operating.damping_ratio}
         for key, value in (overrides or {}).items():
             if key not in parameters:
-                raise InputError(str(path), key, "cannot be set on a topology; parameters: "
-                                 "omega, damping_ratio")
+                raise InputError(
+                    str(path), key, "cannot be set on a topology; parameters: omega, damping_ratio"
+                )
             parameters[key] = float(value)
         if not math.isfinite(omega):
             raise InputError(str(path), "operating", "gives a non-finite omega")
-        return Scene(topology.name, topology.description, topology, Features(), parameters,
-                     None, None, str(path), kind="topology")
+        return Scene(
+            topology.name,
+            topology.description,
+            topology,
+            Features(),
+            parameters,
+            None,
+            None,
+            str(path),
+            kind="topology",
+        )
     if "scene" not in data:
-        raise InputError(str(path), "", "is neither a scene (no [scene] table) nor a topology "
-                                        "(no [topology] table)")
+        raise InputError(
+            str(path),
+            "",
+            "is neither a scene (no [scene] table) nor a topology (no [topology] table)",
+        )
     return load_scene(path, overrides)

@@ -66,8 +66,9 @@ class MeshStiffness:
         return c, s
 
 
-def contact_line_stiffness(mean: float, transverse_ratio: float, axial_ratio: float,
-                           harmonics: int = 10) -> MeshStiffness:
+def contact_line_stiffness(
+    mean: float, transverse_ratio: float, axial_ratio: float, harmonics: int = 10
+) -> MeshStiffness:
     """Stiffness proportional to the total contact-line length (closed-form series).
 
     Parameters

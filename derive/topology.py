@@ -5,9 +5,10 @@ A topology file is TOML with unit-suffixed keys (``_mm``, ``_deg``, ``_um``, ``_
 (m, rad, N, kg, s) on load and validated.  See ``docs/user-guide.md`` for the full list
 of keys.  Each rotating body is one gear; inertia attached to a gear (a flywheel, a
 coupling) is lumped with it.  Every rotation and torque is counted positive in the
-gear's own operating direction: a driving torque is positive, a load torque negative.  The meshes must form a tree over the gears (every gear
-reachable, no closed loop), so that the ``m`` mesh coordinates and one rigid-body
-rotation describe the ``m + 1`` gears exactly.
+gear's own operating direction: a driving torque is positive, a load torque negative.
+The meshes must form a tree over the gears (every gear reachable, no closed loop), so
+that the ``m`` mesh coordinates and one rigid-body rotation describe the ``m + 1`` gears
+exactly.
 """
 
 from __future__ import annotations
@@ -18,12 +19,20 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
 
-from ._input import InputError, Table, load_toml, nearest
+from ._input import Table, load_toml, nearest
 from .geometry import GearGeometry, PairGeometry, gear_geometry, pair_geometry
 from .stiffness import MeshStiffness, contact_line_stiffness
 
-__all__ = ["Gear", "Material", "Mesh", "Operating", "Topology", "TransmissionError",
-           "load_topology", "parse_topology"]
+__all__ = [
+    "Gear",
+    "Material",
+    "Mesh",
+    "Operating",
+    "Topology",
+    "TransmissionError",
+    "load_topology",
+    "parse_topology",
+]
 
 _IDENT = re.compile(r"^[A-Za-z][A-Za-z0-9]*$")
 # Names the generated code uses itself; coordinates may not take them.
@@ -163,8 +172,11 @@ class Topology:
 def _ident(t: Table, name: str) -> str:
     value = t.string(name)
     if not _IDENT.match(value):
-        raise t.error(name, f"'{value}' must be a name of letters and digits starting with a "
-                            "letter (it becomes a Python identifier)")
+        raise t.error(
+            name,
+            f"'{value}' must be a name of letters and digits starting with a "
+            "letter (it becomes a Python identifier)",
+        )
     return value
 
 
@@ -190,18 +202,36 @@ def _gear(t: Table, materials: dict[str, Material]) -> Gear:
     shift = t.number("profile_shift", 0.0, low=-1.0, high=1.5)
     mat_name = t.string("material", "steel")
     if mat_name not in materials:
-        raise t.error("material", f"'{mat_name}' is not defined" + nearest(mat_name, materials)
-                      + f"; materials: {', '.join(sorted(materials))}")
+        raise t.error(
+            "material",
+            f"'{mat_name}' is not defined"
+            + nearest(mat_name, materials)
+            + f"; materials: {', '.join(sorted(materials))}",
+        )
     geometry = gear_geometry(teeth, mn, alpha_n, beta, shift)
     bore = t.number("bore_radius_mm", 0.0, low=0.0) * 1e-3
     if bore >= geometry.root_radius:
-        raise t.error("bore_radius_mm", f"{bore * 1e3:g} mm must be below the root radius "
-                                        f"{geometry.root_radius * 1e3:.3f} mm")
+        raise t.error(
+            "bore_radius_mm",
+            f"{bore * 1e3:g} mm must be below the root radius {geometry.root_radius * 1e3:.3f} mm",
+        )
     inertia = t.number("inertia_kg_m2", None, low=0, low_open=True)
     attached = t.number("attached_inertia_kg_m2", 0.0, low=0.0)
     t.finish()
-    return Gear(gid, teeth, mn, alpha_n, beta, width, shift, materials[mat_name], bore,
-                inertia, attached, geometry)
+    return Gear(
+        gid,
+        teeth,
+        mn,
+        alpha_n,
+        beta,
+        width,
+        shift,
+        materials[mat_name],
+        bore,
+        inertia,
+        attached,
+        geometry,
+    )
 
 
 def _stiffness(t: Table, pair: PairGeometry) -> MeshStiffness:
@@ -216,8 +246,9 @@ def _stiffness(t: Table, pair: PairGeometry) -> MeshStiffness:
         return MeshStiffness(mean, cos, sin, "harmonics")
     harmonics = t.integer("harmonics", 10, low=0, high=64)
     t.finish()
-    return contact_line_stiffness(mean, pair.transverse_contact_ratio,
-                                  pair.axial_contact_ratio, harmonics)
+    return contact_line_stiffness(
+        mean, pair.transverse_contact_ratio, pair.axial_contact_ratio, harmonics
+    )
 
 
 def _transmission_error(t: Table | None) -> TransmissionError:
@@ -226,8 +257,7 @@ def _transmission_error(t: Table | None) -> TransmissionError:
     amps = t.numbers("amplitude_um", low=0.0)
     phases = t.numbers("phase_deg", [0.0] * len(amps), length=len(amps))
     t.finish()
-    return TransmissionError(tuple(a * 1e-6 for a in amps), tuple(math.radians(p)
-                                                                   for p in phases))
+    return TransmissionError(tuple(a * 1e-6 for a in amps), tuple(math.radians(p) for p in phases))
 
 
 def parse_topology(data: dict, source: str) -> Topology:
@@ -260,8 +290,12 @@ def parse_topology(data: dict, source: str) -> Topology:
         for end in ("driver", "driven"):
             gid = mt.string(end)
             if gid not in by_id:
-                raise mt.error(end, f"names unknown gear '{gid}'" + nearest(gid, by_id)
-                               + f"; gears: {', '.join(by_id)}")
+                raise mt.error(
+                    end,
+                    f"names unknown gear '{gid}'"
+                    + nearest(gid, by_id)
+                    + f"; gears: {', '.join(by_id)}",
+                )
             ends.append(gid)
         if ends[0] == ends[1]:
             raise mt.error("driven", f"a gear cannot mesh with itself ('{ends[0]}')")
@@ -271,19 +305,24 @@ def parse_topology(data: dict, source: str) -> Topology:
         except ValueError as err:
             raise mt.error("driven", f"'{ends[0]}' and '{ends[1]}' cannot mesh: {err}") from None
         if pair.transverse_contact_ratio < 1.0:
-            raise mt.error("driven", f"transverse contact ratio {pair.transverse_contact_ratio:.3f}"
-                                     " is below 1: the pair cannot transmit motion continuously")
+            raise mt.error(
+                "driven",
+                f"transverse contact ratio {pair.transverse_contact_ratio:.3f}"
+                " is below 1: the pair cannot transmit motion continuously",
+            )
         coordinate = _ident(mt, "coordinate")
         if coordinate in _RESERVED:
-            raise mt.error("coordinate", f"'{coordinate}' is reserved; avoid "
-                                         f"{', '.join(sorted(_RESERVED))}")
+            raise mt.error(
+                "coordinate", f"'{coordinate}' is reserved; avoid {', '.join(sorted(_RESERVED))}"
+            )
         backlash = mt.number("half_backlash_um", low=0, low_open=True) * 1e-6
         stiffness = _stiffness(mt.table("stiffness"), pair)
         te = _transmission_error(mt.table("transmission_error", None))
         phase, phase_source = 0.0, "reference"
         if mt.has("stiffness_phase_deg") and mt.has("layout_angle_deg"):
-            raise mt.error("layout_angle_deg", "give either stiffness_phase_deg or "
-                                               "layout_angle_deg, not both")
+            raise mt.error(
+                "layout_angle_deg", "give either stiffness_phase_deg or layout_angle_deg, not both"
+            )
         if mt.has("stiffness_phase_deg"):
             phase = math.radians(mt.number("stiffness_phase_deg"))
             phase_source = "given"
@@ -294,13 +333,25 @@ def parse_topology(data: dict, source: str) -> Topology:
             if other.id == mid:
                 raise mt.error("id", f"mesh '{mid}' is defined twice")
             if other.coordinate == coordinate:
-                raise mt.error("coordinate", f"'{coordinate}' is already used by mesh "
-                                             f"'{other.id}'")
+                raise mt.error("coordinate", f"'{coordinate}' is already used by mesh '{other.id}'")
             if {other.driver, other.driven} == set(ends):
-                raise mt.error("driven", f"gears '{ends[0]}' and '{ends[1]}' already mesh in "
-                                         f"'{other.id}'")
-        meshes.append(Mesh(mid, ends[0], ends[1], coordinate, backlash, stiffness, te, phase,
-                           phase_source, pair))
+                raise mt.error(
+                    "driven", f"gears '{ends[0]}' and '{ends[1]}' already mesh in '{other.id}'"
+                )
+        meshes.append(
+            Mesh(
+                mid,
+                ends[0],
+                ends[1],
+                coordinate,
+                backlash,
+                stiffness,
+                te,
+                phase,
+                phase_source,
+                pair,
+            )
+        )
 
     # Layout phase: a mesh sharing a gear with the reference mesh, whose pinion centre sits
     # an angle psi further round that gear, sees the same tooth pass psi / w later: a lag of
@@ -312,15 +363,27 @@ def parse_topology(data: dict, source: str) -> Topology:
         mt, angle = layout[m.id]
         common = {m.driver, m.driven} & {ref.driver, ref.driven}
         if i == 0 or not common:
-            raise mt.error("layout_angle_deg", "needs a mesh that shares a gear with the "
-                                               f"reference mesh '{ref.id}' (the first mesh)")
+            raise mt.error(
+                "layout_angle_deg",
+                "needs a mesh that shares a gear with the "
+                f"reference mesh '{ref.id}' (the first mesh)",
+            )
         z = by_id[sorted(common)[0]].teeth
         teeth_spanned = z * angle / 360.0
         delta = teeth_spanned - math.floor(teeth_spanned)
-        meshes[i] = Mesh(m.id, m.driver, m.driven, m.coordinate, m.half_backlash, m.stiffness,
-                         m.transmission_error, 2.0 * math.pi * delta,
-                         f"layout: {angle:g} deg on gear '{sorted(common)[0]}' spans "
-                         f"{teeth_spanned:.4f} teeth, delta = {delta:.4f}", m.pair)
+        meshes[i] = Mesh(
+            m.id,
+            m.driver,
+            m.driven,
+            m.coordinate,
+            m.half_backlash,
+            m.stiffness,
+            m.transmission_error,
+            2.0 * math.pi * delta,
+            f"layout: {angle:g} deg on gear '{sorted(common)[0]}' spans "
+            f"{teeth_spanned:.4f} teeth, delta = {delta:.4f}",
+            m.pair,
+        )
 
     _check_tree(top, gears, meshes)
 
@@ -338,8 +401,11 @@ def parse_topology(data: dict, source: str) -> Topology:
         gid = ot.string("gear")
         if gid not in by_id:
             raise ot.error("gear", f"names unknown gear '{gid}'" + nearest(gid, by_id))
-        operating = Operating(gid, ot.number("speed_rpm", low=0, low_open=True) * math.pi / 30,
-                              ot.number("damping_ratio", low=0.0, high=1.0))
+        operating = Operating(
+            gid,
+            ot.number("speed_rpm", low=0, low_open=True) * math.pi / 30,
+            ot.number("damping_ratio", low=0.0, high=1.0),
+        )
         ot.finish()
     top.finish()
     return Topology(name, description, tuple(gears), tuple(meshes), torques, operating, source)
@@ -347,9 +413,12 @@ def parse_topology(data: dict, source: str) -> Topology:
 
 def _check_tree(top: Table, gears: list[Gear], meshes: list[Mesh]) -> None:
     if len(meshes) != len(gears) - 1:
-        raise top.error("mesh", f"{len(gears)} gears need exactly {len(gears) - 1} meshes "
-                                f"(a tree), got {len(meshes)}; closed gear loops are not "
-                                "supported")
+        raise top.error(
+            "mesh",
+            f"{len(gears)} gears need exactly {len(gears) - 1} meshes "
+            f"(a tree), got {len(meshes)}; closed gear loops are not "
+            "supported",
+        )
     reached = {meshes[0].driver}
     changed = True
     while changed:
@@ -360,8 +429,9 @@ def _check_tree(top: Table, gears: list[Gear], meshes: list[Mesh]) -> None:
                 changed = True
     lost = [g.id for g in gears if g.id not in reached]
     if lost:
-        raise top.error("mesh", f"gear(s) {', '.join(lost)} are not connected to the others "
-                                "by any mesh")
+        raise top.error(
+            "mesh", f"gear(s) {', '.join(lost)} are not connected to the others by any mesh"
+        )
 
 
 def load_topology(path: Path | str) -> Topology:

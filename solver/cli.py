@@ -49,17 +49,24 @@ def _cmd_derive(args) -> int:
 
     if args.check:
         if args.targets or args.set or args.out:
-            raise _Fail("derive --check takes no targets, --set or --out: it checks the "
-                        "shipped scenes and topologies")
+            raise _Fail(
+                "derive --check takes no targets, --set or --out: it checks the "
+                "shipped scenes and topologies"
+            )
         stale = check()
         for line in stale:
             print(f"stale: {line}", file=sys.stderr)
         if stale:
-            print(f"{len(stale)} file(s) differ from a fresh regeneration; run "
-                  "`gearsym derive` and commit the result", file=sys.stderr)
+            print(
+                f"{len(stale)} file(s) differ from a fresh regeneration; run "
+                "`gearsym derive` and commit the result",
+                file=sys.stderr,
+            )
             return 1
-        print("generated/ and docs/ match a fresh regeneration of "
-              f"{len(shipped_targets())} shipped targets")
+        print(
+            "generated/ and docs/ match a fresh regeneration of "
+            f"{len(shipped_targets())} shipped targets"
+        )
         return 0
 
     shipped = not args.targets
@@ -82,19 +89,36 @@ def _summary(model) -> None:
 
     values = dict(zip(model.parameter_names, model.defaults, strict=True))
     coords = model.coordinates
-    print(f"{model.name}  ({model.scene.source})")
+    from gearsym.derive.build import display_path
+
+    print(f"{model.name}  ({display_path(model.scene.source)})")
     print(f"  states: {', '.join(model.states)}   parameters: {len(model.parameters)}")
-    print(f"  omega_n = {model.scales['omega_n_rad_per_s']:.6g} rad/s, "
-          f"omega = {values['omega']:.6g}")
+    print(
+        f"  omega_n = {model.scales['omega_n_rad_per_s']:.6g} rad/s, omega = {values['omega']:.6g}"
+    )
     print("  f: " + ", ".join(f"{c} = {values[f'f_{c}']:.6g}" for c in coords))
-    print("  kappa (means): " + ", ".join(
-        f"{ci}{cj} = {values[f'kappa_{ci}_{cj}']:.6g}" for ci in coords for cj in coords
-        if f"kappa_{ci}_{cj}" in values))
-    print("  xi: " + ", ".join(
-        f"{ci}{cj} = {values[f'xi_{ci}_{cj}']:.6g}" for ci in coords for cj in coords
-        if f"xi_{ci}_{cj}" in values))
-    print(f"  operations: rhs {operation_count(model.rhs)}, rhs + jacobian "
-          f"{operation_count(list(model.rhs) + list(model.jacobian))}")
+    print(
+        "  kappa (means): "
+        + ", ".join(
+            f"{ci}{cj} = {values[f'kappa_{ci}_{cj}']:.6g}"
+            for ci in coords
+            for cj in coords
+            if f"kappa_{ci}_{cj}" in values
+        )
+    )
+    print(
+        "  xi: "
+        + ", ".join(
+            f"{ci}{cj} = {values[f'xi_{ci}_{cj}']:.6g}"
+            for ci in coords
+            for cj in coords
+            if f"xi_{ci}_{cj}" in values
+        )
+    )
+    print(
+        f"  operations: rhs {operation_count(model.rhs)}, rhs + jacobian "
+        f"{operation_count(list(model.rhs) + list(model.jacobian))}"
+    )
 
 
 def _cmd_backlash(args) -> int:
@@ -106,22 +130,33 @@ def _cmd_backlash(args) -> int:
         raise _Fail(f"backlash: {err}") from None
     error = fit.max_error()
     if args.json:
-        print(json.dumps({
-            "order": fit.order,
-            "range": fit.fit_range,
-            "method": "continuous" if fit.samples is None else "samples",
-            "samples": fit.samples,
-            "coefficients": {str(k): c for k, c in zip(fit.powers, fit.coefficients,
-                                                       strict=True)},
-            "valid_range": [-fit.fit_range, fit.fit_range],
-            "max_error_vs_dead_zone": error,
-            "slope_at_zero": fit.coefficients[0],
-        }, indent=2))
+        print(
+            json.dumps(
+                {
+                    "order": fit.order,
+                    "range": fit.fit_range,
+                    "method": "continuous" if fit.samples is None else "samples",
+                    "samples": fit.samples,
+                    "coefficients": {
+                        str(k): c for k, c in zip(fit.powers, fit.coefficients, strict=True)
+                    },
+                    "valid_range": [-fit.fit_range, fit.fit_range],
+                    "max_error_vs_dead_zone": error,
+                    "slope_at_zero": fit.coefficients[0],
+                },
+                indent=2,
+            )
+        )
         return 0
-    how = ("continuous L2" if fit.samples is None
-           else f"{fit.samples} uniform samples, step {args.step:g}")
-    print(f"odd polynomial of order {fit.order}, least squares on [-{fit.fit_range:g}, "
-          f"{fit.fit_range:g}] ({how})")
+    how = (
+        "continuous L2"
+        if fit.samples is None
+        else f"{fit.samples} uniform samples, step {args.step:g}"
+    )
+    print(
+        f"odd polynomial of order {fit.order}, least squares on [-{fit.fit_range:g}, "
+        f"{fit.fit_range:g}] ({how})"
+    )
     for k, c in zip(fit.powers, fit.coefficients, strict=True):
         print(f"  x^{k:<2d} {c: .10f}")
     print(f"valid for |x| <= {fit.fit_range:g}; max |g - dead zone| = {error:.4g}")
@@ -132,40 +167,62 @@ def _cmd_backlash(args) -> int:
 
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog="gearsym",
-        description="Gear-train nonlinear dynamics: derive, generate code, analyse.")
-    parser.add_argument("--debug", action="store_true",
-                        help="show full tracebacks instead of one-line errors")
+        prog="gearsym", description="Gear-train nonlinear dynamics: derive, generate code, analyse."
+    )
+    parser.add_argument(
+        "--debug", action="store_true", help="show full tracebacks instead of one-line errors"
+    )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    d = sub.add_parser("derive", help="derive models; write generated/ and docs/",
-                       description="Derive the non-dimensional model of scenes or "
-                       "topologies, write generated/<name>.py and docs/derivation/<name>.md. "
-                       "Without targets: every shipped scene and topology, and "
-                       "docs/derivation.md.")
-    d.add_argument("targets", nargs="*", metavar="SCENE_OR_TOPOLOGY",
-                   help="a .toml path or the name of a built-in scene or topology")
-    d.add_argument("--json", action="store_true",
-                   help="print every number of the non-dimensional equations as JSON")
-    d.add_argument("--check", action="store_true",
-                   help="exit 1, naming the files, if generated/ or docs/ are stale")
+    d = sub.add_parser(
+        "derive",
+        help="derive models; write generated/ and docs/",
+        description="Derive the non-dimensional model of scenes or "
+        "topologies, write generated/<name>.py and docs/derivation/<name>.md. "
+        "Without targets: every shipped scene and topology, and "
+        "docs/derivation.md.",
+    )
+    d.add_argument(
+        "targets",
+        nargs="*",
+        metavar="SCENE_OR_TOPOLOGY",
+        help="a .toml path or the name of a built-in scene or topology",
+    )
+    d.add_argument(
+        "--json",
+        action="store_true",
+        help="print every number of the non-dimensional equations as JSON",
+    )
+    d.add_argument(
+        "--check",
+        action="store_true",
+        help="exit 1, naming the files, if generated/ or docs/ are stale",
+    )
     d.add_argument("--out", metavar="DIR", help="write under DIR instead of the project")
-    d.add_argument("--set", action="append", metavar="KEY=VALUE",
-                   help="override a scene parameter (repeatable)")
+    d.add_argument(
+        "--set",
+        action="append",
+        metavar="KEY=VALUE",
+        help="override a scene parameter (repeatable)",
+    )
     d.add_argument("--dry-run", action="store_true", help="derive but write nothing")
     d.set_defaults(func=_cmd_derive)
 
-    b = sub.add_parser("backlash", help="odd-polynomial least-squares fit of the dead zone",
-                       description="Fit an odd polynomial to the unit dead zone by least "
-                       "squares; with the defaults it reproduces the reference study's "
-                       "7th-order coefficients.")
+    b = sub.add_parser(
+        "backlash",
+        help="odd-polynomial least-squares fit of the dead zone",
+        description="Fit an odd polynomial to the unit dead zone by least "
+        "squares; with the defaults it reproduces the reference study's "
+        "7th-order coefficients.",
+    )
     b.add_argument("--order", type=int, default=7, help="odd order (default 7)")
-    b.add_argument("--range", type=float, default=3.0, metavar="A",
-                   help="fit on [-A, A] (default 3)")
-    b.add_argument("--step", type=float, default=0.01,
-                   help="spacing of the uniform samples (default 0.01)")
-    b.add_argument("--continuous", action="store_true",
-                   help="continuous L2 fit instead of samples")
+    b.add_argument(
+        "--range", type=float, default=3.0, metavar="A", help="fit on [-A, A] (default 3)"
+    )
+    b.add_argument(
+        "--step", type=float, default=0.01, help="spacing of the uniform samples (default 0.01)"
+    )
+    b.add_argument("--continuous", action="store_true", help="continuous L2 fit instead of samples")
     b.add_argument("--json", action="store_true", help="print JSON")
     b.set_defaults(func=_cmd_backlash)
     return parser

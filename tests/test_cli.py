@@ -1,0 +1,119 @@
+"""End-to-end tests of the `gearsym` command line."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+from gearsym.derive.build import build_files, check, shipped_targets, write_files
+from gearsym.solver.cli import main
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_derive_check_is_clean_on_the_checkout(capsys):
+    code, out, err = run(capsys, "derive", "--check")
+    assert code == 0, err
+    assert "match a fresh regeneration" in out
+
+
+def test_check_names_a_stale_file(tmp_path):
+    write_files(build_files(shipped_targets(), index=True).files, tmp_path)
+    assert check(tmp_path) == []
+    target = tmp_path / "generated" / "siso.py"
+    target.write_text(target.read_text() + "# edited by hand\n")
+    (tmp_path / "docs" / "derivation" / "tiso.md").unlink()
+    assert check(tmp_path) == ["generated/siso.py (differs)", "docs/derivation/tiso.md (missing)"]
+
+
+def test_derive_json_has_every_number(capsys):
+    code, out, _ = run(capsys, "derive", "reference-light", "--json", "--dry-run")
+    assert code == 0
+    data = json.loads(out)["reference_light"]
+    assert data["states"] == ["u", "v", "du", "dv"]
+    assert set(data["kappa"]) == {"uu", "uv", "vu", "vv"}
+    assert len(data["kappa"]["uv"]["cos"]) == 3 and len(data["kappa"]["uv"]["sin"]) == 3
+    assert data["kappa"]["vv"]["phase_rad"] == pytest.approx(2.0943951023931957)
+    assert set(data["xi"]) == {"uu", "uv", "vu", "vv"}
+    assert data["f"] == {"u": 0.1, "v": pytest.approx(-0.01)}
+    assert data["omega"] == 0.5
+    assert data["backlash"]["valid_range"] == 3.0
+    assert set(data["backlash"]["coefficients"]) == {"1", "3", "5", "7"}
+    assert data["transmission_error"]["u"]["amplitude"] == [pytest.approx(0.1)]
+    assert data["operations"]["rhs"] > 0
+    assert data["scales"]["omega_n_rad_per_s"] > 0
+
+
+def test_set_overrides_a_scene_parameter(capsys):
+    code, out, _ = run(
+        capsys, "derive", "reference-light", "--json", "--dry-run", "--set", "lambda=0.8"
+    )
+    assert code == 0
+    assert json.loads(out)["reference_light"]["f"]["v"] == pytest.approx(-0.08)
+
+
+def test_backlash_command_reproduces_the_study(capsys):
+    code, out, _ = run(capsys, "backlash", "--order", "7", "--json")
+    assert code == 0
+    data = json.loads(out)
+    coeff = {k: round(v, 4) for k, v in data["coefficients"].items()}
+    # Reference: the study's printed polynomial.
+    assert coeff == {"1": -0.1555, "3": 0.2833, "5": -0.0366, "7": 0.0017}
+    assert data["valid_range"] == [-3.0, 3.0]
+    assert 0 < data["max_error_vs_dead_zone"] < 0.2
+
+
+def test_regenerating_a_topology_with_an_added_input_gear(tmp_path, root, capsys):
+    text = (root / "scenes" / "topologies" / "diso.toml").read_text()
+    text = text.replace('name = "diso"', 'name = "diso_plus"')
+    extra = """
+[[gear]]
+id = "s"
+teeth = 50
+normal_module_mm = 4
+normal_pressure_angle_deg = 20
+helix_angle_deg = 10
+face_width_mm = 50
+
+[[mesh]]
+id = "sg"
+driver = "s"
+driven = "g"
+coordinate = "w"
+half_backlash_um = 50
+stiffness = { source = "contact-line", mean_N_per_m = 1.0e9 }
+layout_angle_deg = 240
+"""
+    head, sep, tail = text.partition("# Used when the topology is derived on its own")
+    path = tmp_path / "diso_plus.toml"
+    path.write_text(head + extra + sep + tail)
+    out_dir = tmp_path / "out"
+    code, out, err = run(capsys, "derive", str(path), "--out", str(out_dir))
+    assert code == 0, err
+    sys.path.insert(0, str(out_dir / "generated"))
+    try:
+        import diso_plus
+    finally:
+        sys.path.pop(0)
+    assert diso_plus.STATES == ("u", "v", "w", "du", "dv", "dw")
+    page = (out_dir / "docs" / "derivation" / "diso_plus.md").read_text()
+    assert "x_{sg}" in page and "K_{ww}" in page and "kappa_w_w" in page
+    assert "| s | 50 |" in page
+
+
+def test_console_script_runs_without_traceback_on_bad_input(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[scene]\nname = 'x'\n")
+    proc = subprocess.run(
+        [sys.executable, "-m", "gearsym.solver.cli", "derive", str(bad)],
+        capture_output=True,
+        text=True,
+    )
+    assert proc.returncode == 2
+    assert "Traceback" not in proc.stderr
+    assert proc.stderr.count("\n") == 1
+    assert "scene.topology: is required but missing" in proc.stderr
