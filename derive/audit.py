@@ -33,6 +33,14 @@ def _latex(expr, names: dict | None = None) -> str:
     return sp.latex(expr, symbol_names=names or {}, long_frac_ratio=3)
 
 
+def _closed(nd, expr) -> str:
+    """``closed form = value``, or just the number when the closed form is one."""
+    value = _num(nd.value(expr), 8)
+    if sp.sympify(expr).is_number:
+        return value
+    return _latex(expr) + " = " + value
+
+
 def _names(model: Model) -> dict:
     names = {s: p.latex for s, p in zip(model.parameter_symbols, model.parameters, strict=True)}
     for c, s in zip(model.coordinates, model.state_symbols, strict=False):
@@ -232,13 +240,7 @@ def audit_page(model: Model, command: str) -> str:
     for i, c in enumerate(model.coordinates):
         for j, cj in enumerate(model.coordinates):
             if nd.kappa[i, j] != 0:
-                rows.append(
-                    f"K_{{{c}{cj}}} &= "
-                    + _latex(nd.kappa[i, j])
-                    + " = "
-                    + _num(nd.value(nd.kappa[i, j]), 8)
-                    + r" \\"
-                )
+                rows.append(f"K_{{{c}{cj}}} &= " + _closed(nd, nd.kappa[i, j]) + r" \\")
     for i, c in enumerate(model.coordinates):
         for j, cj in enumerate(model.coordinates):
             if nd.xi[i, j] != 0:
@@ -247,22 +249,9 @@ def audit_page(model: Model, command: str) -> str:
                     if sp.Symbol(f"xi_{c}_{cj}", real=True) in model.parameter_symbols
                     else r"\quad(\text{dropped: damping coupling off})"
                 )
-                rows.append(
-                    f"\\xi_{{{c}{cj}}} &= "
-                    + _latex(nd.xi[i, j])
-                    + " = "
-                    + _num(nd.value(nd.xi[i, j]), 8)
-                    + used
-                    + r" \\"
-                )
+                rows.append(f"\\xi_{{{c}{cj}}} &= " + _closed(nd, nd.xi[i, j]) + used + r" \\")
     for i, c in enumerate(model.coordinates):
-        rows.append(
-            f"f_{{{c}}}^{{\\mathrm{{torques}}}} &= "
-            + _latex(nd.load[i])
-            + " = "
-            + _num(nd.value(nd.load[i]), 8)
-            + r" \\"
-        )
+        rows.append(f"f_{{{c}}}^{{\\mathrm{{torques}}}} &= " + _closed(nd, nd.load[i]) + r" \\")
     w(_math(r"\begin{aligned}", *rows, r"\end{aligned}"))
     if scene.loads is not None:
         w(
