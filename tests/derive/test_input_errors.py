@@ -17,6 +17,12 @@ def derive(capsys, path):
     return code, err
 
 
+def assert_one_line_error(code, err, path, expected):
+    assert code == 2
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert str(path) in err and expected in err, err
+
+
 TOPOLOGY_CASES = [
     # (what, old text, new text, expected fragment)
     (
@@ -118,10 +124,7 @@ def test_bad_topology(files, capsys, what, old, new, expected):
     assert old in topo, f"test set-up: '{old}' not in the topology"
     path = tmp / "topo.toml"
     path.write_text(topo.replace(old, new, 1))
-    code, err = derive(capsys, path)
-    assert code == 2
-    assert err.count("\n") == 1 and "Traceback" not in err
-    assert str(path) in err and expected in err, err
+    assert_one_line_error(*derive(capsys, path), path, expected)
 
 
 def test_disconnected_gear(files, capsys):
@@ -201,10 +204,7 @@ def test_bad_scene(files, capsys, root, what, old, new, expected):
     )
     path = tmp / "scene.toml"
     path.write_text(scene.replace(old, new, 1))
-    code, err = derive(capsys, path)
-    assert code == 2
-    assert err.count("\n") == 1 and "Traceback" not in err
-    assert str(path) in err and expected in err, err
+    assert_one_line_error(*derive(capsys, path), path, expected)
 
 
 def test_bad_toml_syntax(tmp_path, capsys):
