@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .audit import audit_page, index_page
+from ._input import InputError
 from .emit import emit_module, operation_count, write_atomic
 from .model import Model, derive_model
 from .scene import builtin_root, load_target
@@ -71,7 +72,12 @@ def build_files(
     names = [m.name for m in models]
     if len(set(names)) != len(names):
         dup = sorted({n for n in names if names.count(n) > 1})
-        raise ValueError(f"two targets derive to the same model name: {', '.join(dup)}")
+        raise InputError(
+            "derive",
+            "name",
+            f"two targets derive to the same model name ({', '.join(dup)}); "
+            "give each scene or topology its own name",
+        )
     if index:
         files["docs/derivation.md"] = index_page(models, "gearsym derive")
     return Built(tuple(models), files)

@@ -23,7 +23,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import sympy as sp
 
@@ -64,7 +64,6 @@ class Model:
     scales: dict
     frequency_ratios: tuple[sp.Rational, ...]
     inputs_hash: str
-    extra: dict = field(default_factory=dict)
 
     @property
     def features(self) -> Features:
@@ -207,11 +206,9 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
                     f"transmission-error phase {h} of mesh {me.id}, rad",
                     rf"\psi_{{{coords[j]},{h}}}",
                 )
-    backlash_params = {
-        name: param(name, value, meaning, _latex_backlash(name))
-        for name, value, meaning in feats.backlash.parameters()
-    }
-    del backlash_params  # the expression refers to them by name
+    # The backlash expression refers to its parameters by name; register them in order.
+    for pname, value, meaning in feats.backlash.parameters():
+        param(pname, value, meaning, _latex_backlash(pname))
 
     # Assemble the non-dimensional equations.
     phase_arg = [freq[j] * omega * tau - phi.get(j, 0) for j in range(m)]
