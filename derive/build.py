@@ -13,8 +13,8 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
-from .audit import audit_page, index_page
 from ._input import InputError
+from .audit import audit_page, index_page
 from .emit import emit_module, operation_count, write_atomic
 from .model import Model, derive_model
 from .scene import builtin_root, load_target
