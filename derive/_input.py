@@ -53,6 +53,7 @@ def load_toml(path: Path) -> dict[str, Any]:
 
 
 _MISSING = object()
+_TARGET_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
 
 
 class Table:
@@ -148,6 +149,17 @@ class Table:
                     f"'{value}' is not one of {', '.join(repr(c) for c in choices)}"
                     + nearest(value, choices),
                 )
+        return value
+
+    def target_name(self, name: str) -> str:
+        """A scene or topology name: it names ``generated/<name>.py`` ('-' becomes '_')."""
+        value = self.string(name)
+        if not _TARGET_NAME.match(value):
+            raise self.error(
+                name,
+                f"'{value}' must start with a letter and use only letters, digits, '-' and '_' "
+                "(it names the generated module)",
+            )
         return value
 
     def boolean(self, name: str, default: Any = _MISSING) -> bool:

@@ -161,7 +161,7 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
     source = str(path)
     top = Table(data, source)
     head = top.table("scene")
-    name = head.string("name")
+    name = head.target_name("name")
     description = head.string("description", "")
     topo_ref = head.string("topology")
     head.finish()

@@ -264,7 +264,7 @@ def parse_topology(data: dict, source: str) -> Topology:
     """Build and validate a :class:`Topology` from parsed TOML ``data``."""
     top = Table(data, source)
     head = top.table("topology")
-    name = head.string("name")
+    name = head.target_name("name")
     description = head.string("description", "")
     head.finish()
 

@@ -108,6 +108,12 @@ TOPOLOGY_CASES = [
         "operatin: unknown key (did you mean 'operating'?)",
     ),
     (
+        "name that cannot name a module",
+        'name = "diso"',
+        'name = "2 stage"',
+        "topology.name: '2 stage' must start with a letter",
+    ),
+    (
         "torque on unknown gear",
         'gear = "q"\ntorque_Nm',
         'gear = "z"\ntorque_Nm',
