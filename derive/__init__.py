@@ -1,7 +1,8 @@
 """gearsym.derive -- from gear data and topology to the non-dimensional model (SI inside).
 
-Public entry points: :func:`load_target` (scene or topology file), :func:`derive_model`,
-:func:`emit` (generated code and audit pages) and :func:`fit_dead_zone`.
+Public entry points: :func:`load_target` (scene or topology file), :func:`derive_model`
+and :func:`fit_dead_zone`; ``gearsym.derive.build`` writes the generated code and the
+audit pages.
 """
 
 __version__ = "0.1.0"

@@ -54,6 +54,8 @@ def load_toml(path: Path) -> dict[str, Any]:
 
 _MISSING = object()
 _TARGET_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
+_IDENTIFIER = re.compile(r"^[A-Za-z][A-Za-z0-9]*$")
+_MAX_EXPRESSION = 200
 
 
 class Table:
@@ -84,6 +86,8 @@ class Table:
         return InputError(self.source, self.key(name), message)
 
     def has(self, name: str) -> bool:
+        """Whether ``name`` is present; it counts as a known key from then on."""
+        self._seen.add(name)
         return name in self.data
 
     def _get(self, name: str, default: Any) -> Any:
@@ -159,6 +163,17 @@ class Table:
                 name,
                 f"'{value}' must start with a letter and use only letters, digits, '-' and '_' "
                 "(it names the generated module)",
+            )
+        return value
+
+    def identifier(self, name: str) -> str:
+        """A name that becomes a Python identifier in generated code (letters, digits)."""
+        value = self.string(name)
+        if not _IDENTIFIER.match(value) or keyword.iskeyword(value):
+            raise self.error(
+                name,
+                f"'{value}' must be letters and digits starting with a letter, and not a "
+                "Python keyword (it becomes a name in generated code)",
             )
         return value
 
@@ -240,6 +255,13 @@ def parse_expression(text: str, names: dict[str, float], *, source: str, key: st
         return float(text)
     if not isinstance(text, str):
         raise InputError(source, key, f"must be a number or an expression, got {text!r}")
+    if len(text) > _MAX_EXPRESSION or "__kw" in text:
+        raise InputError(
+            source,
+            key,
+            f"'{text[:40]}...' is not a plain arithmetic expression of at most "
+            f"{_MAX_EXPRESSION} characters",
+        )
     # Scene parameters may be named like Python keywords ("lambda"): rename before parsing.
     mangled = _KEYWORD.sub(lambda mo: mo.group(0) + "__kw", text)
     try:
@@ -257,7 +279,7 @@ def parse_expression(text: str, names: dict[str, float], *, source: str, key: st
         ):
             return float(node.value)
         if isinstance(node, ast.Name):
-            name = node.id.removesuffix("__kw") if node.id.endswith("__kw") else node.id
+            name = node.id.removesuffix("__kw")
             if name not in names:
                 raise InputError(
                     source,
@@ -281,7 +303,14 @@ def parse_expression(text: str, names: dict[str, float], *, source: str, key: st
             f"'{text}' may use only numbers, scene parameters, + - * / ** and parentheses",
         )
 
-    value = walk(tree)
+    try:
+        value = walk(tree)
+    except (OverflowError, RecursionError):
+        raise InputError(source, key, f"'{text}' overflows; use smaller numbers") from None
+    if isinstance(value, complex):
+        raise InputError(
+            source, key, f"'{text}' is not a real number (negative base to a fractional power)"
+        )
     if not math.isfinite(value):
         raise InputError(source, key, f"'{text}' evaluates to {value}")
     return value

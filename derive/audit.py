@@ -14,7 +14,6 @@ import math
 import sympy as sp
 
 from .backlash import fit_dead_zone
-from .emit import operation_count
 from .model import Model
 
 __all__ = ["audit_page", "index_page"]
@@ -271,8 +270,7 @@ def audit_page(model: Model, command: str) -> str:
     w("")
 
     w("## 9. Emitted model\n")
-    ops_rhs = operation_count(model.rhs)
-    ops_all = operation_count(list(model.rhs) + list(model.jacobian))
+    ops_rhs, ops_all = model.operations["rhs"], model.operations["rhs_and_jacobian"]
     feats = scene.features
     w(
         f"States, in order: {', '.join(f'`{s}`' for s in model.states)}. "
@@ -342,7 +340,7 @@ def index_page(models: list[Model], command: str) -> str:
         "|---|---|---|---|---|---|",
     ]
     for model in models:
-        ops = (operation_count(model.rhs), operation_count(list(model.rhs) + list(model.jacobian)))
+        ops = (model.operations["rhs"], model.operations["rhs_and_jacobian"])
         out.append(
             f"| `{model.name}` | `{_rel(model.scene.source)}` | "
             f"{', '.join(model.states)} | {len(model.parameters)} | "

@@ -190,6 +190,9 @@ BACKLASH_MODELS = {
 }
 
 
+_MAX_SAMPLES = 1_000_000
+
+
 def fit_dead_zone(
     order: int = 7, fit_range: float = 3.0, step: float | None = 0.01
 ) -> PolynomialFit:
@@ -223,6 +226,11 @@ def fit_dead_zone(
         if not (math.isfinite(step) and step > 0):
             raise ValueError(f"step must be > 0, got {step}")
         samples = int(round(2.0 * fit_range / step)) + 1
+        if samples > _MAX_SAMPLES:
+            raise ValueError(
+                f"step {step:g} gives {samples} samples (at most {_MAX_SAMPLES}); use a step "
+                f">= {2.0 * fit_range / (_MAX_SAMPLES - 1):.3g}, or 0 for the continuous fit"
+            )
         if samples <= len(powers):
             raise ValueError(
                 f"step {step} leaves {samples} samples for {len(powers)} "

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from ._input import InputError
 from .audit import audit_page, index_page
-from .emit import emit_module, operation_count, write_atomic
+from .emit import emit_module, write_atomic
 from .model import Model, derive_model
 from .scene import builtin_root, load_target
 
@@ -177,12 +177,9 @@ def describe(model: Model) -> dict:
         "transmission_error_form": "ebar_j(tau) = sum_h amplitude_h cos(h(r w tau - phase_j)"
         " + phase_h)",
         "backlash": backlash,
-        "features": feats.describe() | {"backlash": b.kind},
+        "features": feats.flags(),
         "scales": model.scales,
-        "operations": {
-            "rhs": operation_count(model.rhs),
-            "rhs_and_jacobian": operation_count(list(model.rhs) + list(model.jacobian)),
-        },
+        "operations": model.operations,
     }
 
 

@@ -92,9 +92,8 @@ def _body(model: Model, outputs, printer: CodePrinter, indent: str = "    ") -> 
         else set()
     )
     lines = []
-    states = [s for s in model.state_symbols if s in used]
     for k, s in enumerate(model.state_symbols):
-        if s in states:
+        if s in used:
             lines.append(f"{indent}{s.name} = x[{k}]")
     for k, s in enumerate(model.parameter_symbols):
         if s in used:
@@ -184,17 +183,16 @@ def emit_module(model: Model, command: str) -> str:
         "HALF_BACKLASH = {"
         + ", ".join(f"{k!r}: {fmt(v)}" for k, v in scales["half_backlash_m"].items())
         + "}  # m",
-        f"FEATURES = {_features_literal(model)}",
-        f"OPERATIONS = {{'rhs': {operation_count(rhs)}, 'rhs_and_jacobian': "
-        f"{operation_count(rhs + jac)}}}",
+        f"FEATURES = {model.features.flags()!r}",
+        f"OPERATIONS = {model.operations!r}",
         "",
         "",
         "def rhs(tau, x, p):",
-        '    """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); returns x\'s shape."""',
+        '    """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); result (n,) or (n, N)."""',
         *rhs_lines,
-        "    return np.array([",
+        "    return np.array(np.broadcast_arrays(",
         *(f"        {o}," for o in rhs_out),
-        "    ])",
+        "    ))",
         "",
         "",
         "def jacobian(tau, x, p):",
@@ -229,20 +227,6 @@ def emit_module(model: Model, command: str) -> str:
         "",
     ]
     return "\n".join(src)
-
-
-def _features_literal(model: Model) -> str:
-    f = model.features
-    b = f.backlash
-    return repr(
-        {
-            "stiffness_harmonics": f.stiffness_harmonics,
-            "backlash": b.kind,
-            "transmission_error": f.transmission_error,
-            "mesh_phase": f.mesh_phase,
-            "damping_coupling": f.damping_coupling,
-        }
-    )
 
 
 def write_atomic(path: Path, text: str) -> None:

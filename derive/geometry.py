@@ -95,6 +95,7 @@ class PairGeometry:
     transverse_base_pitch: float
     transverse_contact_ratio: float
     axial_contact_ratio: float
+    approach_length: float
 
     @property
     def total_contact_ratio(self) -> float:
@@ -123,6 +124,10 @@ def pair_geometry(driver: GearGeometry, driven: GearGeometry, face_width: float)
     inv_wt = involute(alpha_t) + 2.0 * math.tan(driver.normal_pressure_angle) * shift / (
         driver.teeth + driven.teeth
     )
+    if inv_wt <= 0:
+        raise ValueError(
+            f"the profile shifts (x1 + x2 = {shift:g}) leave no positive working pressure angle"
+        )
     alpha_wt = alpha_t if shift == 0.0 else _inverse_involute(inv_wt)
     a_w = (driver.pitch_radius + driven.pitch_radius) * math.cos(alpha_t) / math.cos(alpha_wt)
     g_alpha = (
@@ -140,6 +145,8 @@ def pair_geometry(driver: GearGeometry, driven: GearGeometry, face_width: float)
         path_of_contact=g_alpha,
         transverse_base_pitch=p_bt,
         transverse_contact_ratio=g_alpha / p_bt,
+        approach_length=math.sqrt(driven.tip_radius**2 - driven.base_radius**2)
+        - driven.base_radius * math.tan(alpha_wt),
         axial_contact_ratio=face_width
         * math.sin(abs(driver.helix_angle))
         / (math.pi * driver.normal_module),

@@ -24,10 +24,12 @@ import hashlib
 import json
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import sympy as sp
 
 from . import __version__
+from ._input import InputError
 from .equations import derive_equations
 from .nondim import NonDim, nondimensionalise
 from .scene import Features, Scene
@@ -81,6 +83,16 @@ class Model:
     def valid_range(self) -> float | None:
         return self.features.backlash.valid_range
 
+    @cached_property
+    def operations(self) -> dict[str, int]:
+        """Operation counts of the emitted code after common-subexpression elimination."""
+        from .emit import operation_count
+
+        return {
+            "rhs": operation_count(self.rhs),
+            "rhs_and_jacobian": operation_count(list(self.rhs) + list(self.jacobian)),
+        }
+
 
 def _inputs_hash(scene: Scene) -> str:
     """sha256 of everything the generated files depend on: the input files' parsed
@@ -120,13 +132,21 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
 
     def param(name: str, value: float, meaning: str, latex: str) -> sp.Symbol:
         if not math.isfinite(value):
-            raise ValueError(f"parameter {name} = {value} is not finite")
+            raise InputError(
+                topo.source,
+                "mesh",
+                f"the data give {name} = {value}, which is not finite; check the stiffness, "
+                "backlash and inertia values for extreme magnitudes",
+            )
         params.append(Parameter(name, float(value), meaning, latex))
         return sp.Symbol(name, real=True)
 
+    omega_value = scene.omega
+    if omega_value is None:  # a topology: from its operating speed and omega_n
+        omega_value = topo.reference_mesh_frequency() / nd.value(nd.omega_n_expr)
     omega = param(
         "omega",
-        scene.omega,
+        omega_value,
         "excitation (mesh) frequency of the reference mesh over omega_n",
         r"\bar\omega",
     )
@@ -164,6 +184,13 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
     H = feats.stiffness_harmonics
     kc, ks = {}, {}
     for j, me in enumerate(meshes):
+        if H > me.stiffness.harmonics:
+            raise InputError(
+                scene.source,
+                "features.stiffness_harmonics",
+                f"asks for {H} harmonics but mesh '{me.id}' of {topo.source} gives only "
+                f"{me.stiffness.harmonics}; lower it or give more harmonics",
+            )
         cs, ss = me.stiffness.normalised(H)
         for h in range(1, H + 1):
             kc[j, h] = param(
@@ -245,14 +272,17 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
     rhs = du + acc
     jac = sp.ImmutableMatrix(rhs).jacobian(state_symbols)
 
+    used = set().union(*(e.free_symbols for e in rhs))
+    # A parameter no term uses (a phase with constant stiffness and no transmission
+    # error, say) is not emitted; omega stays: it sets the forcing period for the solver.
+    params = [p for p in params if p.name == "omega" or sp.Symbol(p.name, real=True) in used]
     names = [p.name for p in params]
-    known = set(state_symbols) | {sp.Symbol(n, real=True) for n in names} | {tau}
-    stray = set().union(*(e.free_symbols for e in rhs)) - known
+    stray = used - set(state_symbols) - {sp.Symbol(n, real=True) for n in names} - {tau}
     if stray:
         raise AssertionError(f"right-hand side uses undeclared symbols {sorted(map(str, stray))}")
     clash = set(names) & set(states)
     if clash or len(set(names)) != len(names):
-        raise ValueError(f"name clash between states and parameters: {sorted(clash)}")
+        raise AssertionError(f"name clash between states and parameters: {sorted(clash)}")
 
     om = nd.value(nd.omega_n_expr)
     scales = {

@@ -27,7 +27,7 @@ import sympy as sp
 from .equations import Equations, derive_equations
 from .topology import Topology
 
-__all__ = ["NonDim", "natural_frequency", "nondimensionalise"]
+__all__ = ["NonDim", "nondimensionalise"]
 
 
 @dataclass(frozen=True)
@@ -36,7 +36,6 @@ class NonDim:
 
     equations: Equations
     zeta: sp.Symbol
-    omega_n: sp.Symbol
     omega_n_expr: sp.Expr
     damping_expr: tuple[sp.Expr, ...]
     kappa: sp.ImmutableMatrix
@@ -57,7 +56,6 @@ def nondimensionalise(
     W = eq.compliance
     m = len(eq.meshes)
     zeta = sp.Symbol(r"\zeta", nonnegative=True)
-    omega_n = sp.Symbol(r"\omega_n", positive=True)
     omega_n_expr = sp.sqrt(eq.mean_stiffness[0] * W[0, 0])
     damping = tuple(2 * zeta * sp.sqrt(eq.mean_stiffness[j] / W[j, j]) for j in range(m))
     b, km = eq.half_backlash, eq.mean_stiffness
@@ -85,10 +83,4 @@ def nondimensionalise(
         values[eq.beta_b[i]] = mesh.pair.driver.base_helix_angle
         values[eq.half_backlash[i]] = mesh.half_backlash
         values[eq.mean_stiffness[i]] = mesh.stiffness.mean
-    return NonDim(eq, zeta, omega_n, omega_n_expr, damping, kappa, xi, load, values)
-
-
-def natural_frequency(topology: Topology) -> float:
-    """``omega_n`` of the reference mesh, rad/s."""
-    nd = nondimensionalise(topology)
-    return nd.value(nd.omega_n_expr)
+    return NonDim(eq, zeta, omega_n_expr, damping, kappa, xi, load, values)

@@ -22,12 +22,12 @@ damping ratio from its ``[operating]`` table.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ._input import InputError, Table, load_toml, nearest, parse_expression
 from .backlash import (
+    BACKLASH_MODELS,
     Backlash,
     DeadZone,
     LinearContact,
@@ -56,14 +56,19 @@ class Features:
     mesh_phase: bool = True
     damping_coupling: bool = True
 
-    def describe(self) -> dict:
+    def flags(self) -> dict:
+        """The feature switches, with the backlash by kind only."""
         return {
             "stiffness_harmonics": self.stiffness_harmonics,
-            "backlash": self.backlash.describe(),
+            "backlash": self.backlash.kind,
             "transmission_error": self.transmission_error,
             "mesh_phase": self.mesh_phase,
             "damping_coupling": self.damping_coupling,
         }
+
+    def describe(self) -> dict:
+        """The feature switches with the backlash model's full description."""
+        return self.flags() | {"backlash": self.backlash.describe()}
 
 
 @dataclass(frozen=True)
@@ -85,38 +90,50 @@ class Scene:
     kind: str = "scene"  # "scene" or "topology" (a topology derived with default features)
 
     @property
-    def omega(self) -> float:
-        return self.parameters["omega"]
+    def omega(self) -> float | None:
+        """omega, or None for a topology whose omega follows from its operating speed."""
+        return self.parameters.get("omega")
 
     @property
     def damping_ratio(self) -> float:
         return self.parameters["damping_ratio"]
 
 
+def _polynomial(t: Table) -> Backlash:
+    order = t.integer("backlash_order", 7, low=1, high=31)
+    if order % 2 == 0:
+        raise t.error("backlash_order", f"must be odd (the dead zone is odd), got {order}")
+    fit_range = t.number("backlash_range", 3.0, low=1.0, low_open=True, high=100.0)
+    step = t.number("backlash_step", 0.01, low=0.0)
+    try:
+        return fit_dead_zone(order, fit_range, step if step > 0 else None)
+    except ValueError as err:
+        raise t.error("backlash_step", str(err)) from None
+
+
+# Registry: backlash kind -> (the keys it reads, how it is built from the [features] table).
+_BACKLASH_BUILDERS = {
+    "linear": ((), lambda t: LinearContact()),
+    "dead-zone": ((), lambda t: DeadZone()),
+    "smooth": (
+        ("backlash_width",),
+        lambda t: SmoothDeadZone(t.number("backlash_width", 0.05, low=0, low_open=True, high=1.0)),
+    ),
+    "polynomial": (("backlash_order", "backlash_range", "backlash_step"), _polynomial),
+}
+assert set(_BACKLASH_BUILDERS) == set(BACKLASH_MODELS)
+
+
 def _features(t: Table | None) -> Features:
     if t is None:
         return Features()
     harmonics = t.integer("stiffness_harmonics", 3, low=0, high=64)
-    kind = t.string(
-        "backlash", "polynomial", choices=("linear", "dead-zone", "smooth", "polynomial")
-    )
-    backlash: Backlash
-    if kind == "polynomial":
-        order = t.integer("backlash_order", 7, low=1, high=31)
-        if order % 2 == 0:
-            raise t.error("backlash_order", f"must be odd (the dead zone is odd), got {order}")
-        fit_range = t.number("backlash_range", 3.0, low=1.0, low_open=True, high=100.0)
-        step = t.number("backlash_step", 0.01, low=0.0)
-        try:
-            backlash = fit_dead_zone(order, fit_range, step if step > 0 else None)
-        except ValueError as err:
-            raise t.error("backlash_step", str(err)) from None
-    elif kind == "smooth":
-        backlash = SmoothDeadZone(t.number("backlash_width", 0.05, low=0, low_open=True, high=1.0))
-    elif kind == "dead-zone":
-        backlash = DeadZone()
-    else:
-        backlash = LinearContact()
+    kind = t.string("backlash", "polynomial", choices=tuple(BACKLASH_MODELS))
+    for other, (keys, _) in _BACKLASH_BUILDERS.items():
+        for key in keys:
+            if other != kind and key in t.data:
+                raise t.error(key, f"applies to backlash = '{other}' only, not '{kind}'")
+    backlash = _BACKLASH_BUILDERS[kind][1](t)
     features = Features(
         stiffness_harmonics=harmonics,
         backlash=backlash,
@@ -230,7 +247,7 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
 
 
 def _check_parameters(t: Table, parameters: dict[str, float]) -> None:
-    if not parameters["omega"] > 0:
+    if "omega" in parameters and not parameters["omega"] > 0:
         raise t.error("omega", f"must be > 0, got {parameters['omega']:g}")
     if not 0 <= parameters["damping_ratio"] <= 1:
         raise t.error("damping_ratio", f"must be in [0, 1], got {parameters['damping_ratio']:g}")
@@ -257,18 +274,16 @@ def load_target(path: Path | str, overrides: dict[str, float] | None = None) -> 
                 "a topology derived on its own needs "
                 "[[torque]] entries for its loads; or derive a scene that uses it",
             )
-        from .nondim import natural_frequency
-
-        omega = topology.reference_mesh_frequency() / natural_frequency(topology)
-        parameters = {"omega": omega, "damping_ratio": topology.operating.damping_ratio}
+        # omega follows from the operating speed once the model knows omega_n (derive_model);
+        # it may be overridden like the damping ratio.
+        parameters = {"damping_ratio": topology.operating.damping_ratio}
         for key, value in (overrides or {}).items():
-            if key not in parameters:
+            if key not in ("omega", "damping_ratio"):
                 raise InputError(
                     str(path), key, "cannot be set on a topology; parameters: omega, damping_ratio"
                 )
             parameters[key] = float(value)
-        if not math.isfinite(omega):
-            raise InputError(str(path), "operating", "gives a non-finite omega")
+        _check_parameters(Table({}, str(path), "operating"), parameters)
         return Scene(
             topology.name,
             topology.description,

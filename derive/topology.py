@@ -34,9 +34,9 @@ __all__ = [
     "parse_topology",
 ]
 
-_IDENT = re.compile(r"^[A-Za-z][A-Za-z0-9]*$")
 # Names the generated code uses itself; coordinates may not take them.
 _RESERVED = {"tau", "x", "p", "np", "ca", "omega", "out", "jac", "rhs"}
+_BACKLASH_NAME = re.compile(r"^g[0-9]+$")
 
 
 @dataclass(frozen=True)
@@ -169,17 +169,6 @@ class Topology:
         return float(self.gear(ref.driver).teeth * speed[ref.driver]) * self.operating.speed
 
 
-def _ident(t: Table, name: str) -> str:
-    value = t.string(name)
-    if not _IDENT.match(value):
-        raise t.error(
-            name,
-            f"'{value}' must be a name of letters and digits starting with a "
-            "letter (it becomes a Python identifier)",
-        )
-    return value
-
-
 def _material(t: Table, name: str) -> Material:
     return Material(
         name=name,
@@ -193,7 +182,7 @@ _STEEL = Material("steel", 2.06e11, 0.3, 7850.0)
 
 
 def _gear(t: Table, materials: dict[str, Material]) -> Gear:
-    gid = _ident(t, "id")
+    gid = t.identifier("id")
     teeth = t.integer("teeth", low=5)
     mn = t.number("normal_module_mm", low=0, low_open=True) * 1e-3
     alpha_n = math.radians(t.number("normal_pressure_angle_deg", 20.0, low=10.0, high=35.0))
@@ -251,6 +240,78 @@ def _stiffness(t: Table, pair: PairGeometry) -> MeshStiffness:
     )
 
 
+def _check_contact(t: Table, pair: PairGeometry, ends: list[str]) -> None:
+    """Involute contact must stay above both base circles, and the total contact ratio
+    must reach 1 (for helical gears the overlap counts: eps_gamma = eps_alpha + eps_beta)."""
+    approach = pair.approach_length
+    recess = pair.path_of_contact - approach
+    for length, gear, other in ((approach, ends[0], ends[1]), (recess, ends[1], ends[0])):
+        base = pair.driver if gear == ends[0] else pair.driven
+        available = base.base_radius * math.tan(pair.working_pressure_angle)
+        if length > available * (1 + 1e-12):
+            raise t.error(
+                "driven",
+                f"involute interference: the tip of '{other}' reaches below the base circle of "
+                f"'{gear}' ({length * 1e3:.3f} mm of contact path against {available * 1e3:.3f} "
+                "mm available); use more teeth or a positive profile shift",
+            )
+    if pair.total_contact_ratio < 1.0:
+        raise t.error(
+            "driven",
+            f"total contact ratio {pair.total_contact_ratio:.3f} is below 1: the pair cannot "
+            "transmit motion continuously",
+        )
+
+
+def _phase(t: Table, meshes: list, ends: list[str], by_id: dict) -> tuple[float, str]:
+    """Stiffness/transmission-error phase lag of a mesh relative to the first mesh.
+
+    Either given (``stiffness_phase_deg``) or from the layout (``layout_angle_deg``): a mesh
+    that shares a gear with the first mesh, in the same role (driver or driven in both),
+    whose other centre lies an angle psi further round that gear in its direction of
+    rotation, sees each tooth psi / w later -- a lag of z psi / 360 teeth, i.e.
+    2 pi delta with delta the fractional part of z psi / 360 deg.
+    """
+    given, angle = t.has("stiffness_phase_deg"), t.has("layout_angle_deg")
+    if not (given or angle):
+        return 0.0, "reference" if not meshes else "none given"
+    if not meshes:
+        raise t.error(
+            "layout_angle_deg" if angle else "stiffness_phase_deg",
+            "the first mesh sets the time origin and takes no phase; give phases on the "
+            "other meshes",
+        )
+    if given and angle:
+        raise t.error(
+            "layout_angle_deg", "give either stiffness_phase_deg or layout_angle_deg, not both"
+        )
+    if given:
+        return math.radians(t.number("stiffness_phase_deg")), "given"
+    psi = t.number("layout_angle_deg", low=-360.0, high=360.0)
+    ref = meshes[0]
+    common = sorted({ends[0], ends[1]} & {ref.driver, ref.driven})
+    if not common:
+        raise t.error(
+            "layout_angle_deg",
+            f"needs a mesh that shares a gear with the first mesh '{ref.id}'",
+        )
+    gear = common[0]
+    role_ref = "driver" if ref.driver == gear else "driven"
+    role_here = "driver" if ends[0] == gear else "driven"
+    if role_ref != role_here:
+        raise t.error(
+            "layout_angle_deg",
+            f"gear '{gear}' is the {role_ref} in mesh '{ref.id}' but the {role_here} here: "
+            "opposite flanks carry the load, which this layout rule does not cover; give "
+            "stiffness_phase_deg instead",
+        )
+    teeth = by_id[gear].teeth * psi / 360.0
+    delta = teeth - math.floor(teeth)
+    return 2.0 * math.pi * delta, (
+        f"layout: {psi:g} deg round gear '{gear}' spans {teeth:.4f} teeth, delta = {delta:.4f}"
+    )
+
+
 def _transmission_error(t: Table | None) -> TransmissionError:
     if t is None:
         return TransmissionError()
@@ -283,9 +344,8 @@ def parse_topology(data: dict, source: str) -> Topology:
     by_id = {g.id: g for g in gears}
 
     meshes: list[Mesh] = []
-    layout: dict[str, tuple[Table, float]] = {}
     for mt in top.tables("mesh"):
-        mid = _ident(mt, "id")
+        mid = mt.identifier("id")
         ends = []
         for end in ("driver", "driven"):
             gid = mt.string(end)
@@ -304,30 +364,17 @@ def parse_topology(data: dict, source: str) -> Topology:
             pair = pair_geometry(g1.geometry, g2.geometry, min(g1.face_width, g2.face_width))
         except ValueError as err:
             raise mt.error("driven", f"'{ends[0]}' and '{ends[1]}' cannot mesh: {err}") from None
-        if pair.transverse_contact_ratio < 1.0:
+        _check_contact(mt, pair, ends)
+        coordinate = mt.identifier("coordinate")
+        if coordinate in _RESERVED or _BACKLASH_NAME.match(coordinate):
             raise mt.error(
-                "driven",
-                f"transverse contact ratio {pair.transverse_contact_ratio:.3f}"
-                " is below 1: the pair cannot transmit motion continuously",
-            )
-        coordinate = _ident(mt, "coordinate")
-        if coordinate in _RESERVED:
-            raise mt.error(
-                "coordinate", f"'{coordinate}' is reserved; avoid {', '.join(sorted(_RESERVED))}"
+                "coordinate",
+                f"'{coordinate}' is reserved; avoid {', '.join(sorted(_RESERVED))} and g1, g3, ...",
             )
         backlash = mt.number("half_backlash_um", low=0, low_open=True) * 1e-6
         stiffness = _stiffness(mt.table("stiffness"), pair)
         te = _transmission_error(mt.table("transmission_error", None))
-        phase, phase_source = 0.0, "reference"
-        if mt.has("stiffness_phase_deg") and mt.has("layout_angle_deg"):
-            raise mt.error(
-                "layout_angle_deg", "give either stiffness_phase_deg or layout_angle_deg, not both"
-            )
-        if mt.has("stiffness_phase_deg"):
-            phase = math.radians(mt.number("stiffness_phase_deg"))
-            phase_source = "given"
-        if mt.has("layout_angle_deg"):
-            layout[mid] = (mt, mt.number("layout_angle_deg", low=-360.0, high=360.0))
+        phase, phase_source = _phase(mt, meshes, ends, by_id)
         mt.finish()
         for other in meshes:
             if other.id == mid:
@@ -353,37 +400,14 @@ def parse_topology(data: dict, source: str) -> Topology:
             )
         )
 
-    # Layout phase: a mesh sharing a gear with the reference mesh, whose pinion centre sits
-    # an angle psi further round that gear, sees the same tooth pass psi / w later: a lag of
-    # z psi teeth, i.e. 2 pi delta with delta the fractional part of z psi / 2 pi.
-    ref = meshes[0]
-    for i, m in enumerate(meshes):
-        if m.id not in layout:
-            continue
-        mt, angle = layout[m.id]
-        common = {m.driver, m.driven} & {ref.driver, ref.driven}
-        if i == 0 or not common:
-            raise mt.error(
-                "layout_angle_deg",
-                "needs a mesh that shares a gear with the "
-                f"reference mesh '{ref.id}' (the first mesh)",
+    coords = {m.coordinate for m in meshes}
+    for m in meshes:
+        if f"d{m.coordinate}" in coords:
+            raise top.error(
+                "mesh",
+                f"coordinates '{m.coordinate}' and 'd{m.coordinate}' clash: the derivative of "
+                f"'{m.coordinate}' is named 'd{m.coordinate}'; rename one",
             )
-        z = by_id[sorted(common)[0]].teeth
-        teeth_spanned = z * angle / 360.0
-        delta = teeth_spanned - math.floor(teeth_spanned)
-        meshes[i] = Mesh(
-            m.id,
-            m.driver,
-            m.driven,
-            m.coordinate,
-            m.half_backlash,
-            m.stiffness,
-            m.transmission_error,
-            2.0 * math.pi * delta,
-            f"layout: {angle:g} deg on gear '{sorted(common)[0]}' spans "
-            f"{teeth_spanned:.4f} teeth, delta = {delta:.4f}",
-            m.pair,
-        )
 
     _check_tree(top, gears, meshes)
 

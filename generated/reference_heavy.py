@@ -38,7 +38,7 @@ Parameters (in order; default = the scene's value):
     20  ks_v_2        0.0112835920213354  sine stiffness harmonic 2 of mesh qg over its mean
     21  kc_v_3        0.0014086338110351  cosine stiffness harmonic 3 of mesh qg over its mean
     22  ks_v_3        0.00296030393880896  sine stiffness harmonic 3 of mesh qg over its mean
-    23  phi_v         2.09439510239321  stiffness/TE phase lag of mesh qg, rad (layout: 120 deg on gear 'g' spans 33.3333 teeth, delta = 0.3333)
+    23  phi_v         2.09439510239321  stiffness/TE phase lag of mesh qg, rad (layout: 120 deg round gear 'g' spans 33.3333 teeth, delta = 0.3333)
     24  E_u_1         0.1  transmission-error harmonic 1 of mesh pg over its half backlash
     25  psi_u_1       0  transmission-error phase 1 of mesh pg, rad
     26  E_v_1         0.1  transmission-error harmonic 1 of mesh qg over its half backlash
@@ -102,7 +102,7 @@ OPERATIONS = {'rhs': 91, 'rhs_and_jacobian': 132}
 
 
 def rhs(tau, x, p):
-    """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); returns x's shape."""
+    """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); result (n,) or (n, N)."""
     u = x[0]
     v = x[1]
     du = x[2]
@@ -152,12 +152,12 @@ def rhs(tau, x, p):
     _t10 = _t5 - 2*phi_v
     _t11 = _t6 - 3*phi_v
     _t12 = v*(_t8*(_t8*(_t8*g7 + g5) + g3) + g1)*(kc_v_1*np.cos(_t9) + kc_v_2*np.cos(_t10) + kc_v_3*np.cos(_t11) + ks_v_1*np.sin(_t9) + ks_v_2*np.sin(_t10) + ks_v_3*np.sin(_t11) + 1)
-    return np.array([
+    return np.array(np.broadcast_arrays(
         du,
         dv,
         -E_u_1*_t2*np.cos(_t3 + psi_u_1) - _t0*xi_u_u - _t1*xi_u_v - _t12*kappa_u_v - _t7*kappa_u_u + f_u,
         -E_v_1*_t2*np.cos(_t9 + psi_v_1) - _t0*xi_v_u - _t1*xi_v_v - _t12*kappa_v_v - _t7*kappa_v_u + f_v,
-    ])
+    ))
 
 
 def jacobian(tau, x, p):

@@ -56,7 +56,7 @@ OPERATIONS = {'rhs': 14, 'rhs_and_jacobian': 20}
 
 
 def rhs(tau, x, p):
-    """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); returns x's shape."""
+    """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); result (n,) or (n, N)."""
     u = x[0]
     v = x[1]
     du = x[2]
@@ -69,12 +69,12 @@ def rhs(tau, x, p):
     kappa_u_v = p[6]
     kappa_v_u = p[7]
     kappa_v_v = p[8]
-    return np.array([
+    return np.array(np.broadcast_arrays(
         du,
         dv,
         -2*du*xi_u_u + f_u - kappa_u_u*u - kappa_u_v*v,
         -2*dv*xi_v_v + f_v - kappa_v_u*u - kappa_v_v*v,
-    ])
+    ))
 
 
 def jacobian(tau, x, p):

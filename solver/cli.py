@@ -85,40 +85,17 @@ def _cmd_derive(args) -> int:
 
 
 def _summary(model) -> None:
-    from gearsym.derive.emit import operation_count
+    from gearsym.derive.build import describe, display_path
 
-    values = dict(zip(model.parameter_names, model.defaults, strict=True))
-    coords = model.coordinates
-    from gearsym.derive.build import display_path
-
+    d = describe(model)
     print(f"{model.name}  ({display_path(model.scene.source)})")
-    print(f"  states: {', '.join(model.states)}   parameters: {len(model.parameters)}")
-    print(
-        f"  omega_n = {model.scales['omega_n_rad_per_s']:.6g} rad/s, omega = {values['omega']:.6g}"
-    )
-    print("  f: " + ", ".join(f"{c} = {values[f'f_{c}']:.6g}" for c in coords))
-    print(
-        "  kappa (means): "
-        + ", ".join(
-            f"{ci}{cj} = {values[f'kappa_{ci}_{cj}']:.6g}"
-            for ci in coords
-            for cj in coords
-            if f"kappa_{ci}_{cj}" in values
-        )
-    )
-    print(
-        "  xi: "
-        + ", ".join(
-            f"{ci}{cj} = {values[f'xi_{ci}_{cj}']:.6g}"
-            for ci in coords
-            for cj in coords
-            if f"xi_{ci}_{cj}" in values
-        )
-    )
-    print(
-        f"  operations: rhs {operation_count(model.rhs)}, rhs + jacobian "
-        f"{operation_count(list(model.rhs) + list(model.jacobian))}"
-    )
+    print(f"  states: {', '.join(d['states'])}   parameters: {len(d['parameters'])}")
+    print(f"  omega_n = {d['scales']['omega_n_rad_per_s']:.6g} rad/s, omega = {d['omega']:.6g}")
+    print("  f: " + ", ".join(f"{c} = {v:.6g}" for c, v in d["f"].items()))
+    print("  kappa (means): " + ", ".join(f"{k} = {v['mean']:.6g}" for k, v in d["kappa"].items()))
+    print("  xi: " + ", ".join(f"{k} = {v:.6g}" for k, v in d["xi"].items()))
+    ops = d["operations"]
+    print(f"  operations: rhs {ops['rhs']}, rhs + jacobian {ops['rhs_and_jacobian']}")
 
 
 def _cmd_backlash(args) -> int:

@@ -99,3 +99,22 @@ def test_generated_banner_and_order_are_documented():
     for k, name in enumerate(mod.PARAMETERS):
         assert f"{k:2d}  {name}" in mod.__doc__
     assert len(shipped_targets()) == len(NAMES)
+
+
+def test_rhs_broadcasts_one_state_over_many_parameter_sets():
+    mod = load_generated("reference_light")
+    x = np.array([1.0, -0.5, 0.1, 0.2])
+    P = np.array(mod.DEFAULTS)[:, None] * np.linspace(0.9, 1.1, 5)[None, :]
+    batch = mod.rhs(2.0, x, P)
+    assert batch.shape == (4, 5)
+    for k in range(5):
+        assert np.array_equal(batch[:, k], mod.rhs(2.0, x, P[:, k]))
+
+
+def test_unused_parameters_are_not_emitted(tmp_path):
+    # Constant stiffness and no transmission error: the mesh phase has nothing to shift.
+    model = _scene(
+        tmp_path, "stiffness_harmonics = 0\ntransmission_error = false\nmesh_phase = true"
+    )
+    assert "phi_v" not in model.parameter_names
+    assert model.parameter_names[0] == "omega"  # kept: it sets the forcing period

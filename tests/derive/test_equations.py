@@ -62,7 +62,7 @@ def test_generated_rhs_equals_hand_newton(name, diso_model, light_model):
     cb = [math.cos(m.pair.driver.base_helix_angle) for m in meshes]
     b = [m.half_backlash for m in meshes]
     wn = model.scales["omega_n_rad_per_s"]
-    omega = model.scene.omega
+    omega = dict(zip(model.parameter_names, model.defaults, strict=True))["omega"]
     we = omega * wn
     zeta = model.scene.damping_ratio
     W = hand_compliance(topo)

@@ -108,6 +108,58 @@ TOPOLOGY_CASES = [
         "operatin: unknown key (did you mean 'operating'?)",
     ),
     (
+        "keyword coordinate",
+        'coordinate = "v"',
+        'coordinate = "if"',
+        "mesh[1].coordinate: 'if' must be letters and digits starting with a letter, and not "
+        "a Python keyword",
+    ),
+    (
+        "coordinate clashing with a derivative",
+        'coordinate = "v"',
+        'coordinate = "du"',
+        "mesh: coordinates 'u' and 'du' clash",
+    ),
+    (
+        "coordinate named like a backlash coefficient",
+        'coordinate = "v"',
+        'coordinate = "g1"',
+        "mesh[1].coordinate: 'g1' is reserved",
+    ),
+    (
+        "phase on the first mesh",
+        'coordinate = "u"',
+        'coordinate = "u"\nstiffness_phase_deg = 90',
+        "mesh[0].stiffness_phase_deg: the first mesh sets the time origin",
+    ),
+    (
+        "misspelt layout key",
+        "layout_angle_deg = 120",
+        "layout_angle = 120",
+        "mesh[1].layout_angle: unknown key (did you mean 'layout_angle_deg'?)",
+    ),
+    (
+        "involute interference",
+        "teeth = 50\nnormal_module_mm = 4\nnormal_pressure_angle_deg = 20\nhelix_angle_deg = 10"
+        '\nface_width_mm = 50\nmaterial = "steel"\nbore_radius_mm = 30',
+        "teeth = 8\nnormal_module_mm = 4\nnormal_pressure_angle_deg = 20\nhelix_angle_deg = 10"
+        '\nface_width_mm = 50\nmaterial = "steel"\nbore_radius_mm = 5',
+        "mesh[0].driven: involute interference: the tip of 'g' reaches below the base circle "
+        "of 'p'",
+    ),
+    (
+        "vanishing stiffness",
+        "mean_N_per_m = 1.0e9",
+        "mean_N_per_m = 1e-320",
+        "is not finite; check the stiffness",
+    ),
+    (
+        "misspelt array of tables",
+        '[[torque]]\ngear = "q"',
+        '[[torqe]]\ngear = "q"',
+        "torqe: unknown key (did you mean 'torque'?)",
+    ),
+    (
         "name that cannot name a module",
         'name = "diso"',
         'name = "2 stage"',
@@ -192,6 +244,42 @@ SCENE_CASES = [
         "neither a file next to the scene nor a built-in topology",
     ),
     (
+        "key of another backlash model",
+        'backlash = "polynomial"',
+        'backlash = "smooth"',
+        "features.backlash_order: applies to backlash = 'polynomial' only, not 'smooth'",
+    ),
+    (
+        "backlash fit step too small",
+        "backlash_step = 0.01",
+        "backlash_step = 1e-7",
+        "features.backlash_step: step 1e-07 gives 60000001 samples",
+    ),
+    (
+        "load overflows",
+        'v = "-lambda*f1"',
+        'v = "10**10**10"',
+        "loads.v: '10**10**10' overflows",
+    ),
+    (
+        "load is complex",
+        'v = "-lambda*f1"',
+        'v = "(-1)**0.5"',
+        "loads.v: '(-1)**0.5' is not a real number",
+    ),
+    (
+        "load too long",
+        'v = "-lambda*f1"',
+        'v = "' + "-" * 5000 + '1"',
+        "is not a plain arithmetic expression of at most 200 characters",
+    ),
+    (
+        "mangled keyword smuggled in",
+        'v = "-lambda*f1"',
+        'v = "-lambda__kw*f1"',
+        "is not a plain arithmetic expression",
+    ),
+    (
         "harmonics out of range",
         "stiffness_harmonics = 3",
         "stiffness_harmonics = -1",
@@ -241,3 +329,72 @@ def test_bad_set_values(capsys):
 def test_backlash_command_bad_order(capsys):
     assert main(["backlash", "--order", "4"]) == 2
     assert "odd" in capsys.readouterr().err
+
+
+def test_topology_target_parameters_are_checked(root, capsys):
+    topo = root / "scenes" / "topologies" / "diso.toml"
+    for setting, fragment in (
+        ("omega=-5", "operating.omega: must be > 0, got -5"),
+        ("damping_ratio=5", "operating.damping_ratio: must be in [0, 1], got 5"),
+    ):
+        code = main(["derive", str(topo), "--dry-run", "--set", setting])
+        err = capsys.readouterr().err
+        assert code == 2 and fragment in err and err.count("\n") == 1
+
+
+def test_layout_rule_refuses_an_idler(tmp_path, capsys):
+    # p drives g, g drives h: g is driven in the first mesh and driver in the second, so
+    # opposite flanks carry load and the plain layout rule does not apply.
+    path = tmp_path / "idler.toml"
+    gear = "teeth = {z}\nnormal_module_mm = 4\nface_width_mm = 40\n"
+    path.write_text(
+        '[topology]\nname = "idler"\n'
+        + "".join(
+            f'[[gear]]\nid = "{g}"\n' + gear.format(z=z)
+            for g, z in (("p", 30), ("g", 40), ("h", 50))
+        )
+        + '[[mesh]]\nid = "pg"\ndriver = "p"\ndriven = "g"\ncoordinate = "u"\n'
+        'half_backlash_um = 50\nstiffness = { source = "harmonics", mean_N_per_m = 1e9 }\n'
+        '[[mesh]]\nid = "gh"\ndriver = "g"\ndriven = "h"\ncoordinate = "v"\n'
+        'half_backlash_um = 50\nstiffness = { source = "harmonics", mean_N_per_m = 1e9 }\n'
+        "layout_angle_deg = 100\n"
+    )
+    code, err = derive(capsys, path)
+    assert_one_line_error(
+        code,
+        err,
+        path,
+        "mesh[1].layout_angle_deg: gear 'g' is the driven in mesh 'pg' but the driver here",
+    )
+
+
+def test_more_harmonics_than_the_mesh_gives(files, capsys, root):
+    tmp, topo, scene = files
+    topo = topo.replace(
+        'stiffness = { source = "contact-line", mean_N_per_m = 1.0e9, harmonics = 10 }',
+        'stiffness = { source = "harmonics", mean_N_per_m = 1.0e9, cos_N_per_m = [1e7], '
+        "sin_N_per_m = [0.0] }",
+    )
+    (tmp / "topologies").mkdir()
+    (tmp / "topologies" / "diso.toml").write_text(topo)
+    path = tmp / "scene.toml"
+    path.write_text(scene)
+    code, err = derive(capsys, path)
+    assert_one_line_error(
+        code, err, path, "features.stiffness_harmonics: asks for 3 harmonics but mesh 'pg'"
+    )
+
+
+def test_negative_profile_shifts_say_what_is_wrong(tmp_path, capsys):
+    path = tmp_path / "shifted.toml"
+    gear = "teeth = 10\nnormal_module_mm = 4\nface_width_mm = 40\nprofile_shift = -1.0\n"
+    path.write_text(
+        '[topology]\nname = "shifted"\n'
+        + "".join(f'[[gear]]\nid = "{g}"\n' + gear for g in "pg")
+        + '[[mesh]]\nid = "pg"\ndriver = "p"\ndriven = "g"\ncoordinate = "u"\n'
+        'half_backlash_um = 50\nstiffness = { source = "harmonics", mean_N_per_m = 1e9 }\n'
+    )
+    code, err = derive(capsys, path)
+    assert_one_line_error(
+        code, err, path, "(x1 + x2 = -2) leave no positive working pressure angle"
+    )
