@@ -314,3 +314,19 @@ def parse_expression(text: str, names: dict[str, float], *, source: str, key: st
     if not math.isfinite(value):
         raise InputError(source, key, f"'{text}' evaluates to {value}")
     return value
+
+
+def expression_source(text: str | float, mapping: str = "s") -> str:
+    """Python source of a load expression already checked by :func:`parse_expression`,
+    with each parameter ``name`` read as ``s['name']``: ``"-lambda*f1"`` gives
+    ``"-s['lambda'] * s['f1']"``."""
+    if not isinstance(text, str):
+        return repr(float(text))
+    tree = ast.parse(_KEYWORD.sub(lambda mo: mo.group(0) + "__kw", text), mode="eval")
+
+    class _Names(ast.NodeTransformer):
+        def visit_Name(self, node):  # noqa: N802 (ast API)
+            key = ast.Constant(node.id.removesuffix("__kw"))
+            return ast.Subscript(ast.Name(mapping, ast.Load()), key, ast.Load())
+
+    return ast.unparse(_Names().visit(tree))

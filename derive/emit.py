@@ -184,6 +184,9 @@ def emit_module(model: Model, command: str) -> str:
         + ", ".join(f"{k!r}: {fmt(v)}" for k, v in scales["half_backlash_m"].items())
         + "}  # m",
         f"FEATURES = {model.features.flags()!r}",
+        "SCENE_PARAMETERS = {"
+        + ", ".join(f"{k!r}: {fmt(v)}" for k, v in model.scene_parameters.items())
+        + "}",
         f"OPERATIONS = {model.operations!r}",
         "",
         "",
@@ -193,6 +196,31 @@ def emit_module(model: Model, command: str) -> str:
         "    return np.array(np.broadcast_arrays(",
         *(f"        {o}," for o in rhs_out),
         "    ))",
+        "",
+        "",
+        "def parameters(**values):",
+        '    """Parameter vector p from named values; the rest keep the scene\'s values.',
+        "",
+        "    Names may be scene parameters (SCENE_PARAMETERS: what the scene's [parameters]",
+        "    table sets, such as a load ratio) or model parameters (PARAMETERS); a model",
+        "    parameter given by name overrides what the scene parameters imply.",
+        '    """',
+        "    unknown = sorted(set(values) - set(SCENE_PARAMETERS) - set(PARAMETERS))",
+        "    if unknown:",
+        "        raise KeyError(f'unknown parameter(s) {unknown}; scene parameters: '",
+        "                       f'{sorted(SCENE_PARAMETERS)}; model parameters: '",
+        "                       f'{list(PARAMETERS)}')",
+        "    s = dict(SCENE_PARAMETERS)",
+        "    s.update((k, float(v)) for k, v in values.items() if k in SCENE_PARAMETERS)",
+        "    p = list(DEFAULTS)",
+        *(
+            f"    p[{model.parameter_names.index(k)}] = {src}  # {k}"
+            for k, src in model.parameter_sources.items()
+        ),
+        "    for k, v in values.items():",
+        "        if k in PARAMETERS and k not in SCENE_PARAMETERS:",
+        "            p[PARAMETERS.index(k)] = float(v)",
+        "    return np.array(p, dtype=float)",
         "",
         "",
         "def jacobian(tau, x, p):",

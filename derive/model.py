@@ -29,7 +29,7 @@ from functools import cached_property
 import sympy as sp
 
 from . import __version__
-from ._input import InputError
+from ._input import InputError, expression_source
 from .equations import derive_equations
 from .nondim import NonDim, nondimensionalise
 from .scene import Features, Scene
@@ -65,6 +65,8 @@ class Model:
     nondim: NonDim
     scales: dict
     frequency_ratios: tuple[sp.Rational, ...]
+    scene_parameters: dict[str, float]
+    parameter_sources: dict[str, str]  # model parameter -> Python source in s['<scene name>']
     inputs_hash: str
 
     @property
@@ -284,6 +286,17 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
     if clash or len(set(names)) != len(names):
         raise AssertionError(f"name clash between states and parameters: {sorted(clash)}")
 
+    # How the scene's named parameters set the model's: a sweep over lambda or the damping
+    # ratio changes these entries and nothing else.
+    scene_parameters = dict(scene.parameters) | {"omega": omega_value}
+    sources = {"omega": "s['omega']"}
+    if scene.loads is not None:
+        for c in coords:
+            sources[f"f_{c}"] = expression_source(scene.load_expressions[c])
+    for i, j in xi:
+        unit = nd.value(nd.xi[i, j].subs(nd.zeta, 1))
+        sources[f"xi_{coords[i]}_{coords[j]}"] = f"{float(f'{unit:.15g}')!r} * s['damping_ratio']"
+
     om = nd.value(nd.omega_n_expr)
     scales = {
         "omega_n_rad_per_s": om,
@@ -312,6 +325,8 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
         nondim=nd,
         scales=scales,
         frequency_ratios=freq,
+        scene_parameters=scene_parameters,
+        parameter_sources={k: v for k, v in sources.items() if k in names},
         inputs_hash=_inputs_hash(scene),
     )
 

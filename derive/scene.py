@@ -233,7 +233,7 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
         for c in coords:
             raw = lt.raw(c)
             loads[c] = parse_expression(raw, parameters, source=source, key=lt.key(c))
-            expressions[c] = str(raw)
+            expressions[c] = raw if isinstance(raw, str) else float(raw)
         lt.finish()
     elif not topology.torques:
         raise InputError(

@@ -52,6 +52,7 @@ VALID_RANGE = None  # |coordinate| bound of the backlash model, None if global
 OMEGA_N = 11787.6125789536  # rad/s; tau = OMEGA_N * t
 HALF_BACKLASH = {'u': 5e-05, 'v': 5e-05}  # m
 FEATURES = {'stiffness_harmonics': 0, 'backlash': 'linear', 'transmission_error': False, 'mesh_phase': False, 'damping_coupling': False}
+SCENE_PARAMETERS = {'omega': 0.5, 'damping_ratio': 0.03, 'f1': 0.1, 'lambda': 0.1}
 OPERATIONS = {'rhs': 14, 'rhs_and_jacobian': 20}
 
 
@@ -75,6 +76,32 @@ def rhs(tau, x, p):
         -2*du*xi_u_u + f_u - kappa_u_u*u - kappa_u_v*v,
         -2*dv*xi_v_v + f_v - kappa_v_u*u - kappa_v_v*v,
     ))
+
+
+def parameters(**values):
+    """Parameter vector p from named values; the rest keep the scene's values.
+
+    Names may be scene parameters (SCENE_PARAMETERS: what the scene's [parameters]
+    table sets, such as a load ratio) or model parameters (PARAMETERS); a model
+    parameter given by name overrides what the scene parameters imply.
+    """
+    unknown = sorted(set(values) - set(SCENE_PARAMETERS) - set(PARAMETERS))
+    if unknown:
+        raise KeyError(f'unknown parameter(s) {unknown}; scene parameters: '
+                       f'{sorted(SCENE_PARAMETERS)}; model parameters: '
+                       f'{list(PARAMETERS)}')
+    s = dict(SCENE_PARAMETERS)
+    s.update((k, float(v)) for k, v in values.items() if k in SCENE_PARAMETERS)
+    p = list(DEFAULTS)
+    p[0] = s['omega']  # omega
+    p[1] = s['f1']  # f_u
+    p[2] = -s['lambda'] * s['f1']  # f_v
+    p[3] = 1.0 * s['damping_ratio']  # xi_u_u
+    p[4] = 1.0 * s['damping_ratio']  # xi_v_v
+    for k, v in values.items():
+        if k in PARAMETERS and k not in SCENE_PARAMETERS:
+            p[PARAMETERS.index(k)] = float(v)
+    return np.array(p, dtype=float)
 
 
 def jacobian(tau, x, p):

@@ -64,6 +64,7 @@ VALID_RANGE = 3.0  # |coordinate| bound of the backlash model, None if global
 OMEGA_N = 11787.6125789536  # rad/s; tau = OMEGA_N * t
 HALF_BACKLASH = {'u': 5e-05}  # m
 FEATURES = {'stiffness_harmonics': 3, 'backlash': 'polynomial', 'transmission_error': True, 'mesh_phase': True, 'damping_coupling': True}
+SCENE_PARAMETERS = {'damping_ratio': 0.03, 'omega': 0.666291123954781}
 OPERATIONS = {'rhs': 41, 'rhs_and_jacobian': 55}
 
 
@@ -95,6 +96,29 @@ def rhs(tau, x, p):
         du,
         -E_u_1*omega**2*np.cos(_t0 + psi_u_1) - 2*du*xi_u_u + f_u - kappa_u_u*u*(_t1*(_t1*(_t1*g7 + g5) + g3) + g1)*(kc_u_1*np.cos(_t0) + kc_u_2*np.cos(_t2) + kc_u_3*np.cos(_t3) + ks_u_1*np.sin(_t0) + ks_u_2*np.sin(_t2) + ks_u_3*np.sin(_t3) + 1),
     ))
+
+
+def parameters(**values):
+    """Parameter vector p from named values; the rest keep the scene's values.
+
+    Names may be scene parameters (SCENE_PARAMETERS: what the scene's [parameters]
+    table sets, such as a load ratio) or model parameters (PARAMETERS); a model
+    parameter given by name overrides what the scene parameters imply.
+    """
+    unknown = sorted(set(values) - set(SCENE_PARAMETERS) - set(PARAMETERS))
+    if unknown:
+        raise KeyError(f'unknown parameter(s) {unknown}; scene parameters: '
+                       f'{sorted(SCENE_PARAMETERS)}; model parameters: '
+                       f'{list(PARAMETERS)}')
+    s = dict(SCENE_PARAMETERS)
+    s.update((k, float(v)) for k, v in values.items() if k in SCENE_PARAMETERS)
+    p = list(DEFAULTS)
+    p[0] = s['omega']  # omega
+    p[2] = 1.0 * s['damping_ratio']  # xi_u_u
+    for k, v in values.items():
+        if k in PARAMETERS and k not in SCENE_PARAMETERS:
+            p[PARAMETERS.index(k)] = float(v)
+    return np.array(p, dtype=float)
 
 
 def jacobian(tau, x, p):

@@ -140,6 +140,7 @@ VALID_RANGE = 3.0  # |coordinate| bound of the backlash model, None if global
 OMEGA_N = 11787.6125789536  # rad/s; tau = OMEGA_N * t
 HALF_BACKLASH = {'u': 5e-05, 'v': 5e-05, 'w': 4e-05}  # m
 FEATURES = {'stiffness_harmonics': 3, 'backlash': 'polynomial', 'transmission_error': True, 'mesh_phase': True, 'damping_coupling': True}
+SCENE_PARAMETERS = {'damping_ratio': 0.03, 'omega': 0.666291123954781}
 OPERATIONS = {'rhs': 149, 'rhs_and_jacobian': 228}
 
 
@@ -230,6 +231,37 @@ def rhs(tau, x, p):
         -E_v_1*_t3*np.cos(_t10 + psi_v_1) - _t0*xi_v_u - _t1*xi_v_v - _t13*kappa_v_v - _t18*kappa_v_w - _t2*xi_v_w - _t8*kappa_v_u + f_v,
         -E_w_1*_t3*np.cos(_t15 + psi_w_1) - _t0*xi_w_u - _t1*xi_w_v - _t13*kappa_w_v - _t18*kappa_w_w - _t2*xi_w_w - _t8*kappa_w_u + f_w,
     ))
+
+
+def parameters(**values):
+    """Parameter vector p from named values; the rest keep the scene's values.
+
+    Names may be scene parameters (SCENE_PARAMETERS: what the scene's [parameters]
+    table sets, such as a load ratio) or model parameters (PARAMETERS); a model
+    parameter given by name overrides what the scene parameters imply.
+    """
+    unknown = sorted(set(values) - set(SCENE_PARAMETERS) - set(PARAMETERS))
+    if unknown:
+        raise KeyError(f'unknown parameter(s) {unknown}; scene parameters: '
+                       f'{sorted(SCENE_PARAMETERS)}; model parameters: '
+                       f'{list(PARAMETERS)}')
+    s = dict(SCENE_PARAMETERS)
+    s.update((k, float(v)) for k, v in values.items() if k in SCENE_PARAMETERS)
+    p = list(DEFAULTS)
+    p[0] = s['omega']  # omega
+    p[4] = 1.0 * s['damping_ratio']  # xi_u_u
+    p[5] = 0.0230153772879178 * s['damping_ratio']  # xi_u_v
+    p[6] = 0.0118426355832695 * s['damping_ratio']  # xi_u_w
+    p[7] = 0.0230153772879178 * s['damping_ratio']  # xi_v_u
+    p[8] = 1.0 * s['damping_ratio']  # xi_v_v
+    p[9] = 0.0118426355832695 * s['damping_ratio']  # xi_v_w
+    p[10] = 0.0287692216098972 * s['damping_ratio']  # xi_w_u
+    p[11] = 0.0287692216098972 * s['damping_ratio']  # xi_w_v
+    p[12] = 1.24379757873127 * s['damping_ratio']  # xi_w_w
+    for k, v in values.items():
+        if k in PARAMETERS and k not in SCENE_PARAMETERS:
+            p[PARAMETERS.index(k)] = float(v)
+    return np.array(p, dtype=float)
 
 
 def jacobian(tau, x, p):

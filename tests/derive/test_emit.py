@@ -118,3 +118,22 @@ def test_unused_parameters_are_not_emitted(tmp_path):
     )
     assert "phi_v" not in model.parameter_names
     assert model.parameter_names[0] == "omega"  # kept: it sets the forcing period
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_parameters_function_reproduces_the_defaults(name):
+    mod = load_generated(name)
+    assert np.allclose(mod.parameters(), mod.DEFAULTS, rtol=1e-14, atol=0)
+
+
+def test_parameters_function_maps_scene_parameters():
+    mod = load_generated("reference_light")
+    idx = {n: k for k, n in enumerate(mod.PARAMETERS)}
+    p = mod.parameters(**{"lambda": 0.8, "f1": 0.5, "damping_ratio": 0.06})
+    # The scene's [loads]: u = "f1", v = "-lambda*f1"; xi scales with the damping ratio.
+    assert p[idx["f_u"]] == 0.5 and p[idx["f_v"]] == pytest.approx(-0.4)
+    assert p[idx["xi_u_u"]] == pytest.approx(0.06)
+    assert p[idx["xi_u_v"]] == pytest.approx(2 * mod.DEFAULTS[idx["xi_u_v"]])
+    assert mod.parameters(kappa_u_v=0.0)[idx["kappa_u_v"]] == 0.0
+    with pytest.raises(KeyError, match="unknown parameter"):
+        mod.parameters(lamda=0.3)
