@@ -96,7 +96,7 @@ class Model:
         }
 
 
-def _inputs_hash(scene: Scene) -> str:
+def inputs_hash(scene: Scene) -> str:
     """sha256 of everything the generated files depend on: the input files' parsed
     contents (scene and topology), the resolved parameters, the generator's version and
     SymPy's (term order in the emitted code may change with SymPy)."""
@@ -327,7 +327,7 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
         frequency_ratios=freq,
         scene_parameters=scene_parameters,
         parameter_sources={k: v for k, v in sources.items() if k in names},
-        inputs_hash=_inputs_hash(scene),
+        inputs_hash=inputs_hash(scene),
     )
 
 

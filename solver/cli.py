@@ -142,6 +142,161 @@ def _cmd_backlash(args) -> int:
     return 0
 
 
+def _system(scene_arg: str, sets: dict[str, float]):
+    """The System of a scene: its generated module when current, else derived now into a
+    cache folder (so a user's own scene needs no manual `gearsym derive`)."""
+    import importlib
+    import os
+
+    from gearsym.derive import derive_model, load_target, resolve_target
+    from gearsym.derive.emit import emit_module, write_atomic
+    from gearsym.derive.model import inputs_hash
+    from gearsym.solver.system import System
+
+    path = resolve_target(scene_arg)
+    scene = load_target(path)
+    name = scene.name.replace("-", "_")
+    digest = inputs_hash(scene)
+    module = None
+    try:
+        module = importlib.import_module(f"gearsym.generated.{name}")
+    except ModuleNotFoundError:
+        pass
+    if module is None or getattr(module, "INPUTS_SHA256", "") != digest:
+        cache = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "gearsym"
+        target = cache / f"{name}_{digest[:12]}.py"
+        if not target.exists():
+            model = derive_model(scene)
+            write_atomic(target, emit_module(model, f"gearsym derive {path}"))
+        module = target
+    try:
+        return System.load(module, **sets)
+    except KeyError as err:
+        raise _Fail(f"--set: {err.args[0]}") from None
+
+
+def _analysis_settings(args) -> dict:
+    for name in ("rtol", "atol"):
+        value = getattr(args, name)
+        if not (value > 0 and math.isfinite(value)):
+            raise _Fail(f"--{name} must be a positive number, got {value}")
+    for name in ("transient", "periods"):
+        if getattr(args, name) < (0 if name == "transient" else 1):
+            raise _Fail(f"--{name} must be a whole number >= {0 if name == 'transient' else 1}")
+    return dict(method=args.method, rtol=args.rtol, atol=args.atol, transient=args.transient,
+                periods=args.periods, lyapunov_periods=args.lyapunov_periods)  # fmt: skip
+
+
+def _cmd_simulate(args) -> int:
+    from gearsym.solver.point import analyse_point
+    from gearsym.solver.simulate import SimulationError
+
+    system = _system(args.scene, _parse_set(args.set))
+    try:
+        result = analyse_point(system, **_analysis_settings(args))
+    except (SimulationError, ValueError) as err:
+        raise _Fail(f"simulate: {err}") from None
+    data = result.describe()
+    if args.out:
+        from gearsym.solver import plots
+
+        out = Path(args.out)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "point.json").write_text(json.dumps(data, indent=1), encoding="utf-8")
+        plots.point_figure(result.trajectory, out / "point.png", title=system.name)
+    if args.json:
+        print(json.dumps(data, indent=1))
+        return 0
+    tr = result.trajectory
+    print(f"{system.name}: {tr.method}, rtol {tr.rtol:g}, {tr.transient} + {tr.periods} periods, "
+          f"{tr.wall_time:.2f} s, status {tr.status}")  # fmt: skip
+    if result.lyapunov is not None:
+        print(f"  largest Lyapunov exponent {result.lyapunov.exponent:.5f} per unit tau")
+    for c, k in result.classification.items():
+        e = data["extremes"][c]
+        peaks = ", ".join(f"{p['frequency']:.3g}" for p in data["spectra"][c]["peaks"][:4])
+        shares = data["meshing_states"][c]
+        print(f"  {c}: {k.motion:<15} range [{e['min']:.4f}, {e['max']:.4f}]  peaks at {peaks}"
+              f"  forward/separated/backward {shares['forward']:.2f}/{shares['separated']:.2f}/"
+              f"{shares['backward']:.2f}")  # fmt: skip
+    if tr.left_valid_range is not None:
+        t, c, v = tr.left_valid_range
+        print(f"  warning: {c} = {v:.3g} at tau = {t:.6g} is outside the backlash model's "
+              f"valid range |{c}| <= {system.valid_range:g}")  # fmt: skip
+    return 0
+
+
+def _parse_range(text: str):
+    import numpy as np
+
+    parts = text.split(":")
+    try:
+        start, stop, num = float(parts[0]), float(parts[1]), int(parts[2])
+    except (IndexError, ValueError):
+        raise _Fail(f"--range {text}: expected START:STOP:NUM, for example 0:1:51") from None
+    if num < 1 or len(parts) != 3:
+        raise _Fail(f"--range {text}: NUM must be a whole number >= 1")
+    return np.linspace(start, stop, num)
+
+
+def _cmd_sweep(args) -> int:
+    from gearsym.solver import plots
+    from gearsym.solver.simulate import SimulationError
+    from gearsym.solver.sweep import Progress, sweep
+
+    values = _parse_range(args.range)
+    system = _system(args.scene, _parse_set(args.set))
+    try:
+        system.with_values(**{args.param: float(values[0])})
+    except KeyError as err:
+        raise _Fail(f"--param: {err.args[0]}") from None
+    out = Path(args.out or f"sweep_{system.name}_{args.param}")
+    bar = Progress(len(values), f"{args.param}", enabled=not args.quiet)
+    try:
+        result = sweep(system, args.param, values, continuation=not args.independent,
+                       backward=args.backward, executor=args.executor,
+                       progress=bar, **_analysis_settings(args))  # fmt: skip
+    except (SimulationError, ValueError) as err:
+        raise _Fail(f"sweep: {err}") from None
+    path = result.save(out / "sweep.json")
+    fig = plots.bifurcation_diagram([result], list(system.coordinates), out / "bifurcation.png",
+                                    title=f"{system.name}: {args.param} sweep")  # fmt: skip
+    print(f"wrote {path} and {fig}")
+    for c in system.coordinates:
+        from gearsym.solver.reproduce import _runs_text
+
+        print(f"  {c}: {_runs_text(values, result.motion(c))}")
+    return 0
+
+
+def _cmd_reproduce(args) -> int:
+    import time
+
+    from gearsym.solver.reproduce import reproduce
+
+    started = time.perf_counter()
+    report = reproduce(Path(args.out), quick=args.quick,
+                       executor="serial" if args.serial else "processes",
+                       progress=not args.quiet)  # fmt: skip
+    print(f"wrote {report} ({time.perf_counter() - started:.0f} s)")
+    print(report.read_text(encoding="utf-8").split("## Figures")[0])
+    return 0
+
+
+def _analysis_options(sub) -> None:
+    from gearsym.solver.simulate import METHODS
+
+    sub.add_argument("--set", action="append", metavar="KEY=VALUE",
+                     help="set a scene or model parameter (repeatable)")  # fmt: skip
+    sub.add_argument("--method", choices=METHODS, default=None, help="integrator")
+    sub.add_argument("--rtol", type=float, default=1e-8)
+    sub.add_argument("--atol", type=float, default=1e-10)
+    sub.add_argument("--transient", type=int, default=300, help="periods discarded")
+    sub.add_argument("--periods", type=int, default=100, help="periods sampled")
+    sub.add_argument("--lyapunov-periods", type=int, default=200,
+                     help="periods for the largest Lyapunov exponent (0: skip)")  # fmt: skip
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="gearsym", description="Gear-train nonlinear dynamics: derive, generate code, analyse."
@@ -202,12 +357,52 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--continuous", action="store_true", help="continuous L2 fit instead of samples")
     b.add_argument("--json", action="store_true", help="print JSON")
     b.set_defaults(func=_cmd_backlash)
+
+    si = sub.add_parser("simulate", help="simulate one operating point and classify it",
+                        description="Simulate a scene, discard the transient, and report the "
+                        "Poincaré points, motion type with its evidence, ranges, spectral "
+                        "peaks and meshing-state shares of every mesh.")  # fmt: skip
+    si.add_argument("scene", metavar="SCENE", help="a scene path or built-in name")
+    _analysis_options(si)
+    si.add_argument("--json", action="store_true", help="print everything as JSON")
+    si.add_argument("--out", metavar="DIR", help="also write point.json and point.png")
+    si.set_defaults(func=_cmd_simulate, method_default="RK45")
+
+    sw = sub.add_parser("sweep", help="bifurcation diagram over one parameter",
+                        description="Sweep one scene or model parameter with continuation "
+                        "of the final state (forward, or --backward), or --independent points "
+                        "run in parallel.")  # fmt: skip
+    sw.add_argument("scene", metavar="SCENE")
+    sw.add_argument("--param", required=True, help="parameter to sweep, e.g. lambda")
+    sw.add_argument("--range", required=True, metavar="START:STOP:NUM")
+    sw.add_argument("--backward", action="store_true", help="continue from STOP to START")
+    sw.add_argument(
+        "--independent",
+        action="store_true",
+        help="no continuation: every point from the same initial state",
+    )
+    sw.add_argument("--executor", choices=("serial", "processes"), default="processes")
+    sw.add_argument("--out", metavar="DIR")
+    sw.add_argument("--quiet", action="store_true", help="no progress bar")
+    _analysis_options(sw)
+    sw.set_defaults(func=_cmd_sweep, method_default="cvodes")
+
+    rp = sub.add_parser("reproduce", help="the reference study's analyses and report",
+                        description="Run the reference study's light- and heavy-load "
+                        "analyses; write figures, data and report.md.")  # fmt: skip
+    rp.add_argument("--out", default="reproduce-out", metavar="DIR")
+    rp.add_argument("--quick", action="store_true", help="coarse resolution (under a minute)")
+    rp.add_argument("--serial", action="store_true", help="one process only")
+    rp.add_argument("--quiet", action="store_true", help="no progress bar")
+    rp.set_defaults(func=_cmd_reproduce)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
+    if getattr(args, "method", "absent") is None:
+        args.method = args.method_default
     if args.debug:
         return args.func(args)
     from gearsym.derive import InputError

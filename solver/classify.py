@@ -1,0 +1,128 @@
+"""Motion type per coordinate, with the evidence.
+
+Three pieces of evidence are weighed:
+
+1. **Poincare points** (the coordinate and its velocity, one point per forcing period):
+   period-n for the smallest n <= 32 with ``|P_{k+n} - P_k| <= tol`` for all k, where
+   ``tol`` follows the integrator's tolerance (``max(1e-6, 1e3 rtol)`` times the size
+   of the point cloud, at least 1e-3 of it for fixed-step methods).
+2. **The largest Lyapunov exponent** of the whole system (variational equations): > 0
+   chaotic, ~ 0 quasi-periodic, < 0 periodic.  "~ 0" is judged against its own finite-time
+   fluctuation.
+3. **The correlation dimension** of the Poincare set (Grassberger and Procaccia 1983,
+   "Characterization of strange attractors", PRL 50): ~ 0 for a finite set of points, ~ 1
+   for the closed curve a two-frequency torus leaves, larger for a strange attractor.
+   Used when no exponent is available, and as a cross-check.
+
+When the evidence disagrees the verdict is ``undetermined`` and says why.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .lyapunov import LyapunovEstimate
+
+__all__ = ["Classification", "classify_points", "correlation_dimension", "periodicity"]
+
+MAX_PERIOD = 32
+
+
+@dataclass(frozen=True)
+class Classification:
+    motion: str  # "period-n", "quasi-periodic", "chaotic", "divergent", "undetermined"
+    period: int | None
+    evidence: dict = field(default_factory=dict)
+
+    def describe(self) -> dict:
+        return {"motion": self.motion, "period": self.period, "evidence": self.evidence}
+
+
+def periodicity(points: np.ndarray, tol: float) -> int | None:
+    """Smallest n <= 32 with every point repeating after n periods, or None.
+
+    ``points`` has shape (d, K): K successive Poincare points.
+    """
+    K = points.shape[1]
+    for n in range(1, min(MAX_PERIOD, K // 2) + 1):
+        gap = np.max(np.linalg.norm(points[:, n:] - points[:, :-n], axis=0))
+        if gap <= tol:
+            return n
+    return None
+
+
+def correlation_dimension(points: np.ndarray) -> float | None:
+    """Grassberger-Procaccia slope of log C(r) against log r over the middle of the
+    pair-distance distribution (points scaled to unit size).  None if degenerate."""
+    P = points / max(np.ptp(points, axis=1).max(), 1e-300)
+    K = P.shape[1]
+    if K < 20:
+        return None
+    d = np.sqrt(((P[:, :, None] - P[:, None, :]) ** 2).sum(axis=0))
+    d = d[np.triu_indices(K, 1)]
+    d = np.sort(d[d > 0])
+    if d.size < 50:
+        return 0.0
+    r = np.quantile(d, [0.02, 0.15])
+    if r[1] <= r[0] * 1.0001:
+        return 0.0
+    radii = np.geomspace(r[0], r[1], 8)
+    C = np.searchsorted(d, radii) / d.size
+    slope = np.polyfit(np.log(radii), np.log(C), 1)[0]
+    return float(slope)
+
+
+def classify_points(
+    points: np.ndarray,
+    *,
+    tol: float,
+    lyapunov: LyapunovEstimate | None = None,
+    divergent: bool = False,
+    spectrum_peaks: list | None = None,
+) -> Classification:
+    """Classify from Poincare points (d, K), an optional exponent and spectral peaks."""
+    evidence: dict = {"poincare_points": int(points.shape[1]), "tolerance": tol}
+    if spectrum_peaks is not None:
+        evidence["spectrum_peaks"] = spectrum_peaks
+    if divergent or not np.all(np.isfinite(points)):
+        return Classification("divergent", None, evidence)
+    scale = max(float(np.ptp(points, axis=1).max()), 1.0)
+    n = periodicity(points, tol * scale)
+    evidence["period_found"] = n
+    dim = None if n is not None else correlation_dimension(points)
+    evidence["correlation_dimension"] = dim
+    lam = None
+    if lyapunov is not None:
+        evidence["lyapunov"] = lyapunov.describe()
+        # "Positive" must clear the estimate's own finite-time wobble.
+        margin = max(2e-3, 3.0 * lyapunov.spread)
+        lam = "positive" if lyapunov.exponent > margin else (
+            "negative" if lyapunov.exponent < -margin else "zero")  # fmt: skip
+        evidence["lyapunov_sign"] = lam
+        evidence["lyapunov_margin"] = margin
+    if n is not None:
+        if lam == "positive":
+            evidence["why"] = "points repeat, yet the exponent is positive"
+            return Classification("undetermined", None, evidence)
+        return Classification(f"period-{n}", n, evidence)
+    if lam == "positive":
+        if dim is not None and dim < 0.5:
+            evidence["why"] = "positive exponent but the points form a finite set"
+            return Classification("undetermined", None, evidence)
+        return Classification("chaotic", None, evidence)
+    if lam == "zero" or (lam is None and dim is not None and 0.7 <= dim <= 1.3):
+        if dim is not None and dim > 1.5:
+            evidence["why"] = "zero exponent but the points fill more than a curve"
+            return Classification("undetermined", None, evidence)
+        return Classification("quasi-periodic", None, evidence)
+    if lam is None and dim is not None and dim > 1.3:
+        return Classification("chaotic", None, evidence)
+    evidence["why"] = (
+        "no repetition within 32 periods, yet the exponent is negative (not settled, or a "
+        "longer period)"
+        if lam == "negative"
+        else "the evidence is inconclusive"
+    )
+    return Classification("undetermined", None, evidence)

@@ -1,0 +1,132 @@
+"""Matplotlib figures: bifurcation diagrams, time series, spectra, phase portraits, maps.
+
+Every function takes data and a path, writes one PNG (Agg back end, no display needed) and
+returns the path.  Axes are labelled with their (non-dimensional) units.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from .analysis import spectrum  # noqa: E402
+from .simulate import Trajectory  # noqa: E402
+from .sweep import SweepResult  # noqa: E402
+
+__all__ = ["bifurcation_diagram", "map_figure", "point_figure"]
+
+_COLOURS = {"forward": "tab:blue", "backward": "tab:orange", "independent": "tab:blue"}
+
+
+def _save(fig, path: Path) -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    return path
+
+
+def bifurcation_diagram(sweeps: list[SweepResult], states: list[str], path: Path,
+                        title: str = "") -> Path:  # fmt: skip
+    """Poincare points of each state against the swept parameter, one panel per state;
+    forward and backward continuation overlaid (hysteresis shows as two colours apart)."""
+    fig, axes = plt.subplots(len(states), 1, figsize=(7, 2.8 * len(states)), sharex=True,
+                             squeeze=False)  # fmt: skip
+    for ax, state in zip(axes[:, 0], states, strict=True):
+        for sw in sweeps:
+            xs, ys = [], []
+            for value, pts in zip(sw.values, sw.poincare(state), strict=True):
+                xs.append(np.full(pts.size, value))
+                ys.append(pts)
+            ax.plot(np.concatenate(xs), np.concatenate(ys), ".", markersize=1.5, alpha=0.8,
+                    color=_COLOURS[sw.direction], label=f"{sw.direction} sweep")  # fmt: skip
+        ax.set_ylabel(f"{state} (Poincaré), 1/half backlash")
+        ax.grid(alpha=0.3)
+    axes[0, 0].legend(loc="best", markerscale=6, fontsize=8)
+    axes[-1, 0].set_xlabel(sweeps[0].parameter)
+    if title:
+        axes[0, 0].set_title(title)
+    return _save(fig, path)
+
+
+def point_figure(tr: Trajectory, path: Path, title: str = "", periods_shown: int = 20) -> Path:
+    """One operating point: time series, phase portrait with Poincare points, and spectrum
+    of each mesh coordinate (one row per coordinate)."""
+    coords = tr.system.coordinates
+    fig, axes = plt.subplots(len(coords), 3, figsize=(13, 3.2 * len(coords)), squeeze=False)
+    spp = tr.samples_per_period
+    shown = slice(max(0, tr.t.size - periods_shown * spp), None)
+    for row, c in enumerate(coords):
+        u, du = tr.coordinate(c), tr.coordinate(f"d{c}")
+        ax = axes[row, 0]
+        ax.plot(tr.t[shown], u[shown], lw=0.8)
+        for edge in (-1, 1):
+            ax.axhline(edge, color="grey", lw=0.6, ls="--")
+        ax.set_xlabel("τ (non-dimensional time)")
+        ax.set_ylabel(f"{c} (1/half backlash)")
+        ax.set_title(f"{c}: time series (last {periods_shown} periods)", fontsize=9)
+        ax = axes[row, 1]
+        ax.plot(u, du, lw=0.3, color="tab:blue", alpha=0.6)
+        ax.plot(tr.poincare[tr.system.index(c)], tr.poincare[tr.system.index(f"d{c}")], "o",
+                ms=2.5, color="tab:red", label="Poincaré")  # fmt: skip
+        ax.set_xlabel(c)
+        ax.set_ylabel(f"d{c}/dτ")
+        ax.set_title(f"{c}: phase portrait", fontsize=9)
+        ax.legend(fontsize=7, loc="upper right")
+        ax = axes[row, 2]
+        sp = spectrum(tr, c)
+        keep = sp.frequency <= 6 * sp.omega
+        ax.semilogy(sp.frequency[keep], np.maximum(sp.amplitude[keep], 1e-8), lw=0.8)
+        ax.set_xlabel("frequency (rad per unit τ)")
+        ax.set_ylabel("amplitude")
+        ax.set_title(f"{c}: spectrum (ω̄ = {sp.omega:g})", fontsize=9)
+        ax.grid(alpha=0.3)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+_MOTION_CODES = {"period-1": 1, "period-n": 2, "quasi-periodic": 3, "chaotic": 4,
+                 "undetermined": 5, "divergent": 6}  # fmt: skip
+
+
+def motion_code(motion: str) -> int:
+    if motion.startswith("period-") and motion != "period-1":
+        return _MOTION_CODES["period-n"]
+    return _MOTION_CODES.get(motion, 5)
+
+
+def map_figure(f_values, lam_values, max_u, min_v, motion_v, path: Path, title: str = "",
+               names=("f1", "lambda", "u", "v")) -> Path:  # fmt: skip
+    """Maps over (f1, lambda): Max(u), Min(v) and the motion type of v."""
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4))
+    extent = [lam_values[0], lam_values[-1], f_values[0], f_values[-1]]
+    for ax, data, label in ((axes[0], max_u, f"Max({names[2]})"),
+                            (axes[1], min_v, f"Min({names[3]})")):  # fmt: skip
+        im = ax.imshow(np.asarray(data), origin="lower", aspect="auto", extent=extent)
+        fig.colorbar(im, ax=ax, label=label)
+        ax.set_xlabel(names[1])
+        ax.set_ylabel(names[0])
+        ax.set_title(label)
+    codes = np.vectorize(motion_code)(np.asarray(motion_v))
+    cmap = matplotlib.colors.ListedColormap(
+        ["tab:green", "tab:olive", "tab:blue", "tab:red", "lightgrey", "black"]
+    )
+    im = axes[2].imshow(codes, origin="lower", aspect="auto", extent=extent, cmap=cmap,
+                        vmin=0.5, vmax=6.5)  # fmt: skip
+    cbar = fig.colorbar(im, ax=axes[2], ticks=range(1, 7))
+    cbar.ax.set_yticklabels(["period-1", "period-n", "quasi-periodic", "chaotic",
+                             "undetermined", "divergent"])  # fmt: skip
+    axes[2].set_xlabel(names[1])
+    axes[2].set_ylabel(names[0])
+    axes[2].set_title(f"motion of {names[3]}")
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return _save(fig, path)

@@ -1,0 +1,89 @@
+"""Everything about one operating point: response, spectra, exponent and verdicts.
+
+``analyse_point`` is the convenience call on top of :func:`simulate`,
+:func:`largest_lyapunov` and :func:`classify_points`; sweeps call it once per point.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .analysis import extremes, meshing_states, spectrum
+from .classify import Classification, classify_points
+from .lyapunov import LyapunovEstimate, largest_lyapunov
+from .simulate import Trajectory, simulate
+from .system import System
+
+__all__ = ["PointResult", "analyse_point", "classification_tolerance"]
+
+
+@dataclass(frozen=True)
+class PointResult:
+    trajectory: Trajectory
+    lyapunov: LyapunovEstimate | None
+    classification: dict[str, Classification]
+
+    def describe(self, poincare: bool = True) -> dict:
+        tr = self.trajectory
+        out = {
+            "system": tr.system.describe(),
+            "integration": tr.describe(),
+            "classification": {c: k.describe() for c, k in self.classification.items()},
+            "extremes": extremes(tr),
+            "meshing_states": meshing_states(tr),
+            "spectra": {c: spectrum(tr, c).describe() for c in tr.system.coordinates},
+            "lyapunov": None if self.lyapunov is None else self.lyapunov.describe(),
+        }
+        if poincare:
+            out["poincare"] = {s: tr.poincare[k].tolist() for k, s in enumerate(tr.system.states)}
+        return out
+
+
+def classification_tolerance(method: str, rtol: float) -> float:
+    """How close Poincare points must come to count as the same, relative to the cloud."""
+    if method in ("rk", "collocation"):
+        return 1e-3
+    return max(1e-6, 1e3 * rtol)
+
+
+def analyse_point(
+    system: System,
+    x0=None,
+    *,
+    method: str = "RK45",
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    transient: int = 300,
+    periods: int = 100,
+    samples_per_period: int = 64,
+    lyapunov_periods: int = 200,
+    steps_per_period: int = 512,
+) -> PointResult:
+    """Simulate, estimate the largest exponent from the end state, classify each mesh."""
+    tr = simulate(
+        system, x0, method=method, rtol=rtol, atol=atol, transient=transient, periods=periods,
+        samples_per_period=samples_per_period, steps_per_period=steps_per_period,
+    )  # fmt: skip
+    lyap = None
+    if tr.status == "ok" and lyapunov_periods > 0:
+        t_end = tr.t[-1] + tr.t[1] - tr.t[0]
+        try:
+            lyap = largest_lyapunov(system, tr.x_final, t0=t_end, periods=lyapunov_periods)
+        except (FloatingPointError, RuntimeError):
+            lyap = None
+    tol = classification_tolerance(method, rtol)
+    verdicts = {}
+    for c in system.coordinates:
+        i, j = system.index(c), system.index(f"d{c}")
+        points = tr.poincare[[i, j]]
+        verdicts[c] = classify_points(
+            points, tol=tol, lyapunov=lyap, divergent=tr.status == "divergent",
+            spectrum_peaks=spectrum(tr, c).peaks() if tr.status == "ok" else None,
+        )  # fmt: skip
+    return PointResult(tr, lyap, verdicts)
+
+
+def final_state(result: PointResult) -> np.ndarray:
+    return result.trajectory.x_final

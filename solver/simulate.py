@@ -1,0 +1,358 @@
+"""One front door for time integration: ``simulate(system, ..., method=...)``.
+
+Back ends by name (:data:`METHODS`):
+
+* SciPy ``solve_ivp``: ``RK45`` (the reference study's variable-step Runge-Kutta 4(5),
+  the default), ``DOP853``, ``LSODA``, ``Radau`` -- on the generated NumPy right-hand side
+  (and its Jacobian for the implicit ones);
+* CasADi ``integrator``: ``cvodes`` (SUNDIALS, adaptive), ``rk`` (fixed-step RK4 with
+  ``steps_per_period`` steps), ``collocation`` (fixed-step implicit Legendre collocation)
+  -- on the CasADi graph of the same equations.
+
+The run is split into a transient of ``transient`` forcing periods, discarded, and a
+sampled window of ``periods`` periods with ``samples_per_period`` samples each, aligned
+with the forcing so that every ``samples_per_period``-th sample is a stroboscopic
+(Poincare) point.  With the dead-zone backlash the SciPy back ends stop at every
+contact-boundary crossing (``|u| = 1``) and restart there, so the method's order holds
+across the kinks; the CasADi back ends rely on error control (cvodes) or a fine fixed step.
+
+Every result records the method, the tolerances, the work done, and how the run ended.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .system import System
+
+__all__ = ["METHODS", "SimulationError", "Trajectory", "simulate"]
+
+SCIPY_METHODS = ("RK45", "DOP853", "LSODA", "Radau")
+CASADI_METHODS = ("cvodes", "rk", "collocation")
+METHODS = SCIPY_METHODS + CASADI_METHODS
+
+
+class SimulationError(RuntimeError):
+    """An integration could not be carried out (bad options or a failed solver)."""
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """A sampled response.
+
+    Attributes
+    ----------
+    t : ndarray, shape (K,)
+        Sample times (non-dimensional, tau) of the sampled window.
+    x : ndarray, shape (n, K)
+        States at ``t``.
+    samples_per_period : int
+        Samples per forcing period; ``x[:, ::samples_per_period]`` are Poincare points.
+    status : str
+        ``ok``, ``divergent`` (a state passed ``bound``) or ``failed``.
+    """
+
+    system: System
+    method: str
+    rtol: float
+    atol: float
+    transient: int
+    periods: int
+    samples_per_period: int
+    t: np.ndarray
+    x: np.ndarray
+    x_final: np.ndarray
+    status: str
+    message: str
+    nfev: int
+    nsteps: int | None
+    wall_time: float
+    boundary_crossings: int = 0
+    left_valid_range: tuple | None = None  # (tau, state, value) of the first exit
+    options: dict = field(default_factory=dict)
+
+    @property
+    def period(self) -> float:
+        return self.system.period
+
+    @property
+    def poincare(self) -> np.ndarray:
+        """Stroboscopic points at the start of each sampled period, shape (n, periods)."""
+        return self.x[:, : self.periods * self.samples_per_period : self.samples_per_period]
+
+    def coordinate(self, name: str) -> np.ndarray:
+        return self.x[self.system.index(name)]
+
+    def describe(self) -> dict:
+        return {
+            "method": self.method,
+            "rtol": self.rtol,
+            "atol": self.atol,
+            "transient_periods": self.transient,
+            "sampled_periods": self.periods,
+            "samples_per_period": self.samples_per_period,
+            "status": self.status,
+            "message": self.message,
+            "nfev": self.nfev,
+            "nsteps": self.nsteps,
+            "wall_time_s": self.wall_time,
+            "boundary_crossings": self.boundary_crossings,
+            "left_valid_range": None
+            if self.left_valid_range is None
+            else dict(zip(("tau", "state", "value"), self.left_valid_range, strict=True)),
+            "options": self.options,
+        }
+
+
+def simulate(
+    system: System,
+    x0=None,
+    *,
+    method: str = "RK45",
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    transient: int = 300,
+    periods: int = 100,
+    samples_per_period: int = 64,
+    t0: float = 0.0,
+    steps_per_period: int = 512,
+    max_step: float | None = None,
+    bound: float = 1e3,
+) -> Trajectory:
+    """Integrate ``system`` from ``x0`` and sample the response after a transient.
+
+    Parameters
+    ----------
+    system : System
+        The model and its parameter values.
+    x0 : array_like, shape (n,), optional
+        Initial state; default: each coordinate at its static load (``u = 1 + f``
+        roughly in contact), velocities zero.
+    method : str
+        One of :data:`METHODS`.
+    rtol, atol : float
+        Tolerances of the adaptive methods (``rk`` and ``collocation`` use
+        ``steps_per_period`` instead).
+    transient, periods : int
+        Forcing periods discarded, then sampled.
+    samples_per_period : int
+        Samples per period in the window (a power of two suits the FFT).
+    bound : float
+        A state beyond this magnitude ends the run as ``divergent``.
+    """
+    if method not in METHODS:
+        raise ValueError(f"unknown method '{method}'; methods: {', '.join(METHODS)}")
+    for name, value in (("transient", transient), ("periods", periods)):
+        if not (isinstance(value, int) and value >= 0):
+            raise ValueError(f"{name} must be a whole number >= 0, got {value!r}")
+    if periods < 1 or samples_per_period < 1:
+        raise ValueError("periods and samples_per_period must be >= 1")
+    if method in ("rk", "collocation") and steps_per_period % samples_per_period:
+        raise ValueError(
+            f"steps_per_period ({steps_per_period}) must be a multiple of samples_per_period "
+            f"({samples_per_period}) for the fixed-step methods"
+        )
+    if not (rtol > 0 and atol > 0):
+        raise ValueError(f"tolerances must be > 0, got rtol={rtol}, atol={atol}")
+    x0 = default_initial_state(system) if x0 is None else np.asarray(x0, dtype=float)
+    if x0.shape != (system.n,) or not np.all(np.isfinite(x0)):
+        raise ValueError(f"x0 must be {system.n} finite numbers ({', '.join(system.states)})")
+    T = system.period
+    t_start = t0 + transient * T
+    grid = t_start + T * np.arange(periods * samples_per_period + 1) / samples_per_period
+    started = time.perf_counter()
+    if method in SCIPY_METHODS:
+        run = _scipy_run(system, x0, t0, grid, method, rtol, atol, max_step, bound)
+    else:
+        run = _casadi_run(
+            system, x0, t0, grid, method, rtol, atol, steps_per_period, samples_per_period, bound
+        )
+    x, status, message, nfev, nsteps, crossings = run
+    x_final = x[:, -1].copy()
+    # Keep the window without its closing sample: exactly `periods` whole periods.
+    t_out, x_out = grid[:-1], x[:, :-1]
+    status, message = _check_bound(t_out, x_out, status, message, bound)
+    return Trajectory(
+        system=system,
+        method=method,
+        rtol=rtol,
+        atol=atol,
+        transient=transient,
+        periods=periods,
+        samples_per_period=samples_per_period,
+        t=t_out,
+        x=x_out,
+        x_final=x_final,
+        status=status,
+        message=message,
+        nfev=nfev,
+        nsteps=nsteps,
+        wall_time=time.perf_counter() - started,
+        boundary_crossings=crossings,
+        left_valid_range=_first_exit(system, t_out, x_out),
+        options={"steps_per_period": steps_per_period} if method in ("rk", "collocation") else {},
+    )
+
+
+def default_initial_state(system: System) -> np.ndarray:
+    """Each coordinate pressed into contact by its load (``u = 1 + f`` with the sign of
+    ``f``), at rest: close to the loaded equilibrium for ``g`` near the dead zone."""
+    x0 = np.zeros(system.n)
+    names = set(system.module.PARAMETERS)
+    for i, c in enumerate(system.coordinates):
+        f = system.parameter(f"f_{c}") if f"f_{c}" in names else 0.0
+        x0[i] = math.copysign(1.0, f) + f if f != 0 else 0.0
+    return x0
+
+
+def _check_bound(t, x, status, message, bound):
+    if status != "ok":
+        return status, message
+    bad = ~np.all(np.isfinite(x) & (np.abs(x) <= bound), axis=0)
+    if np.any(bad):
+        k = int(np.argmax(bad))
+        return "divergent", f"a state passed |x| = {bound:g} by tau = {t[k]:.6g}"
+    return status, message
+
+
+def _first_exit(system: System, t, x):
+    a = system.valid_range
+    if a is None:
+        return None
+    m = len(system.coordinates)
+    out = np.abs(x[:m]) > a
+    if not np.any(out):
+        return None
+    k = int(np.argmax(np.any(out, axis=0)))
+    i = int(np.argmax(out[:, k]))
+    return float(t[k]), system.coordinates[i], float(x[i, k])
+
+
+# -- SciPy -------------------------------------------------------------------------------
+
+
+def _scipy_run(system, x0, t0, grid, method, rtol, atol, max_step, bound):
+    fun = system.rhs
+    opts = {"rtol": rtol, "atol": atol}
+    if method in ("Radau", "LSODA"):
+        opts["jac"] = system.jacobian
+    if max_step is not None:
+        opts["max_step"] = max_step
+    boundaries = _boundaries(system) if system.backlash == "dead-zone" else []
+    x = np.full((system.n, grid.size), np.nan)
+    t, y = t0, np.array(x0, dtype=float)
+    nfev = crossings = 0
+    offset: dict[int, float] = {}
+    t_end = grid[-1]
+    while True:
+        events = [_boundary_event(i, edge, offset.get(k, 0.0))
+                  for k, (i, edge) in enumerate(boundaries)] + [_escape_event(bound)]  # fmt: skip
+        lo = np.searchsorted(grid, t, side="right" if crossings else "left")
+        sol = solve_ivp(fun, (t, t_end), y, method=method, t_eval=grid[lo:], events=events,
+                        **opts)  # fmt: skip
+        nfev += sol.nfev
+        if sol.status == -1:
+            raise SimulationError(f"{method} failed at tau = {t:.6g}: {sol.message}")
+        t_out = np.asarray(sol.t, dtype=float)  # a list when no output time was reached
+        if t_out.size:
+            start = int(np.searchsorted(grid, t_out[0]))
+            x[:, start : start + t_out.size] = sol.y
+        if sol.status == 0:
+            return x, "ok", "", nfev, None, crossings
+        k = next(k for k, te in enumerate(sol.t_events) if te.size)
+        t_e, y_e = float(sol.t_events[k][0]), sol.y_events[k][0]
+        if k == len(boundaries):
+            return x, "divergent", f"a state passed |x| = {bound:g} at tau = {t_e:.6g}", \
+                nfev, None, crossings  # fmt: skip
+        # Restart on the contact boundary; the boundary just crossed is moved a hair to the
+        # side the motion goes to, so that it does not fire again at once.
+        i = boundaries[k][0]
+        direction = math.copysign(1.0, y_e[len(system.coordinates) + i])
+        offset = {k: direction * 1e-10}
+        t, y = t_e, y_e
+        crossings += 1
+
+
+def _boundaries(system: System) -> list[tuple[int, float]]:
+    return [(i, edge) for i in range(len(system.coordinates)) for edge in (1.0, -1.0)]
+
+
+def _boundary_event(i: int, edge: float, offset: float):
+    def event(t, y):
+        return y[i] - edge + offset
+
+    event.terminal = True
+    return event
+
+
+def _escape_event(bound: float):
+    def escape(t, y):
+        return bound - np.max(np.abs(y))
+
+    escape.terminal = True
+    return escape
+
+
+# -- CasADi ------------------------------------------------------------------------------
+
+
+def _casadi_run(system, x0, t0, grid, method, rtol, atol, steps, spp, bound):
+    import casadi as ca
+
+    f, _ = system.casadi
+    tau = ca.SX.sym("tau")
+    xs = ca.SX.sym("x", system.n)
+    ps = ca.SX.sym("p", system.p.size)
+    dae = {"x": xs, "p": ps, "t": tau, "ode": f(tau, xs, ps)}
+    T = system.period
+
+    def options(periods: int) -> dict:
+        if method == "cvodes":
+            return {"reltol": rtol, "abstol": atol, "max_num_steps": 1_000_000}
+        # CasADi spreads number_of_finite_elements over the whole horizon, so it is
+        # `steps` per forcing period times the periods covered (collocation: elements of
+        # four points each, i.e. steps / 4 elements per period).
+        per_period = steps if method == "rk" else max(spp, steps // 4)
+        opts = {"number_of_finite_elements": per_period * periods}
+        if method == "collocation":
+            opts["interpolation_order"] = 4
+            opts["rootfinder_options"] = {"error_on_fail": True}
+        return opts
+
+    nfev = 0
+    try:
+        y = np.asarray(x0, dtype=float)
+        transient = int(round((grid[0] - t0) / T))
+        if transient > 0:
+            F = ca.integrator("transient", method, dae, t0, t0 + T * np.arange(1, transient + 1),
+                              options(transient))  # fmt: skip
+            ends = np.asarray(F(x0=y, p=system.p)["xf"])
+            nfev += _casadi_nfev(F)
+            if not np.all(np.isfinite(ends)) or np.max(np.abs(ends)) > bound:
+                bad = np.argmax(~np.all(np.isfinite(ends) & (np.abs(ends) <= bound), axis=0))
+                out = np.full((system.n, grid.size), np.nan)
+                message = f"a state passed |x| = {bound:g} in transient period {bad + 1}"
+                return out, "divergent", message, nfev, None, 0
+            y = ends[:, -1]
+        window = int(round((grid[-1] - grid[0]) / T))
+        F = ca.integrator("window", method, dae, grid[0], grid[1:], options(window))
+        rest = np.asarray(F(x0=y, p=system.p)["xf"])
+        nfev += _casadi_nfev(F)
+    except RuntimeError as err:
+        first = str(err).strip().splitlines()[-1][:200]
+        raise SimulationError(f"{method} failed: {first}") from None
+    x = np.concatenate([y[:, None], rest], axis=1)
+    return x, "ok", "", nfev, None, 0
+
+
+def _casadi_nfev(F) -> int:
+    try:
+        stats = F.stats()
+    except RuntimeError:
+        return 0
+    return int(stats.get("nfevals", 0) or 0)

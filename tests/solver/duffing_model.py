@@ -1,0 +1,57 @@
+"""Ueda's forced Duffing oscillator in the generated-model interface (test fixture).
+
+    x'' + k x' + x^3 = B cos(omega tau),  k = 0.05, B = 7.5, omega = 1
+
+is chaotic (Ueda 1979, "Randomly transitional phenomena in the system governed by
+Duffing's equation", J. Stat. Phys. 20).  Written by hand: the solver must work on any
+module with this interface, not only on what the derivation emits.
+"""
+
+import numpy as np
+
+NAME = "ueda_duffing"
+SCENE = "ueda"
+INPUTS_SHA256 = "0" * 64
+STATES = ("x", "dx")
+COORDINATES = ("x",)
+PARAMETERS = ("omega", "k", "B")
+DEFAULTS = (1.0, 0.05, 7.5)
+VALID_RANGE = None
+OMEGA_N = 1.0
+HALF_BACKLASH = {"x": 1.0}
+FEATURES = {
+    "backlash": "cubic",
+    "stiffness_harmonics": 0,
+    "transmission_error": False,
+    "mesh_phase": False,
+    "damping_coupling": False,
+}
+SCENE_PARAMETERS = {"omega": 1.0}
+OPERATIONS = {"rhs": 8, "rhs_and_jacobian": 12}
+
+
+def parameters(**values):
+    p = dict(zip(PARAMETERS, DEFAULTS, strict=True))
+    unknown = set(values) - set(p)
+    if unknown:
+        raise KeyError(f"unknown parameter(s) {sorted(unknown)}")
+    p.update(values)
+    return np.array([p[k] for k in PARAMETERS], dtype=float)
+
+
+def rhs(tau, x, p):
+    return np.array(np.broadcast_arrays(x[1], -p[1] * x[1] - x[0] ** 3 + p[2] * np.cos(p[0] * tau)))
+
+
+def jacobian(tau, x, p):
+    z = np.zeros_like(x[0])
+    return np.array([[z, z + 1.0], [-3.0 * x[0] ** 2, z - p[1]]])
+
+
+def casadi_functions():
+    import casadi as ca
+
+    tau, x, p = ca.SX.sym("tau"), ca.SX.sym("x", 2), ca.SX.sym("p", 3)
+    xdot = ca.vertcat(x[1], -p[1] * x[1] - x[0] ** 3 + p[2] * ca.cos(p[0] * tau))
+    f = ca.Function("rhs", [tau, x, p], [xdot])
+    return f, ca.Function("jacobian", [tau, x, p], [ca.jacobian(xdot, x)])

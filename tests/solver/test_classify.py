@@ -1,0 +1,48 @@
+"""Motion classification against systems whose motion is known."""
+
+import numpy as np
+from gearsym.solver.classify import classify_points, correlation_dimension
+from gearsym.solver.point import analyse_point
+from gearsym.solver.system import System
+
+
+def test_period_one_response_gives_one_poincare_cluster():
+    system = System.load("reference_light", **{"lambda": 0.8})
+    result = analyse_point(system, method="cvodes", transient=200, periods=64, lyapunov_periods=100)
+    for c in ("u", "v"):
+        assert result.classification[c].motion == "period-1"
+        points = result.trajectory.poincare[[system.index(c), system.index("d" + c)]]
+        assert np.ptp(points, axis=1).max() < 1e-5  # one cluster
+    assert result.lyapunov.exponent < 0
+
+
+def test_two_frequency_signal_is_quasi_periodic():
+    # x(t) = cos t + 0.5 cos(sqrt(2) t), sampled at t = 2 pi k: the points lie on a closed
+    # curve (a torus section), never repeating.
+    k = np.arange(400)
+    t = 2 * np.pi * k
+    w = np.sqrt(2.0)
+    points = np.vstack([np.cos(t) + 0.5 * np.cos(w * t), -np.sin(t) - 0.5 * w * np.sin(w * t)])
+    verdict = classify_points(points, tol=1e-6)
+    assert verdict.motion == "quasi-periodic", verdict.evidence
+    assert 0.8 < correlation_dimension(points) < 1.2
+
+
+def test_period_three_sequence_is_found():
+    base = np.array([[0.1, 0.5, -0.3], [1.0, 0.2, 0.7]])
+    points = np.tile(base, 20)
+    assert classify_points(points, tol=1e-9).motion == "period-3"
+
+
+def test_ueda_duffing_is_chaotic_with_a_positive_exponent(duffing):
+    # Ueda (1979): x'' + 0.05 x' + x^3 = 7.5 cos t is chaotic.
+    result = analyse_point(
+        duffing,
+        np.array([3.0, 4.0]),
+        method="cvodes",
+        transient=100,
+        periods=200,
+        lyapunov_periods=300,
+    )
+    assert result.lyapunov.exponent > 0.05
+    assert result.classification["x"].motion == "chaotic", result.classification["x"].evidence

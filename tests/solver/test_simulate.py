@@ -1,0 +1,142 @@
+"""The integration front door against closed forms and against each other."""
+
+import numpy as np
+import pytest
+from gearsym.solver.simulate import METHODS, simulate
+from gearsym.solver.system import System
+
+
+def closed_form_steady_state(system, tau):
+    """u(tau) of u'' + 2 Xi u' + K u = f + ebar''(tau) by complex amplitudes (the forced
+    damped linear oscillator): u = K^-1 f + Re[(K - w^2 I + i w 2 Xi)^-1 F e^{i w tau}]."""
+    names = list(system.module.PARAMETERS)
+    val = dict(zip(names, system.p, strict=True))
+    c = system.coordinates
+    m = len(c)
+    K = np.array([[val.get(f"kappa_{a}_{b}", 0.0) for b in c] for a in c])
+    Xi = np.array([[val.get(f"xi_{a}_{b}", 0.0) for b in c] for a in c])
+    f = np.array([val[f"f_{a}"] for a in c])
+    w = val["omega"]
+    F = np.array(
+        [
+            -(w**2) * val[f"E_{a}_1"] * np.exp(1j * (val[f"psi_{a}_1"] - val.get(f"phi_{a}", 0.0)))
+            for a in c
+        ]
+    )
+    X = np.linalg.solve(K - w**2 * np.eye(m) + 2j * w * Xi, F)
+    static = np.linalg.solve(K, f)
+    u = static[:, None] + np.real(X[:, None] * np.exp(1j * w * tau[None, :]))
+    du = np.real(1j * w * X[:, None] * np.exp(1j * w * tau[None, :]))
+    return np.vstack([u, du])
+
+
+@pytest.mark.parametrize("method", ["DOP853", "cvodes"])
+def test_linear_limit_matches_the_closed_form_steady_state(linear_system, method):
+    tr = simulate(
+        linear_system,
+        method=method,
+        rtol=1e-11,
+        atol=1e-13,
+        transient=200,
+        periods=4,
+        samples_per_period=16,
+    )
+    exact = closed_form_steady_state(linear_system, tr.t)
+    # Amplitude and phase to 1e-6: every sample of the steady state within 1e-6.
+    assert np.max(np.abs(tr.x - exact)) < 1e-6
+
+
+def test_all_methods_reach_the_steady_state(linear_system):
+    for method in METHODS:
+        tr = simulate(
+            linear_system,
+            method=method,
+            rtol=1e-9,
+            atol=1e-11,
+            transient=150,
+            periods=2,
+            samples_per_period=8,
+            steps_per_period=2048,
+        )
+        exact = closed_form_steady_state(linear_system, tr.t)
+        assert np.max(np.abs(tr.x - exact)) < 1e-5, method
+        assert tr.describe()["method"] == method
+
+
+def test_fixed_step_rk4_converges_at_fourth_order(linear_system):
+    # Global error at a fixed time against the closed form; the slope of log error
+    # against log step is the observed order (theory: 4 for the classical RK4).
+    errors, steps = [], [32, 64, 128, 256]
+    for n in steps:
+        tr = simulate(
+            linear_system,
+            method="rk",
+            transient=0,
+            periods=3,
+            samples_per_period=1,
+            steps_per_period=n,
+            x0=None,
+        )
+        exact = closed_form_steady_state_from(linear_system, tr)
+        errors.append(np.max(np.abs(tr.x_final - exact)))
+    order = -np.polyfit(np.log(steps), np.log(errors), 1)[0]
+    assert 3.8 < order < 4.3, (order, errors)
+
+
+def closed_form_steady_state_from(system, tr):
+    """A tight reference of the same initial-value problem (the transient included)."""
+    ref = simulate(
+        system,
+        tr.x[:, 0],
+        method="cvodes",
+        rtol=1e-13,
+        atol=1e-15,
+        transient=0,
+        periods=tr.periods,
+        samples_per_period=1,
+        t0=tr.t[0],
+    )
+    return ref.x_final
+
+
+def test_scipy_and_casadi_agree_on_a_periodic_poincare_point():
+    system = System.load("reference_light", **{"lambda": 0.8})
+    a = simulate(system, method="DOP853", rtol=1e-10, atol=1e-12, transient=150, periods=4)
+    b = simulate(system, method="cvodes", rtol=1e-10, atol=1e-12, transient=150, periods=4)
+    assert np.max(np.abs(a.poincare[:, -1] - b.poincare[:, -1])) < 1e-6
+
+
+def test_dead_zone_runs_stop_at_each_contact_boundary(tmp_path):
+    from gearsym.derive.build import build_files, project_root, write_files
+
+    text = (project_root() / "scenes" / "reference-light.toml").read_text()
+    text = text.replace('backlash = "polynomial"', 'backlash = "dead-zone"')
+    for key in ("backlash_order", "backlash_range", "backlash_step"):
+        text = "\n".join(line for line in text.splitlines() if not line.startswith(key))
+    text = text.replace(
+        'topology = "topologies/diso.toml"',
+        f'topology = "{(project_root() / "scenes/topologies/diso.toml").as_posix()}"',
+    )
+    text = text.replace('name = "reference-light"', 'name = "dead-zone-light"')
+    scene = tmp_path / "dz.toml"
+    scene.write_text(text)
+    write_files(build_files([scene]).files, tmp_path)
+    # A light load keeps both meshes crossing the contact boundaries every period.
+    system = System.load(tmp_path / "generated" / "dead_zone_light.py", f1=0.02, **{"lambda": 0.1})
+    # Over a few periods (the motion may be sensitive to its initial state, so compare
+    # before errors could grow): RK45 restarted at each crossing against a tight CVODES.
+    a = simulate(system, method="RK45", rtol=1e-10, atol=1e-12, transient=4, periods=4)
+    b = simulate(system, method="cvodes", rtol=1e-12, atol=1e-14, transient=4, periods=4)
+    assert a.boundary_crossings >= 8  # u and v meet the contact boundaries every period
+    assert np.max(np.abs(a.x - b.x)) < 1e-6
+
+
+def test_divergence_is_reported_not_hidden(duffing):
+    runaway = duffing.with_values(k=-0.5)  # negative damping: the energy grows
+    tr = simulate(runaway, method="RK45", transient=0, periods=50, bound=50.0)
+    assert tr.status == "divergent" and "passed |x| = 50" in tr.message
+
+
+def test_unknown_method_lists_the_valid_ones(duffing):
+    with pytest.raises(ValueError, match="methods: RK45, DOP853"):
+        simulate(duffing, method="rk45")
