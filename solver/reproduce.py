@@ -179,13 +179,14 @@ def _report(res, lam, by_case, points, maps, map_lam, elapsed, quick, systems) -
         u_b = np.array([p["extremes"]["v"]["min"] for p in bwd.points])
         apart = [float(v) for v, a, b in zip(lam, u_f, u_b, strict=True) if abs(a - b) > 0.05]
         if hysteresis or apart:
-            row(
-                f"f1 = {f1} (not in the study): forward against backward sweep",
-                f"motion of v differs at {len(hysteresis)} and Min(v) at {len(apart)} of "
-                f"{len(lam)} values of λ",
-                None,
-                "coexisting attractors: the motion depends on the initial state",
-            )
+            span = f"λ ∈ [{min(apart):g}, {max(apart):g}]" if apart else ""
+            row(f"f1 = {f1} (not in the study): forward against backward sweep",
+                (f"motion type of v differs at {len(hysteresis)} values of λ; " if hysteresis
+                 else "same motion type at every λ; ")
+                + (f"Min(v) differs by more than 0.05 at {len(apart)} of {len(lam)} values, "
+                   f"{span}" if apart else ""),
+                None, "coexisting attractors: which one the system settles on depends on its "
+                "history (hysteresis)")  # fmt: skip
 
     def point(case, value):
         r = points[(case, value)]

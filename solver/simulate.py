@@ -70,7 +70,7 @@ class Trajectory:
     status: str
     message: str
     nfev: int
-    nsteps: int | None
+    nsteps: int
     wall_time: float
     boundary_crossings: int = 0
     left_valid_range: tuple | None = None  # (tau, state, value) of the first exit
@@ -246,29 +246,30 @@ def _scipy_run(system, x0, t0, grid, method, rtol, atol, max_step, bound):
     boundaries = _boundaries(system) if system.backlash == "dead-zone" else []
     x = np.full((system.n, grid.size), np.nan)
     t, y = t0, np.array(x0, dtype=float)
-    nfev = crossings = 0
+    nfev = nsteps = crossings = 0
     offset: dict[int, float] = {}
     t_end = grid[-1]
     while True:
         events = [_boundary_event(i, edge, offset.get(k, 0.0))
                   for k, (i, edge) in enumerate(boundaries)] + [_escape_event(bound)]  # fmt: skip
-        lo = np.searchsorted(grid, t, side="right" if crossings else "left")
-        sol = solve_ivp(fun, (t, t_end), y, method=method, t_eval=grid[lo:], events=events,
+        sol = solve_ivp(fun, (t, t_end), y, method=method, dense_output=True, events=events,
                         **opts)  # fmt: skip
         nfev += sol.nfev
         if sol.status == -1:
             raise SimulationError(f"{method} failed at tau = {t:.6g}: {sol.message}")
-        t_out = np.asarray(sol.t, dtype=float)  # a list when no output time was reached
-        if t_out.size:
-            start = int(np.searchsorted(grid, t_out[0]))
-            x[:, start : start + t_out.size] = sol.y
+        nsteps += sol.t.size - 1
+        # Samples that fall in this segment, from the method's own dense output.
+        lo = np.searchsorted(grid, t, side="left")
+        hi = np.searchsorted(grid, sol.t[-1], side="right")
+        if hi > lo:
+            x[:, lo:hi] = sol.sol(grid[lo:hi])
         if sol.status == 0:
-            return x, "ok", "", nfev, None, crossings
+            return x, "ok", "", nfev, nsteps, crossings
         k = next(k for k, te in enumerate(sol.t_events) if te.size)
         t_e, y_e = float(sol.t_events[k][0]), sol.y_events[k][0]
         if k == len(boundaries):
-            return x, "divergent", f"a state passed |x| = {bound:g} at tau = {t_e:.6g}", \
-                nfev, None, crossings  # fmt: skip
+            message = f"a state passed |x| = {bound:g} at tau = {t_e:.6g}"
+            return x, "divergent", message, nfev, nsteps, crossings
         # Restart on the contact boundary; the boundary just crossed is moved a hair to the
         # side the motion goes to, so that it does not fire again at once.
         i = boundaries[k][0]
@@ -324,7 +325,7 @@ def _casadi_run(system, x0, t0, grid, method, rtol, atol, steps, spp, bound):
             opts["rootfinder_options"] = {"error_on_fail": True}
         return opts
 
-    nfev = 0
+    nfev = nsteps = 0
     try:
         y = np.asarray(x0, dtype=float)
         transient = int(round((grid[0] - t0) / T))
@@ -332,27 +333,35 @@ def _casadi_run(system, x0, t0, grid, method, rtol, atol, steps, spp, bound):
             F = ca.integrator("transient", method, dae, t0, t0 + T * np.arange(1, transient + 1),
                               options(transient))  # fmt: skip
             ends = np.asarray(F(x0=y, p=system.p)["xf"])
-            nfev += _casadi_nfev(F)
+            work = _casadi_work(F, method)
+            nfev, nsteps = nfev + work[0], nsteps + work[1]
             if not np.all(np.isfinite(ends)) or np.max(np.abs(ends)) > bound:
                 bad = np.argmax(~np.all(np.isfinite(ends) & (np.abs(ends) <= bound), axis=0))
                 out = np.full((system.n, grid.size), np.nan)
                 message = f"a state passed |x| = {bound:g} in transient period {bad + 1}"
-                return out, "divergent", message, nfev, None, 0
+                return out, "divergent", message, nfev, nsteps, 0
             y = ends[:, -1]
         window = int(round((grid[-1] - grid[0]) / T))
         F = ca.integrator("window", method, dae, grid[0], grid[1:], options(window))
         rest = np.asarray(F(x0=y, p=system.p)["xf"])
-        nfev += _casadi_nfev(F)
+        work = _casadi_work(F, method)
+        nfev, nsteps = nfev + work[0], nsteps + work[1]
     except RuntimeError as err:
         first = str(err).strip().splitlines()[-1][:200]
         raise SimulationError(f"{method} failed: {first}") from None
     x = np.concatenate([y[:, None], rest], axis=1)
-    return x, "ok", "", nfev, None, 0
+    return x, "ok", "", nfev, nsteps, 0
 
 
-def _casadi_nfev(F) -> int:
+def _casadi_work(F, method: str) -> tuple[int, int]:
+    """(right-hand side evaluations, steps) from a CasADi integrator's statistics."""
     try:
         stats = F.stats()
     except RuntimeError:
-        return 0
-    return int(stats.get("nfevals", 0) or 0)
+        return 0, 0
+    if method == "cvodes":
+        return int(stats.get("nfevals", 0)), int(stats.get("nsteps", 0))
+    steps = int(stats.get("n_call_step", 0))
+    # RK4 evaluates the right-hand side four times a step; a collocation step solves for
+    # its four points with Newton, whose evaluations CasADi does not count separately.
+    return (4 * steps if method == "rk" else 0), steps

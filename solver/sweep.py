@@ -44,6 +44,7 @@ class SweepResult:
     base_values: dict
     settings: dict
     points: list = field(default_factory=list)  # dicts, see _summary
+    scales: dict = field(default_factory=dict)  # omega_n and half backlash: back to SI
 
     def poincare(self, state: str) -> list[np.ndarray]:
         return [np.asarray(p["poincare"][state]) for p in self.points]
@@ -60,6 +61,7 @@ class SweepResult:
             "direction": self.direction,
             "base_values": self.base_values,
             "settings": self.settings,
+            "scales": self.scales,
             "points": self.points,
         }
 
@@ -76,7 +78,8 @@ class SweepResult:
     def load(cls, path: Path) -> SweepResult:
         d = json.loads(Path(path).read_text(encoding="utf-8"))
         return cls(d["model"], d["model_hash"], d["parameter"], np.asarray(d["values"]),
-                   d["direction"], d["base_values"], d["settings"], d["points"])  # fmt: skip
+                   d["direction"], d["base_values"], d["settings"], d["points"],
+                   d.get("scales", {}))  # fmt: skip
 
 
 class Progress:
@@ -196,6 +199,7 @@ def sweep(
         base_values={k: float(v) for k, v in system.values.items()},
         settings={k: v for k, v in settings.items()},
         points=points,
+        scales=_scales(system),
     )
 
 
@@ -232,11 +236,18 @@ def sweep_many(
                 np.asarray(job["values"], dtype=float),
                 "backward" if backward else "forward",
                 {k: float(v) for k, v in system.values.items()}, settings, chunk,
+                _scales(system),
             ))  # fmt: skip
             if progress:
                 for _ in chunk:
                     progress.step()
     return results
+
+
+def _scales(system: System) -> dict:
+    return {"omega_n_rad_per_s": float(system.module.OMEGA_N),
+            "half_backlash_m": dict(system.module.HALF_BACKLASH),
+            "time": "tau = omega_n t; coordinates in half backlashes"}  # fmt: skip
 
 
 def _job_settings(job: dict) -> dict:

@@ -63,24 +63,33 @@ def test_all_methods_reach_the_steady_state(linear_system):
         assert tr.describe()["method"] == method
 
 
-def test_fixed_step_rk4_converges_at_fourth_order(linear_system):
-    # Global error at a fixed time against the closed form; the slope of log error
-    # against log step is the observed order (theory: 4 for the classical RK4).
-    errors, steps = [], [32, 64, 128, 256]
+@pytest.mark.parametrize(
+    "method,theory,steps",
+    [
+        ("rk", 4, [32, 64, 128, 256]),  # classical Runge-Kutta: order 4
+        ("collocation", 7, [32, 64, 128]),  # Radau IIA with 4 points: order 2*4 - 1 = 7
+    ],
+)
+def test_fixed_step_methods_converge_at_their_theoretical_order(
+    linear_system, method, theory, steps
+):
+    # Global error after three periods against a tight CVODES run of the same problem;
+    # the slope of log error against log step count is the observed order.
+    x0 = np.array([1.1, -0.99, 0.0, 0.0])
+    errors = []
     for n in steps:
         tr = simulate(
             linear_system,
-            method="rk",
+            x0,
+            method=method,
             transient=0,
             periods=3,
             samples_per_period=1,
             steps_per_period=n,
-            x0=None,
         )
-        exact = closed_form_steady_state_from(linear_system, tr)
-        errors.append(np.max(np.abs(tr.x_final - exact)))
+        errors.append(np.max(np.abs(tr.x_final - closed_form_steady_state_from(linear_system, tr))))
     order = -np.polyfit(np.log(steps), np.log(errors), 1)[0]
-    assert 3.8 < order < 4.3, (order, errors)
+    assert abs(order - theory) < 0.35, (order, errors)
 
 
 def closed_form_steady_state_from(system, tr):
