@@ -66,22 +66,28 @@ class Spectrum:
 
 
 def spectrum(tr: Trajectory, state: str) -> Spectrum:
-    """Hann-windowed FFT of ``state`` over the sampled window (mean removed)."""
+    """Hann-windowed FFT of ``state`` over the sampled window (mean removed); non-finite
+    samples (a divergent run) give an empty spectrum."""
     y = tr.coordinate(state)
+    dt = tr.period / tr.samples_per_period
+    if not np.all(np.isfinite(y)):
+        empty = np.zeros(0)
+        return Spectrum(empty, empty, tr.system.omega, "hann", 0, y.size * dt)
     n = y.size
-    w = np.hanning(n)
+    w = 0.5 - 0.5 * np.cos(2 * np.pi * np.arange(n) / n)  # periodic Hann: exact on bins
     amp = 2.0 * np.abs(np.fft.rfft((y - y.mean()) * w)) / w.sum()
-    dt = tr.t[1] - tr.t[0]
     freq = 2 * np.pi * np.fft.rfftfreq(n, dt)
     return Spectrum(freq, amp, tr.system.omega, "hann", n, n * dt)
 
 
 def extremes(tr: Trajectory) -> dict:
     """Max and min of every state over the sampled window."""
-    return {
-        s: {"max": float(np.max(tr.x[k])), "min": float(np.min(tr.x[k]))}
-        for k, s in enumerate(tr.system.states)
-    }
+    out = {}
+    for k, s in enumerate(tr.system.states):
+        finite = tr.x[k][np.isfinite(tr.x[k])]
+        out[s] = {"max": float(finite.max()) if finite.size else None,
+                  "min": float(finite.min()) if finite.size else None}  # fmt: skip
+    return out
 
 
 def meshing_states(tr: Trajectory) -> dict:
@@ -90,6 +96,10 @@ def meshing_states(tr: Trajectory) -> dict:
     out = {}
     for c in tr.system.coordinates:
         u = tr.coordinate(c)
+        u = u[np.isfinite(u)]
+        if not u.size:
+            out[c] = {"forward": None, "separated": None, "backward": None}
+            continue
         out[c] = {
             "forward": float(np.mean(u > 1.0)),
             "separated": float(np.mean(np.abs(u) <= 1.0)),

@@ -11,8 +11,9 @@ Three pieces of evidence are weighed:
    fluctuation.
 3. **The correlation dimension** of the Poincare set (Grassberger and Procaccia 1983,
    "Characterization of strange attractors", PRL 50): ~ 0 for a finite set of points, ~ 1
-   for the closed curve a two-frequency torus leaves, larger for a strange attractor.
-   Used when no exponent is available, and as a cross-check.
+   for the closed curve a two-frequency torus leaves (0.85 to 1.15 is read as a curve),
+   larger for a strange attractor.  Used when no exponent is available, and as a
+   cross-check.  Alone it is weak: Henon's attractor has 1.21.
 
 When the evidence disagrees the verdict is ``undetermined`` and says why.
 """
@@ -28,6 +29,7 @@ from .lyapunov import LyapunovEstimate
 __all__ = ["Classification", "classify_points", "correlation_dimension", "periodicity"]
 
 MAX_PERIOD = 32
+CURVE = (0.85, 1.15)  # correlation dimensions read as a closed curve
 
 
 @dataclass(frozen=True)
@@ -74,6 +76,18 @@ def correlation_dimension(points: np.ndarray) -> float | None:
     return float(slope)
 
 
+def distinct_points(points: np.ndarray, tol: float) -> int:
+    """Number of clusters of points closer than ``tol`` (greedy; enough to tell a finite
+    set of points from a curve or a cloud)."""
+    centres: list[np.ndarray] = []
+    for p in points.T:
+        if not any(np.linalg.norm(p - c) <= tol for c in centres):
+            centres.append(p)
+            if len(centres) > points.shape[1] // 2:
+                break
+    return len(centres)
+
+
 def classify_points(
     points: np.ndarray,
     *,
@@ -81,14 +95,23 @@ def classify_points(
     lyapunov: LyapunovEstimate | None = None,
     divergent: bool = False,
     spectrum_peaks: list | None = None,
+    period: float | None = None,
 ) -> Classification:
-    """Classify from Poincare points (d, K), an optional exponent and spectral peaks."""
-    evidence: dict = {"poincare_points": int(points.shape[1]), "tolerance": tol}
+    """Classify from Poincare points (d, K), an optional exponent and spectral peaks.
+
+    ``period`` is the forcing period T: the exponent counts as positive when the growth
+    per period exceeds ``exp(0.02)`` and three times the estimate's own finite-time
+    spread.
+    """
+    evidence: dict = {"poincare_points": int(points.shape[1])}
     if spectrum_peaks is not None:
         evidence["spectrum_peaks"] = spectrum_peaks
     if divergent or not np.all(np.isfinite(points)):
         return Classification("divergent", None, evidence)
+    # Relative to the cloud's size, but never finer than `tol` in absolute terms: the
+    # coordinates are in half backlashes, O(1).
     scale = max(float(np.ptp(points, axis=1).max()), 1.0)
+    evidence["tolerance"] = tol * scale
     n = periodicity(points, tol * scale)
     evidence["period_found"] = n
     dim = None if n is not None else correlation_dimension(points)
@@ -96,8 +119,8 @@ def classify_points(
     lam = None
     if lyapunov is not None:
         evidence["lyapunov"] = lyapunov.describe()
-        # "Positive" must clear the estimate's own finite-time wobble.
-        margin = max(2e-3, 3.0 * lyapunov.spread)
+        floor = 0.02 / period if period else 2e-3
+        margin = max(floor, 3.0 * lyapunov.spread)
         lam = "positive" if lyapunov.exponent > margin else (
             "negative" if lyapunov.exponent < -margin else "zero")  # fmt: skip
         evidence["lyapunov_sign"] = lam
@@ -107,17 +130,29 @@ def classify_points(
             evidence["why"] = "points repeat, yet the exponent is positive"
             return Classification("undetermined", None, evidence)
         return Classification(f"period-{n}", n, evidence)
+    clusters = distinct_points(points, tol * scale)
+    if clusters <= points.shape[1] // 2:
+        evidence["distinct_points"] = clusters
+        evidence["why"] = (f"a finite set of {clusters} points: a period above {MAX_PERIOD}, or "
+                           "not settled")  # fmt: skip
+        return Classification("undetermined", None, evidence)
+    # A torus section is a closed curve, dimension 1; the window is narrow because strange
+    # attractors can sit close to it (Henon's map: 1.21).
+    curve = dim is not None and CURVE[0] <= dim <= CURVE[1]
     if lam == "positive":
         if dim is not None and dim < 0.5:
             evidence["why"] = "positive exponent but the points form a finite set"
             return Classification("undetermined", None, evidence)
         return Classification("chaotic", None, evidence)
-    if lam == "zero" or (lam is None and dim is not None and 0.7 <= dim <= 1.3):
-        if dim is not None and dim > 1.5:
-            evidence["why"] = "zero exponent but the points fill more than a curve"
+    if lam == "zero" or (lam is None and curve):
+        if not curve:
+            evidence["why"] = (
+                "zero exponent, but the points do not lie on a curve (correlation dimension "
+                f"{'unknown' if dim is None else f'{dim:.2f}'}, expected {CURVE[0]} to {CURVE[1]})"
+            )
             return Classification("undetermined", None, evidence)
         return Classification("quasi-periodic", None, evidence)
-    if lam is None and dim is not None and dim > 1.3:
+    if lam is None and dim is not None and dim > CURVE[1]:
         return Classification("chaotic", None, evidence)
     evidence["why"] = (
         "no repetition within 32 periods, yet the exponent is negative (not settled, or a "

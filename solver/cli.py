@@ -173,6 +173,8 @@ def _system(scene_arg: str, sets: dict[str, float]):
         return System.load(module, **sets)
     except KeyError as err:
         raise _Fail(f"--set: {err.args[0]}") from None
+    except ValueError as err:
+        raise _Fail(f"--set: {err}") from None
 
 
 def _analysis_settings(args) -> dict:
@@ -188,6 +190,7 @@ def _analysis_settings(args) -> dict:
 
 
 def _cmd_simulate(args) -> int:
+    from gearsym.solver._json import dumps
     from gearsym.solver.point import analyse_point
     from gearsym.solver.simulate import SimulationError
 
@@ -202,10 +205,10 @@ def _cmd_simulate(args) -> int:
 
         out = Path(args.out)
         out.mkdir(parents=True, exist_ok=True)
-        (out / "point.json").write_text(json.dumps(data, indent=1), encoding="utf-8")
+        (out / "point.json").write_text(dumps(data, indent=1), encoding="utf-8")
         plots.point_figure(result.trajectory, out / "point.png", title=system.name)
     if args.json:
-        print(json.dumps(data, indent=1))
+        print(dumps(data, indent=1))
         return 0
     tr = result.trajectory
     print(f"{system.name}: {tr.method}, rtol {tr.rtol:g}, {tr.transient} + {tr.periods} periods, "
@@ -231,25 +234,27 @@ def _parse_range(text: str):
 
     parts = text.split(":")
     try:
+        if len(parts) != 3:
+            raise ValueError
         start, stop, num = float(parts[0]), float(parts[1]), int(parts[2])
-    except (IndexError, ValueError):
-        raise _Fail(f"--range {text}: expected START:STOP:NUM, for example 0:1:51") from None
-    if num < 1 or len(parts) != 3:
-        raise _Fail(f"--range {text}: NUM must be a whole number >= 1")
+    except ValueError:
+        raise _Fail(f"--range {text}: expected START:STOP:NUM, for example 0:1:51 "
+                    "(write --range=-0.5:1:11 when START is negative)") from None  # fmt: skip
+    if not (math.isfinite(start) and math.isfinite(stop)):
+        raise _Fail(f"--range {text}: START and STOP must be finite numbers")
+    if num < 1 or (num == 1 and start != stop):
+        raise _Fail(f"--range {text}: NUM must be >= 2, or 1 with START equal to STOP")
     return np.linspace(start, stop, num)
 
 
 def _cmd_sweep(args) -> int:
     from gearsym.solver import plots
+    from gearsym.solver.reproduce import runs_text
     from gearsym.solver.simulate import SimulationError
     from gearsym.solver.sweep import Progress, sweep
 
     values = _parse_range(args.range)
     system = _system(args.scene, _parse_set(args.set))
-    try:
-        system.with_values(**{args.param: float(values[0])})
-    except KeyError as err:
-        raise _Fail(f"--param: {err.args[0]}") from None
     out = Path(args.out or f"sweep_{system.name}_{args.param}")
     bar = Progress(len(values), f"{args.param}", enabled=not args.quiet)
     try:
@@ -258,14 +263,16 @@ def _cmd_sweep(args) -> int:
                        progress=bar, **_analysis_settings(args))  # fmt: skip
     except (SimulationError, ValueError) as err:
         raise _Fail(f"sweep: {err}") from None
+    failed = [p["value"] for p in result.points if p["status"] != "ok"]
     path = result.save(out / "sweep.json")
     fig = plots.bifurcation_diagram([result], list(system.coordinates), out / "bifurcation.png",
                                     title=f"{system.name}: {args.param} sweep")  # fmt: skip
     print(f"wrote {path} and {fig}")
     for c in system.coordinates:
-        from gearsym.solver.reproduce import _runs_text
-
-        print(f"  {c}: {_runs_text(values, result.motion(c))}")
+        print(f"  {c}: {runs_text(values, result.motion(c))}")
+    if failed:
+        print(f"  {len(failed)} point(s) did not finish normally (status in sweep.json): "
+              + ", ".join(f"{v:g}" for v in failed[:10]))  # fmt: skip
     return 0
 
 
@@ -374,7 +381,9 @@ def _parser() -> argparse.ArgumentParser:
                         "run in parallel.")  # fmt: skip
     sw.add_argument("scene", metavar="SCENE")
     sw.add_argument("--param", required=True, help="parameter to sweep, e.g. lambda")
-    sw.add_argument("--range", required=True, metavar="START:STOP:NUM")
+    sw.add_argument("--range", required=True, metavar="START:STOP:NUM",
+                    help="NUM values from START to STOP; write --range=-1:1:21 when START "
+                    "is negative")  # fmt: skip
     sw.add_argument("--backward", action="store_true", help="continue from STOP to START")
     sw.add_argument(
         "--independent",

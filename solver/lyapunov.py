@@ -28,6 +28,8 @@ class LyapunovEstimate:
     running: np.ndarray  # estimate after each period
     periods: int
     spread: float  # max - min of the running estimate over its last half
+    rtol: float = 1e-8
+    atol: float = 1e-10
 
     def describe(self) -> dict:
         return {
@@ -35,6 +37,9 @@ class LyapunovEstimate:
             "periods": self.periods,
             "last_half_spread": self.spread,
             "units": "per unit tau",
+            "method": "Benettin, variational equations, CVODES",
+            "rtol": self.rtol,
+            "atol": self.atol,
         }
 
 
@@ -79,4 +84,5 @@ def largest_lyapunov(
         z[n:] /= growth
         running[k] = total / ((k + 1) * T)
     half = running[periods // 2 :]
-    return LyapunovEstimate(float(running[-1]), running, periods, float(half.max() - half.min()))
+    return LyapunovEstimate(float(running[-1]), running, periods,
+                            float(half.max() - half.min()), rtol, atol)  # fmt: skip

@@ -106,7 +106,14 @@ def map_figure(f_values, lam_values, max_u, min_v, motion_v, path: Path, title: 
                names=("f1", "lambda", "u", "v")) -> Path:  # fmt: skip
     """Maps over (f1, lambda): Max(u), Min(v) and the motion type of v."""
     fig, axes = plt.subplots(1, 3, figsize=(15, 4))
-    extent = [lam_values[0], lam_values[-1], f_values[0], f_values[-1]]
+
+    # Cells centred on the sampled values.
+    def edges(v):
+        v = np.asarray(v, dtype=float)
+        half = (v[1] - v[0]) / 2 if v.size > 1 else 0.5
+        return v[0] - half, v[-1] + half
+
+    extent = [*edges(lam_values), *edges(f_values)]
     for ax, data, label in ((axes[0], max_u, f"Max({names[2]})"),
                             (axes[1], min_v, f"Min({names[3]})")):  # fmt: skip
         im = ax.imshow(np.asarray(data), origin="lower", aspect="auto", extent=extent)

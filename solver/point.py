@@ -8,8 +8,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
-
 from .analysis import extremes, meshing_states, spectrum
 from .classify import Classification, classify_points
 from .lyapunov import LyapunovEstimate, largest_lyapunov
@@ -68,9 +66,11 @@ def analyse_point(
     )  # fmt: skip
     lyap = None
     if tr.status == "ok" and lyapunov_periods > 0:
-        t_end = tr.t[-1] + tr.t[1] - tr.t[0]
+        # The variational equations always go through CVODES (the only back end that
+        # integrates them here), at the run's own tolerances.
         try:
-            lyap = largest_lyapunov(system, tr.x_final, t0=t_end, periods=lyapunov_periods)
+            lyap = largest_lyapunov(system, tr.x_final, t0=tr.t_final, periods=lyapunov_periods,
+                                    rtol=max(rtol, 1e-13), atol=max(atol, 1e-15))  # fmt: skip
         except (FloatingPointError, RuntimeError):
             lyap = None
     tol = classification_tolerance(method, rtol)
@@ -80,10 +80,7 @@ def analyse_point(
         points = tr.poincare[[i, j]]
         verdicts[c] = classify_points(
             points, tol=tol, lyapunov=lyap, divergent=tr.status == "divergent",
+            period=system.period,
             spectrum_peaks=spectrum(tr, c).peaks() if tr.status == "ok" else None,
         )  # fmt: skip
     return PointResult(tr, lyap, verdicts)
-
-
-def final_state(result: PointResult) -> np.ndarray:
-    return result.trajectory.x_final

@@ -11,13 +11,13 @@ the study leaves open are those of the shipped scenes, stated in their files.
 
 from __future__ import annotations
 
-import json
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ._json import dumps
 from .point import analyse_point
 from .sweep import Progress, sweep_many
 from .system import System
@@ -76,10 +76,9 @@ def reproduce(out: Path, *, quick: bool = False, executor: str = "processes",
 
     from . import plots
 
-    figures = {}
     points = {}
     for case, _, f1 in CASES:
-        figures[f"bifurcation_{case}"] = plots.bifurcation_diagram(
+        plots.bifurcation_diagram(
             by_case[case], ["u", "v"], out / f"bifurcation_{case}.png",
             title=f"{case} load, f1 = {f1}: Poincaré points against lambda",
         )  # fmt: skip
@@ -90,16 +89,16 @@ def reproduce(out: Path, *, quick: bool = False, executor: str = "processes",
             result = analyse_point(systems[case].with_values(**{"lambda": value}), x0,
                                    **settings)  # fmt: skip
             points[(case, value)] = result
-            figures[f"point_{case}_{value}"] = plots.point_figure(
+            plots.point_figure(
                 result.trajectory, out / f"point_{case}_lambda_{value}.png",
                 title=f"{case} load (f1 = {f1}), lambda = {value}",
             )  # fmt: skip
             (out / "data" / f"point_{case}_lambda_{value}.json").write_text(
-                json.dumps(result.describe()), encoding="utf-8")  # fmt: skip
-    max_u = [[p["extremes"]["u"]["max"] for p in sw.points] for sw in maps]
-    min_v = [[p["extremes"]["v"]["min"] for p in sw.points] for sw in maps]
+                dumps(result.describe()), encoding="utf-8")  # fmt: skip
+    max_u = [[_value(p["extremes"]["u"]["max"]) for p in sw.points] for sw in maps]
+    min_v = [[_value(p["extremes"]["v"]["min"]) for p in sw.points] for sw in maps]
     motion_v = [sw.motion("v") for sw in maps]
-    figures["map"] = plots.map_figure(np.array(res.map_f1), map_lam, max_u, min_v, motion_v,
+    plots.map_figure(np.array(res.map_f1), map_lam, max_u, min_v, motion_v,
                                       out / "map_f1_lambda.png",
                                       title="light-load scene with f1 varied")  # fmt: skip
     elapsed = time.perf_counter() - started
@@ -123,12 +122,8 @@ def runs(values, labels) -> list[tuple[str, float, float]]:
     return out
 
 
-def _runs_text(values, labels) -> str:
+def runs_text(values, labels) -> str:
     return "; ".join(f"{lab} on [{a:g}, {b:g}]" for lab, a, b in runs(values, labels))
-
-
-def _family(motion: str) -> str:
-    return "periodic" if motion.startswith("period-") else motion
 
 
 def _range(tr, c) -> tuple[float, float]:
@@ -136,13 +131,21 @@ def _range(tr, c) -> tuple[float, float]:
     return float(u.min()), float(u.max())
 
 
+def _value(v) -> float:
+    """A number from a point summary; NaN for a failed point."""
+    return float("nan") if v is None else float(v)
+
+
 def _grade(full: bool, part: bool) -> bool | None:
     """True when the finding is reproduced, None when only in part, False otherwise."""
     return True if full else (None if part else False)
 
 
-def _verdict(ok: bool | None) -> str:
-    return {True: "agrees", False: "**differs**", None: "partly"}[ok]
+NOT_TESTED = "n/a"
+
+
+def _verdict(ok) -> str:
+    return {True: "agrees", False: "**differs**", None: "partly", NOT_TESTED: "not tested"}[ok]
 
 
 def _report(res, lam, by_case, points, maps, map_lam, elapsed, quick, systems) -> str:
@@ -161,7 +164,7 @@ def _report(res, lam, by_case, points, maps, map_lam, elapsed, quick, systems) -
         low = [m for m, v in zip(mu, lam, strict=True) if v < edge]
         row(
             f"f1 = {f1}: p-g quasi-periodic for λ ∈ [0, {edge}], {target} for λ ∈ [{edge}, 1]",
-            f"u (forward): {_runs_text(lam, mu)}",
+            f"u (forward): {runs_text(lam, mu)}",
             _grade(
                 all(m == target for m in high) and "quasi-periodic" in low,
                 all(m == target for m in high),
@@ -170,7 +173,7 @@ def _report(res, lam, by_case, points, maps, map_lam, elapsed, quick, systems) -
         )
         row(
             f"f1 = {f1}: q-g chaotic at low λ, {target} at high λ",
-            f"v (forward): {_runs_text(lam, mv)}",
+            f"v (forward): {runs_text(lam, mv)}",
             _grade(mv[0] == "chaotic" and mv[-1] == target, mv[-1] == target),
         )
         hysteresis = [float(v) for v, a, b in zip(lam, mv, bwd.motion("v"), strict=True)
@@ -238,8 +241,8 @@ def _report(res, lam, by_case, points, maps, map_lam, elapsed, quick, systems) -
 
     # Table 2 trends from the (f1, lambda) map.
     f1s = np.array(RESOLUTIONS["quick" if quick else "full"].map_f1)
-    max_u = np.array([[p["extremes"]["u"]["max"] for p in sw.points] for sw in maps])
-    min_v = np.array([[p["extremes"]["v"]["min"] for p in sw.points] for sw in maps])
+    max_u = np.array([[_value(p["extremes"]["u"]["max"]) for p in sw.points] for sw in maps])
+    min_v = np.array([[_value(p["extremes"]["v"]["min"]) for p in sw.points] for sw in maps])
     spread = float(np.max(np.ptp(max_u, axis=1)))
     row(
         "Raising λ changes Max(u) little",
@@ -261,7 +264,8 @@ def _report(res, lam, by_case, points, maps, map_lam, elapsed, quick, systems) -
     row("Raising f1 lowers the critical λ past which q-g is periodic",
         "critical λ for f1 = " + ", ".join(f"{f:g}: {c:g}" for f, c in zip(f1s, crit,
                                                                           strict=True)),
-        None if nowhere or not np.all(np.isfinite(crit)) else bool(np.all(np.diff(crit) < 0)),
+        NOT_TESTED if nowhere or not np.all(np.isfinite(crit))
+        else bool(np.all(np.diff(crit) < 0)),
         "v is periodic at every λ: there is no critical λ to compare" if nowhere else
         "smallest λ from which every larger λ gives a periodic v")  # fmt: skip
     chaotic_min = [float(min((p["extremes"]["v"]["min"] for p in sw.points
@@ -270,7 +274,7 @@ def _report(res, lam, by_case, points, maps, map_lam, elapsed, quick, systems) -
     row("Raising f1 enlarges |Min(v)| in the chaotic range",
         "Min(v) over chaotic points for f1 = " + ", ".join(
             f"{f:g}: {m:.3f}" for f, m in zip(f1s, chaotic_min, strict=True)),
-        None if not np.any(np.isfinite(chaotic_min)) else bool(
+        NOT_TESTED if not np.any(np.isfinite(chaotic_min)) else bool(
             np.all(np.diff(np.abs(np.array(chaotic_min))[np.isfinite(chaotic_min)]) > 0)),
         "no chaotic point found" if not np.any(np.isfinite(chaotic_min)) else "")  # fmt: skip
     row(

@@ -67,12 +67,13 @@ class Trajectory:
     t: np.ndarray
     x: np.ndarray
     x_final: np.ndarray
+    t_final: float
     status: str
     message: str
     nfev: int
     nsteps: int
     wall_time: float
-    boundary_crossings: int = 0
+    boundary_crossings: int | None = None  # located crossings (SciPy back ends only)
     left_valid_range: tuple | None = None  # (tau, state, value) of the first exit
     options: dict = field(default_factory=dict)
 
@@ -152,11 +153,21 @@ def simulate(
             raise ValueError(f"{name} must be a whole number >= 0, got {value!r}")
     if periods < 1 or samples_per_period < 1:
         raise ValueError("periods and samples_per_period must be >= 1")
-    if method in ("rk", "collocation") and steps_per_period % samples_per_period:
+    if not (isinstance(samples_per_period, int) and isinstance(steps_per_period, int)):
+        raise ValueError("samples_per_period and steps_per_period must be whole numbers")
+    unit = {"rk": 1, "collocation": 4}.get(method)
+    if unit and (steps_per_period < unit * samples_per_period
+                 or steps_per_period % (unit * samples_per_period)):  # fmt: skip
         raise ValueError(
-            f"steps_per_period ({steps_per_period}) must be a multiple of samples_per_period "
-            f"({samples_per_period}) for the fixed-step methods"
+            f"steps_per_period ({steps_per_period}) must be a multiple of "
+            f"{'4 x ' if unit == 4 else ''}samples_per_period ({samples_per_period}) for "
+            f"'{method}', so that every sample interval holds whole steps"
         )
+    if not math.isfinite(system.omega) or system.omega <= 0:
+        raise ValueError(f"omega must be a positive number, got {system.omega:g}")
+    if method in SCIPY_METHODS and rtol < 100 * np.finfo(float).eps:
+        raise ValueError(f"rtol {rtol:g} is below what SciPy honours (2.2e-14); use cvodes "
+                         "or a larger rtol")  # fmt: skip
     if not (rtol > 0 and atol > 0):
         raise ValueError(f"tolerances must be > 0, got rtol={rtol}, atol={atol}")
     x0 = default_initial_state(system) if x0 is None else np.asarray(x0, dtype=float)
@@ -188,6 +199,7 @@ def simulate(
         t=t_out,
         x=x_out,
         x_final=x_final,
+        t_final=float(grid[-1]),
         status=status,
         message=message,
         nfev=nfev,
@@ -246,7 +258,7 @@ def _scipy_run(system, x0, t0, grid, method, rtol, atol, max_step, bound):
     boundaries = _boundaries(system) if system.backlash == "dead-zone" else []
     x = np.full((system.n, grid.size), np.nan)
     t, y = t0, np.array(x0, dtype=float)
-    nfev = nsteps = crossings = 0
+    nfev = nsteps = crossings = stalls = 0
     offset: dict[int, float] = {}
     t_end = grid[-1]
     while True:
@@ -270,11 +282,23 @@ def _scipy_run(system, x0, t0, grid, method, rtol, atol, max_step, bound):
         if k == len(boundaries):
             message = f"a state passed |x| = {bound:g} at tau = {t_e:.6g}"
             return x, "divergent", message, nfev, nsteps, crossings
-        # Restart on the contact boundary; the boundary just crossed is moved a hair to the
-        # side the motion goes to, so that it does not fire again at once.
-        i = boundaries[k][0]
-        direction = math.copysign(1.0, y_e[len(system.coordinates) + i])
-        offset = {k: direction * 1e-10}
+        # Restart on the contact boundary.  Every boundary the state sits on (the one just
+        # crossed, and any other within a hair) is shifted a hair behind the motion, so
+        # that it does not fire again at once but does fire on the way back.
+        m = len(system.coordinates)
+        offset = {}
+        for b, (i, edge) in enumerate(boundaries):
+            if abs(y_e[i] - edge) <= 1e-9:
+                offset[b] = math.copysign(1e-10, y_e[m + i]) if y_e[m + i] != 0 else 1e-10
+        if t_e <= t:
+            stalls += 1
+            if stalls > 2 * len(boundaries):
+                raise SimulationError(
+                    f"{method} cannot leave the contact boundary at tau = {t:.6g}: the state "
+                    "stays on |u| = 1; start from another state"
+                )
+        else:
+            stalls = 0
         t, y = t_e, y_e
         crossings += 1
 
@@ -318,7 +342,7 @@ def _casadi_run(system, x0, t0, grid, method, rtol, atol, steps, spp, bound):
         # CasADi spreads number_of_finite_elements over the whole horizon, so it is
         # `steps` per forcing period times the periods covered (collocation: elements of
         # four points each, i.e. steps / 4 elements per period).
-        per_period = steps if method == "rk" else max(spp, steps // 4)
+        per_period = steps if method == "rk" else steps // 4
         opts = {"number_of_finite_elements": per_period * periods}
         if method == "collocation":
             opts["interpolation_order"] = 4
@@ -339,7 +363,7 @@ def _casadi_run(system, x0, t0, grid, method, rtol, atol, steps, spp, bound):
                 bad = np.argmax(~np.all(np.isfinite(ends) & (np.abs(ends) <= bound), axis=0))
                 out = np.full((system.n, grid.size), np.nan)
                 message = f"a state passed |x| = {bound:g} in transient period {bad + 1}"
-                return out, "divergent", message, nfev, nsteps, 0
+                return out, "divergent", message, nfev, nsteps, None
             y = ends[:, -1]
         window = int(round((grid[-1] - grid[0]) / T))
         F = ca.integrator("window", method, dae, grid[0], grid[1:], options(window))
@@ -350,7 +374,7 @@ def _casadi_run(system, x0, t0, grid, method, rtol, atol, steps, spp, bound):
         first = str(err).strip().splitlines()[-1][:200]
         raise SimulationError(f"{method} failed: {first}") from None
     x = np.concatenate([y[:, None], rest], axis=1)
-    return x, "ok", "", nfev, nsteps, 0
+    return x, "ok", "", nfev, nsteps, None
 
 
 def _casadi_work(F, method: str) -> tuple[int, int]:

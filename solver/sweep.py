@@ -24,7 +24,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ._json import dumps
 from .point import analyse_point
+from .simulate import SimulationError
 from .system import System
 
 __all__ = ["SweepResult", "sweep", "sweep_many", "Progress"]
@@ -70,7 +72,7 @@ class SweepResult:
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_suffix(path.suffix + ".tmp")
-        tmp.write_text(json.dumps(self.to_dict()), encoding="utf-8")
+        tmp.write_text(dumps(self.to_dict()), encoding="utf-8")
         os.replace(tmp, path)
         return path
 
@@ -126,19 +128,106 @@ def _summary(result, value: float) -> dict:
     }
 
 
-def _run_chain(task) -> list[dict]:
-    """Worker: one continuation chain (or one independent point) of a sweep."""
-    module, base_values, parameter, values, x0, settings, continuation = task
-    system = System.load(module, **base_values)
+def _failed(system: System, value: float, error: Exception) -> dict:
+    """A point whose integration failed: recorded with its error, never dropped."""
+    return {
+        "value": float(value),
+        "status": "failed",
+        "error": str(error),
+        "classification": {
+            c: {"motion": "failed", "period": None, "evidence": {"error": str(error)}}
+            for c in system.coordinates
+        },  # fmt: skip
+        "extremes": {s: {"max": None, "min": None} for s in system.states},
+        "meshing_states": {},
+        "lyapunov": None,
+        "spectra": {},
+        "poincare": {s: [] for s in system.states},
+        "x_final": None,
+        "integration": {},
+    }
+
+
+@dataclass(frozen=True)
+class _Chain:
+    """One worker task: a continuation chain, or a single independent point."""
+
+    module: str
+    base_values: dict
+    parameter: str
+    values: list
+    x0: list | None
+    settings: dict
+    continuation: bool
+
+
+def _run_chain(chain: _Chain, on_point=None) -> list[dict]:
+    system = System.load(chain.module, **chain.base_values)
+    state = None if chain.x0 is None else np.asarray(chain.x0, dtype=float)
     out = []
-    state = None if x0 is None else np.asarray(x0, dtype=float)
-    for value in values:
-        sys_k = system.with_values(**{parameter: value})
-        result = analyse_point(sys_k, state, **settings)
-        out.append(_summary(result, value))
-        if continuation and result.trajectory.status == "ok":
-            state = result.trajectory.x_final
+    for value in chain.values:
+        try:
+            point_system = system.with_values(**{chain.parameter: value})
+            point = _summary(analyse_point(point_system, state, **chain.settings), value)
+        except (SimulationError, ValueError, FloatingPointError) as err:
+            point = _failed(system, value, err)
+        out.append(point)
+        if chain.continuation and point["status"] == "ok":
+            state = np.asarray(point["x_final"])
+        if on_point is not None:
+            on_point(point)
     return out
+
+
+def _plan(system: System, parameter: str, values, *, continuation: bool, backward: bool,
+          x0, settings: dict) -> list[_Chain]:  # fmt: skip
+    values = np.asarray(values, dtype=float)
+    if values.ndim != 1 or values.size == 0 or not np.all(np.isfinite(values)):
+        raise ValueError("sweep values must be a non-empty list of finite numbers")
+    try:
+        system.with_values(**{parameter: float(values[0])})  # an unknown name fails here
+    except KeyError as err:
+        raise ValueError(err.args[0]) from None
+    order = [float(v) for v in (values[::-1] if backward else values)]
+    x0 = None if x0 is None else [float(v) for v in x0]
+    base = (module_ref(system), dict(system.values), parameter)
+    if continuation:
+        return [_Chain(*base, order, x0, settings, True)]
+    return [_Chain(*base, [v], x0, settings, False) for v in order]
+
+
+def _execute(chains: list[_Chain], executor: str, workers: int | None,
+             progress: Progress | None) -> list[list[dict]]:  # fmt: skip
+    if executor not in EXECUTORS:
+        raise ValueError(f"unknown executor '{executor}'; executors: {', '.join(EXECUTORS)}")
+
+    def tick(point):
+        if progress:
+            progress.step(f"{chains[0].parameter}={point['value']:.4g}")
+
+    if executor == "serial" or len(chains) == 1:
+        return [_run_chain(c, on_point=tick) for c in chains]
+    results = []
+    with ProcessPoolExecutor(max_workers=workers or os.cpu_count()) as pool:
+        for chunk in pool.map(_run_chain, chains):
+            results.append(chunk)
+            for point in chunk:
+                tick(point)
+    return results
+
+
+def _result(system, parameter, values, direction, settings, points) -> SweepResult:
+    return SweepResult(
+        model=system.name,
+        model_hash=system.model_hash,
+        parameter=parameter,
+        values=np.asarray(values, dtype=float),
+        direction=direction,
+        base_values={k: float(v) for k, v in system.values.items()},
+        settings=dict(settings),
+        points=points,
+        scales=_scales(system),
+    )
 
 
 def sweep(
@@ -155,92 +244,35 @@ def sweep(
     **settings,
 ) -> SweepResult:
     """Sweep ``parameter`` over ``values`` (see module docstring); ``settings`` go to
-    :func:`analyse_point` (method, rtol, transient, periods, ...)."""
-    if executor not in EXECUTORS:
-        raise ValueError(f"unknown executor '{executor}'; executors: {', '.join(EXECUTORS)}")
-    values = np.asarray(values, dtype=float)
-    system.with_values(**{parameter: float(values[0])})  # fails early on an unknown name
-    order = values[::-1] if backward else values
-    task_base = (module_ref(system), dict(system.values), parameter)
-    if continuation:
-        tasks = [(*task_base, list(order), x0, settings, True)]
-    else:
-        tasks = [(*task_base, [v], x0, settings, False) for v in order]
-    points: list[dict] = []
-    if executor == "serial" or len(tasks) == 1:
-        for task in tasks:
-            if continuation:
-                # Step through the chain one point at a time to report progress.
-                state = task[4]
-                for v in task[3]:
-                    (pt,) = _run_chain((*task_base, [v], state, settings, True))
-                    points.append(pt)
-                    state = pt["x_final"] if pt["status"] == "ok" else state
-                    if progress:
-                        progress.step(f"{parameter}={v:.4g}")
-            else:
-                points.extend(_run_chain(task))
-                if progress:
-                    progress.step(f"{parameter}={task[3][0]:.4g}")
-    else:
-        with ProcessPoolExecutor(max_workers=workers or os.cpu_count()) as pool:
-            for chunk in pool.map(_run_chain, tasks):
-                points.extend(chunk)
-                if progress:
-                    progress.step(f"{parameter}={chunk[0]['value']:.4g}")
+    :func:`analyse_point` (method, rtol, transient, periods, ...).  A point whose
+    integration fails is recorded as ``failed`` with its error."""
+    chains = _plan(system, parameter, values, continuation=continuation, backward=backward,
+                   x0=x0, settings=settings)  # fmt: skip
+    points = [p for chunk in _execute(chains, executor, workers, progress) for p in chunk]
     if backward:
         points = points[::-1]
-    return SweepResult(
-        model=system.name,
-        model_hash=system.model_hash,
-        parameter=parameter,
-        values=values,
-        direction=("backward" if backward else "forward") if continuation else "independent",
-        base_values={k: float(v) for k, v in system.values.items()},
-        settings={k: v for k, v in settings.items()},
-        points=points,
-        scales=_scales(system),
-    )
+    direction = ("backward" if backward else "forward") if continuation else "independent"
+    settings = dict(settings, x0=None if x0 is None else [float(v) for v in x0])
+    return _result(system, parameter, values, direction, settings, points)
 
 
-def sweep_many(
-    jobs: list[dict],
-    *,
-    executor: str = "processes",
-    workers: int | None = None,
-    progress: Progress | None = None,
-) -> list[SweepResult]:
-    """Run several sweeps (each a dict of :func:`sweep` arguments, ``system`` included);
-    continuation chains run side by side in worker processes."""
-    if executor == "serial":
-        return [sweep(progress=progress, **job) for job in jobs]
-    tasks = []
+def sweep_many(jobs: list[dict], *, executor: str = "processes", workers: int | None = None,
+               progress: Progress | None = None) -> list[SweepResult]:  # fmt: skip
+    """Several continuation sweeps (each a dict of :func:`sweep` arguments, ``system``
+    included) run side by side, one chain per worker process."""
+    plans = []
     for job in jobs:
-        system = job["system"]
-        values = np.asarray(job["values"], dtype=float)
-        backward = job.get("backward", False)
-        order = values[::-1] if backward else values
         settings = _job_settings(job)
-        tasks.append((module_ref(system), dict(system.values),
-                      job["parameter"], list(order), job.get("x0"), settings, True))  # fmt: skip
+        (chain,) = _plan(job["system"], job["parameter"], job["values"], continuation=True,
+                         backward=job.get("backward", False), x0=job.get("x0"),
+                         settings=settings)  # fmt: skip
+        plans.append(chain)
     results = []
-    with ProcessPoolExecutor(max_workers=workers or os.cpu_count()) as pool:
-        for job, chunk in zip(jobs, pool.map(_run_chain, tasks), strict=True):
-            backward = job.get("backward", False)
-            if backward:
-                chunk = chunk[::-1]
-            system = job["system"]
-            settings = _job_settings(job)
-            results.append(SweepResult(
-                system.name, system.model_hash, job["parameter"],
-                np.asarray(job["values"], dtype=float),
-                "backward" if backward else "forward",
-                {k: float(v) for k, v in system.values.items()}, settings, chunk,
-                _scales(system),
-            ))  # fmt: skip
-            if progress:
-                for _ in chunk:
-                    progress.step()
+    for job, points in zip(jobs, _execute(plans, executor, workers, progress), strict=True):
+        backward = job.get("backward", False)
+        results.append(_result(job["system"], job["parameter"], job["values"],
+                               "backward" if backward else "forward", _job_settings(job),
+                               points[::-1] if backward else points))  # fmt: skip
     return results
 
 

@@ -38,6 +38,13 @@ class System:
     p: np.ndarray
     values: dict = field(default_factory=dict)
 
+    def __post_init__(self):
+        bad = [n for n, v in zip(self.module.PARAMETERS, self.p, strict=True) if not np.isfinite(v)]
+        if bad:
+            raise ValueError(f"parameter(s) {', '.join(bad)} are not finite numbers")
+        if not self.p[list(self.module.PARAMETERS).index("omega")] > 0:
+            raise ValueError("omega (the excitation frequency) must be > 0")
+
     @classmethod
     def load(cls, name_or_module, **values) -> System:
         module = (

@@ -46,3 +46,22 @@ def test_ueda_duffing_is_chaotic_with_a_positive_exponent(duffing):
     )
     assert result.lyapunov.exponent > 0.05
     assert result.classification["x"].motion == "chaotic", result.classification["x"].evidence
+
+
+def test_a_period_above_32_is_not_called_quasi_periodic():
+    rng = np.random.default_rng(0)
+    points = np.tile(rng.standard_normal((2, 40)), 3)[:, :100]  # period 40
+    verdict = classify_points(points, tol=1e-6)
+    assert verdict.motion == "undetermined" and "finite set of 40 points" in verdict.evidence["why"]
+
+
+def test_henon_points_are_not_a_torus():
+    # Henon's map x' = 1 - 1.4 x^2 + y, y' = 0.3 x: a strange attractor of correlation
+    # dimension about 1.21 (Grassberger and Procaccia 1983).
+    x, y, points = 0.1, 0.1, []
+    for k in range(500):
+        x, y = 1 - 1.4 * x * x + y, 0.3 * x
+        if k >= 100:
+            points.append((x, y))
+    verdict = classify_points(np.array(points).T, tol=1e-6)
+    assert verdict.motion == "chaotic", verdict.evidence

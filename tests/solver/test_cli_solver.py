@@ -91,3 +91,58 @@ def test_reproduce_quick_writes_the_report(tmp_path, capsys):
         "point_heavy_lambda_0.8.png",
     ):
         assert (tmp_path / name).stat().st_size > 1000
+
+
+@pytest.mark.parametrize(
+    "argv,fragment",
+    [
+        (
+            ["simulate", "reference-light", "--set", "omega=0"],
+            "omega (the excitation frequency) must be > 0",
+        ),
+        (["sweep", "reference-light", "--param", "lambda", "--range", "nan:1:3"], "must be finite"),
+        (
+            ["sweep", "reference-light", "--param", "lambda", "--range", "0:1:2:7"],
+            "expected START:STOP:NUM",
+        ),
+        (["sweep", "reference-light", "--param", "lambda", "--range", "0:1:1"], "NUM must be >= 2"),
+        (
+            ["sweep", "reference-light", "--param", "lamda", "--range", "0:1:3"],
+            "unknown parameter(s) ['lamda']",
+        ),
+    ],
+)
+def test_solver_commands_fail_in_one_line(argv, fragment, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and fragment in err, err
+
+
+def test_a_failing_point_is_recorded_and_the_sweep_goes_on(tmp_path, capsys):
+    out = tmp_path / "sw"
+    code = main(
+        [
+            "sweep",
+            "reference-light",
+            "--param",
+            "damping_ratio",
+            "--range=-0.5:0.03:2",
+            "--executor",
+            "serial",
+            "--transient",
+            "20",
+            "--periods",
+            "8",
+            "--lyapunov-periods",
+            "0",
+            "--out",
+            str(out),
+            "--quiet",
+        ]
+    )
+    assert code == 0
+    text = (out / "sweep.json").read_text()
+    data = json.loads(text, parse_constant=lambda c: pytest.fail(f"{c} in JSON"))
+    statuses = [p["status"] for p in data["points"]]
+    assert statuses[-1] == "ok" and statuses[0] in ("failed", "divergent")
+    assert "did not finish normally" in capsys.readouterr().out

@@ -149,3 +149,42 @@ def test_divergence_is_reported_not_hidden(duffing):
 def test_unknown_method_lists_the_valid_ones(duffing):
     with pytest.raises(ValueError, match="methods: RK45, DOP853"):
         simulate(duffing, method="rk45")
+
+
+def test_a_start_on_two_contact_boundaries_finishes(tmp_path):
+    from gearsym.derive.build import build_files, project_root, write_files
+
+    text = (project_root() / "scenes" / "reference-light.toml").read_text()
+    text = text.replace('backlash = "polynomial"', 'backlash = "dead-zone"')
+    text = "\n".join(line for line in text.splitlines() if not line.startswith("backlash_"))
+    text = text.replace(
+        'topology = "topologies/diso.toml"',
+        f'topology = "{(project_root() / "scenes/topologies/diso.toml").as_posix()}"',
+    )
+    text = text.replace('name = "reference-light"', 'name = "dead-zone-two"')
+    scene = tmp_path / "dz.toml"
+    scene.write_text(text)
+    write_files(build_files([scene]).files, tmp_path)
+    system = System.load(tmp_path / "generated" / "dead_zone_two.py")
+    tr = simulate(system, [1.0, -1.0, 0.0, 0.0], method="RK45", transient=2, periods=2)
+    assert tr.status == "ok" and np.all(np.isfinite(tr.x))
+
+
+def test_spectrum_reads_the_closed_form_amplitude(linear_system):
+    from gearsym.solver.analysis import spectrum
+
+    tr = simulate(
+        linear_system,
+        method="cvodes",
+        rtol=1e-11,
+        atol=1e-13,
+        transient=200,
+        periods=8,
+        samples_per_period=32,
+    )
+    exact = closed_form_steady_state(linear_system, tr.t)
+    # Amplitude of u at omega, from the closed form's samples over whole periods.
+    a_exact = (exact[0].max() - exact[0].min()) / 2
+    sp = spectrum(tr, "u")
+    k = int(np.argmin(np.abs(sp.frequency - linear_system.omega)))
+    assert sp.amplitude[k] == pytest.approx(a_exact, rel=1e-4)
