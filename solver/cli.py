@@ -13,6 +13,8 @@ import math
 import sys
 from pathlib import Path
 
+import numpy as np
+
 __all__ = ["main"]
 
 
@@ -290,6 +292,110 @@ def _cmd_reproduce(args) -> int:
     return 0
 
 
+def _orbit_guess(system, n: int, settle: int):
+    """A starting state on the attractor at tau = 0 (mod nT), from a simulation."""
+    from gearsym.solver.simulate import simulate
+
+    run = simulate(system, method="cvodes", transient=settle * n, periods=n,
+                   samples_per_period=1)  # fmt: skip
+    if run.status != "ok":
+        raise _Fail(f"the simulation that gives the initial guess ended {run.status}: "
+                    f"{run.message}")  # fmt: skip
+    return run.poincare[:, 0]
+
+
+def _cmd_shoot(args) -> int:
+    from gearsym.solver._json import dumps
+    from gearsym.solver.shooting import ShootingError, shoot
+
+    if args.period < 1 or args.segments < 1:
+        raise _Fail("--period and --segments must be whole numbers >= 1")
+    system = _system(args.scene, _parse_set(args.set))
+    guess = _orbit_guess(system, args.period, args.settle)
+    try:
+        orbit = shoot(system, guess, args.period, segments=args.segments,
+                      monodromy=args.monodromy)  # fmt: skip
+    except ShootingError as err:
+        raise _Fail(f"shoot: {err}; residuals {[f'{r:.2g}' for r in err.history]}") from None
+    data = orbit.describe()
+    if args.compare_monodromy:
+        from gearsym.solver.flow import FlowMap
+
+        flow = FlowMap(system)
+        mats = {m: flow.with_jacobian(orbit.x0, orbit.period, method=m)[1]
+                for m in ("ad", "variational", "fd")}  # fmt: skip
+        scale = np.max(np.abs(mats["ad"]))
+        data["monodromy_agreement"] = {
+            f"{a}_vs_{b}": float(np.max(np.abs(mats[a] - mats[b])) / scale)
+            for a, b in (("ad", "variational"), ("ad", "fd"), ("variational", "fd"))
+        }
+    if args.json:
+        print(dumps(data, indent=1))
+        return 0
+    fl = orbit.floquet
+    print(f"{system.name}: period-{orbit.n} orbit, residual {orbit.residual:.2e} after "
+          f"{orbit.iterations} Newton iteration(s) ({args.monodromy} monodromy, "
+          f"{args.segments} segment(s))")  # fmt: skip
+    print("  x0: " + ", ".join(f"{k} = {v:.10g}" for k, v in data["x0"].items()))
+    print("  multipliers: " + ", ".join(f"{m.real:+.6f}{m.imag:+.6f}i (|{abs(m):.6f}|)"
+                                        for m in fl.multipliers))  # fmt: skip
+    losing = {"fold": "+1 (fold)", "period-doubling": "-1 (period doubling)",
+              "neimark-sacker": "a complex pair (Neimark-Sacker)"}[fl.kind]  # fmt: skip
+    print(f"  {'stable' if fl.stable else 'unstable'}; the largest multiplier is on the side of "
+          f"{losing}; Liouville relative error {fl.liouville_error:.2e}")  # fmt: skip
+    for k, v in data.get("monodromy_agreement", {}).items():
+        print(f"  monodromy {k}: {v:.2e} (max difference / max entry)")
+    return 0
+
+
+def _cmd_continue(args) -> int:
+    from gearsym.solver import plots
+    from gearsym.solver._json import dumps
+    from gearsym.solver.continuation import continue_orbit, switch_period_doubling
+    from gearsym.solver.shooting import ShootingError
+
+    for name in ("from_", "to"):
+        if not math.isfinite(getattr(args, name)):
+            raise _Fail(f"--{name.rstrip('_')} must be a finite number")
+    system = _system(args.scene, _parse_set(args.set))
+    try:
+        start = system.with_values(**{args.param: args.from_})
+    except KeyError as err:
+        raise _Fail(f"--param: {err.args[0]}") from None
+    except ValueError as err:
+        raise _Fail(f"--from: {err}") from None
+    guess = _orbit_guess(start, args.period, args.settle)
+    try:
+        branches = [continue_orbit(system, args.param, args.from_, args.to, guess,
+                                   n=args.period, ds=args.step, ds_max=4 * args.step)]  # fmt: skip
+    except ShootingError as err:
+        raise _Fail(f"continue: the first orbit was not found: {err}") from None
+    if args.switch:
+        for bif in list(branches[0].bifurcations):
+            if bif.kind == "period-doubling":
+                try:
+                    branches.append(switch_period_doubling(system, args.param, bif, args.period,
+                                                           args.to, ds=args.step,
+                                                           ds_max=4 * args.step))  # fmt: skip
+                except ShootingError as err:
+                    print(f"  branch switching at {bif.value:.6g} failed: {err}")
+    out = Path(args.out or f"continue_{system.name}_{args.param}")
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "branches.json").write_text(dumps([b.describe() for b in branches], indent=1),
+                                       encoding="utf-8")  # fmt: skip
+    state = system.coordinates[0]
+    plots.branch_figure(branches, out / "branches.png", 0, state,
+                        title=f"{system.name}: continuation in {args.param}")  # fmt: skip
+    for br in branches:
+        stable = sum(br.stable)
+        print(f"period-{br.n} branch: {len(br.values)} points, {stable} stable; {br.message}")
+        for b in br.bifurcations:
+            print(f"  {b.kind:<16} {args.param} = {b.value:.8g}  multiplier "
+                  f"{b.multiplier.real:+.6f}{b.multiplier.imag:+.6f}i")  # fmt: skip
+    print(f"wrote {out / 'branches.json'} and {out / 'branches.png'}")
+    return 0
+
+
 def _analysis_options(sub) -> None:
     from gearsym.solver.simulate import METHODS
 
@@ -395,6 +501,44 @@ def _parser() -> argparse.ArgumentParser:
     sw.add_argument("--quiet", action="store_true", help="no progress bar")
     _analysis_options(sw)
     sw.set_defaults(func=_cmd_sweep, method_default="cvodes")
+
+    sh = sub.add_parser("shoot", help="find a periodic orbit by shooting; Floquet multipliers",
+                        description="Find the period-n orbit (period n T) by Newton shooting "
+                        "from a simulated guess, with its Floquet multipliers, stability and "
+                        "Liouville check.")  # fmt: skip
+    sh.add_argument("scene", metavar="SCENE")
+    sh.add_argument("--set", action="append", metavar="KEY=VALUE")
+    sh.add_argument("--period", type=int, default=1, help="n: the orbit's period is n T")
+    sh.add_argument("--segments", type=int, default=1, help="multiple shooting segments")
+    sh.add_argument("--monodromy", choices=("ad", "variational", "fd"), default="ad")
+    sh.add_argument(
+        "--compare-monodromy",
+        action="store_true",
+        help="also compute the monodromy the other two ways and compare",
+    )
+    sh.add_argument("--settle", type=int, default=300, help="periods simulated for the guess")
+    sh.add_argument("--json", action="store_true")
+    sh.set_defaults(func=_cmd_shoot)
+
+    co = sub.add_parser("continue", help="continue a periodic orbit in a parameter",
+                        description="Pseudo-arclength continuation of the period-n orbit, "
+                        "with fold, period-doubling and Neimark-Sacker points located."
+                        )  # fmt: skip
+    co.add_argument("scene", metavar="SCENE")
+    co.add_argument("--param", required=True)
+    co.add_argument("--from", dest="from_", type=float, required=True)
+    co.add_argument("--to", type=float, required=True)
+    co.add_argument("--period", type=int, default=1)
+    co.add_argument("--step", type=float, default=0.02, help="initial arclength step")
+    co.add_argument(
+        "--switch",
+        action="store_true",
+        help="switch onto the period-2n branch at each period doubling",
+    )
+    co.add_argument("--settle", type=int, default=300)
+    co.add_argument("--set", action="append", metavar="KEY=VALUE")
+    co.add_argument("--out", metavar="DIR")
+    co.set_defaults(func=_cmd_continue)
 
     rp = sub.add_parser("reproduce", help="the reference study's analyses and report",
                         description="Run the reference study's light- and heavy-load "

@@ -137,3 +137,58 @@ def map_figure(f_values, lam_values, max_u, min_v, motion_v, path: Path, title: 
         fig.suptitle(title)
     fig.tight_layout()
     return _save(fig, path)
+
+
+def branch_figure(branches, path: Path, state_index: int = 0, state: str = "u",
+                  sweeps=None, title: str = "") -> Path:  # fmt: skip
+    """Continuation branches over the brute-force diagram: stable solid, unstable dashed,
+    bifurcations marked; Poincare points of brute-force sweeps in the background."""
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for sw in sweeps or []:
+        xs, ys = [], []
+        for value, pts in zip(sw.values, sw.poincare(state), strict=True):
+            xs.append(np.full(np.size(pts), value))
+            ys.append(np.asarray(pts))
+        if xs:
+            ax.plot(np.concatenate(xs), np.concatenate(ys), ".", markersize=2, color="0.6",
+                    label=f"brute force ({sw.direction})" if sw is sweeps[0] else None)  # fmt: skip
+    markers = {"fold": ("s", "tab:red"), "period-doubling": ("D", "tab:purple"),
+               "neimark-sacker": ("o", "tab:green")}  # fmt: skip
+    for k, br in enumerate(branches):
+        lam = np.asarray(br.values)
+        y = np.array([s[state_index] for s in br.states])
+        stable = np.asarray(br.stable)
+        colour = f"C{k}"
+        for flag, style in ((True, "-"), (False, "--")):
+            yy = np.where(stable == flag, y, np.nan)
+            ax.plot(lam, yy, style, color=colour, lw=1.4,
+                    label=f"period-{br.n} {'stable' if flag else 'unstable'}")  # fmt: skip
+        for b in br.bifurcations:
+            m, c = markers[b.kind]
+            ax.plot(b.value, b.x0[state_index], m, color=c, ms=7, label=b.kind)
+    handles, labels = ax.get_legend_handles_labels()
+    seen = dict(zip(labels, handles, strict=True))
+    ax.legend(seen.values(), seen.keys(), fontsize=8, loc="best")
+    ax.set_xlabel(branches[0].parameter if branches else "")
+    ax.set_ylabel(f"{state} at τ = 0 mod nT (1/half backlash)")
+    ax.grid(alpha=0.3)
+    if title:
+        ax.set_title(title)
+    return _save(fig, path)
+
+
+def multipliers_figure(multipliers, path: Path, title: str = "") -> Path:
+    """Floquet multipliers in the complex plane with the unit circle."""
+    fig, ax = plt.subplots(figsize=(4.5, 4.5))
+    th = np.linspace(0, 2 * np.pi, 400)
+    ax.plot(np.cos(th), np.sin(th), color="0.5", lw=0.8)
+    mu = np.asarray(multipliers)
+    ax.plot(mu.real, mu.imag, "x", ms=8, color="tab:red")
+    ax.set_aspect("equal")
+    ax.axhline(0, color="0.8", lw=0.5)
+    ax.axvline(0, color="0.8", lw=0.5)
+    ax.set_xlabel("Re μ")
+    ax.set_ylabel("Im μ")
+    if title:
+        ax.set_title(title, fontsize=9)
+    return _save(fig, path)

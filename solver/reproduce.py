@@ -101,8 +101,21 @@ def reproduce(out: Path, *, quick: bool = False, executor: str = "processes",
     plots.map_figure(np.array(res.map_f1), map_lam, max_u, min_v, motion_v,
                                       out / "map_f1_lambda.png",
                                       title="light-load scene with f1 varied")  # fmt: skip
+    branches = _continue_cases(systems, by_case, quick, executor, workers)
+    for case, _, f1 in CASES:
+        plots.branch_figure(
+            branches[case],
+            out / f"continuation_{case}.png",
+            0,
+            "u",
+            sweeps=by_case[case],
+            title=f"{case} load, f1 = {f1}: period-1 branch over the sweeps",
+        )
+        (out / "data" / f"continuation_{case}.json").write_text(
+            dumps([b.describe() for b in branches[case]]), encoding="utf-8")  # fmt: skip
     elapsed = time.perf_counter() - started
-    report = _report(res, lam, by_case, points, maps, map_lam, elapsed, quick, systems)
+    report = _report(res, lam, by_case, points, maps, map_lam, elapsed, quick, systems,
+                     branches)  # fmt: skip
     path = out / "report.md"
     path.write_text(report, encoding="utf-8")
     return path
@@ -148,7 +161,86 @@ def _verdict(ok) -> str:
     return {True: "agrees", False: "**differs**", None: "partly", NOT_TESTED: "not tested"}[ok]
 
 
-def _report(res, lam, by_case, points, maps, map_lam, elapsed, quick, systems) -> str:
+def _continue_case(args):
+    """Worker: continue every periodic branch the forward sweep visits, over [0, 1]."""
+    module, sweep_points, n_values, step = args
+    from .continuation import continue_orbit
+    from .shooting import ShootingError
+
+    system = System.load(module)
+    branches, seen = [], set()
+    for value, point in zip(n_values, sweep_points, strict=True):
+        motion = point["classification"]["u"]["motion"]
+        if not motion.startswith("period-") or motion in seen:
+            continue
+        seen.add(motion)
+        n = int(motion.split("-")[1])
+        x0 = np.array([point["poincare"][s][0] for s in system.states])
+        for target in (1.0, 0.0):  # both ways from where the sweep found it
+            try:
+                br = continue_orbit(system, "lambda", float(value), target, x0, n=n, ds=step,
+                                    ds_max=4 * step)  # fmt: skip
+            except ShootingError:
+                continue
+            if len(br.values) > 1:
+                branches.append(br)
+    return branches
+
+
+def _continue_cases(systems, by_case, quick, executor, workers):
+    from concurrent.futures import ProcessPoolExecutor
+
+    step = 0.05 if quick else 0.02
+    tasks = [(module, by_case[case][0].points, list(by_case[case][0].values), step)
+             for case, module, _ in CASES]  # fmt: skip
+    if executor == "serial":
+        results = [_continue_case(t) for t in tasks]
+    else:
+        with ProcessPoolExecutor(max_workers=workers or len(tasks)) as pool:
+            results = list(pool.map(_continue_case, tasks))
+    return {case: r for (case, _, _), r in zip(CASES, results, strict=True)}
+
+
+def stable_coverage(branches, sweeps, tol: float = 5e-3) -> tuple[int, int, list]:
+    """How many periodic brute-force points lie on a stable continued branch.
+
+    A brute-force point (the Poincare state at tau = 0 mod T of a period-n point, with its
+    parameter value) counts as covered when its distance in (lambda, state) to a segment
+    between two stable neighbouring points of a period-n branch is below ``tol`` (a
+    chord: near a fold the branch curves within a step).
+    """
+    covered = total = 0
+    missed = []
+    for sw in sweeps:
+        for value, point in zip(sw.values, sw.points, strict=True):
+            motion = point["classification"]["u"]["motion"]
+            if not motion.startswith("period-") or not point["poincare"]["u"]:
+                continue
+            total += 1
+            q = np.concatenate([[value], [point["poincare"][s][0] for s in point["poincare"]]])
+            best = np.inf
+            for br in branches:
+                if f"period-{br.n}" != motion:
+                    continue
+                P = np.column_stack([br.values, np.asarray(br.states)])
+                for i in range(len(P) - 1):
+                    if br.stable[i] and br.stable[i + 1]:
+                        best = min(best, _segment_distance(q, P[i], P[i + 1]))
+            if best < tol:
+                covered += 1
+            else:
+                missed.append(float(value))
+    return covered, total, missed
+
+
+def _segment_distance(q, a, b) -> float:
+    d = b - a
+    w = 0.0 if not np.any(d) else float(np.clip(np.dot(q - a, d) / np.dot(d, d), 0.0, 1.0))
+    return float(np.linalg.norm(q - (a + w * d)))
+
+
+def _report(res, lam, by_case, points, maps, map_lam, elapsed, quick, systems,
+            branches) -> str:  # fmt: skip
     rows = []
 
     def row(finding, found, ok, evidence=""):
@@ -285,6 +377,17 @@ def _report(res, lam, by_case, points, maps, map_lam, elapsed, quick, systems) -
         "all points, not only chaotic",
     )
 
+    cont_lines = []
+    for case, _, f1 in CASES:
+        found = sorted({(b.kind, round(b.value, 6)) for br in branches[case]
+                        for b in br.bifurcations}, key=lambda kv: kv[1])  # fmt: skip
+        covered, total, missed = stable_coverage(branches[case], by_case[case])
+        cont_lines.append(
+            f"- f1 = {f1}: " + (", ".join(f"{k} at λ = {v:.6f}" for k, v in found) or
+                               "no bifurcation on [0, 1]")
+            + f"; {covered} of {total} periodic brute-force points lie on a stable continued "
+            "branch" + (f" (not: λ = {', '.join(f'{m:g}' for m in missed[:6])})" if missed
+                        else ""))  # fmt: skip
     light = systems["light"]
     lines = [
         "# Reference study: reproduction report",
@@ -312,6 +415,14 @@ def _report(res, lam, by_case, points, maps, map_lam, elapsed, quick, systems) -
         "model can settle on other attractors than the study's; the forward/backward rows show",
         "where more than one attractor coexists.",
         "",
+        "## Continuation of the periodic orbits",
+        "",
+        "Pseudo-arclength continuation of each periodic branch the forward sweep visits, both "
+        "ways in λ, with fold, period-doubling and Neimark-Sacker points located by bisection "
+        "on test functions (see `docs/analysis.md`):",
+        "",
+        *cont_lines,
+        "",
         "## Figures",
         "",
         "- `bifurcation_light.png`, `bifurcation_heavy.png`: Poincaré points of u and v against "
@@ -319,6 +430,8 @@ def _report(res, lam, by_case, points, maps, map_lam, elapsed, quick, systems) -
         "- `point_<case>_lambda_<λ>.png`: time series, phase portrait with Poincaré points, and "
         "spectrum of u and v.",
         "- `map_f1_lambda.png`: Max(u), Min(v) and the motion of v over (f1, λ).",
+        "- `continuation_<case>.png`: continued branches (stable solid, unstable dashed, "
+        "bifurcations marked) over the brute-force Poincaré points.",
         "",
         "Data (parameter values, scales and model hash with every point) are in `data/`.",
         "",

@@ -1,10 +1,13 @@
-"""Ueda's forced Duffing oscillator in the generated-model interface (test fixture).
+"""The forced Duffing oscillator in the generated-model interface (test fixture).
 
-    x'' + k x' + x^3 = B cos(omega tau),  k = 0.05, B = 7.5, omega = 1
+    x'' + k x' + a x + c x^3 = B cos(omega tau)
 
-is chaotic (Ueda 1979, "Randomly transitional phenomena in the system governed by
-Duffing's equation", J. Stat. Phys. 20).  Written by hand: the solver must work on any
-module with this interface, not only on what the derivation emits.
+With the defaults (a = 0, c = 1, k = 0.05, B = 7.5, omega = 1) it is Ueda's oscillator,
+chaotic (Ueda 1979, "Randomly transitional phenomena in the system governed by Duffing's
+equation", J. Stat. Phys. 20); with a = -1 it is the twin-well oscillator of Guckenheimer
+and Holmes (1983, "Nonlinear Oscillations, Dynamical Systems, and Bifurcations of Vector
+Fields", section 2.2).  Written by hand: the solver must work on any module with this
+interface, not only on what the derivation emits.
 """
 
 import numpy as np
@@ -14,8 +17,8 @@ SCENE = "ueda"
 INPUTS_SHA256 = "0" * 64
 STATES = ("x", "dx")
 COORDINATES = ("x",)
-PARAMETERS = ("omega", "k", "B")
-DEFAULTS = (1.0, 0.05, 7.5)
+PARAMETERS = ("omega", "k", "B", "a", "c")
+DEFAULTS = (1.0, 0.05, 7.5, 0.0, 1.0)
 VALID_RANGE = None
 OMEGA_N = 1.0
 HALF_BACKLASH = {"x": 1.0}
@@ -40,18 +43,20 @@ def parameters(**values):
 
 
 def rhs(tau, x, p):
-    return np.array(np.broadcast_arrays(x[1], -p[1] * x[1] - x[0] ** 3 + p[2] * np.cos(p[0] * tau)))
+    acc = -p[1] * x[1] - p[3] * x[0] - p[4] * x[0] ** 3 + p[2] * np.cos(p[0] * tau)
+    return np.array(np.broadcast_arrays(x[1], acc))
 
 
 def jacobian(tau, x, p):
     z = np.zeros_like(x[0])
-    return np.array([[z, z + 1.0], [-3.0 * x[0] ** 2, z - p[1]]])
+    return np.array([[z, z + 1.0], [-p[3] - 3.0 * p[4] * x[0] ** 2, z - p[1]]])
 
 
 def casadi_functions():
     import casadi as ca
 
-    tau, x, p = ca.SX.sym("tau"), ca.SX.sym("x", 2), ca.SX.sym("p", 3)
-    xdot = ca.vertcat(x[1], -p[1] * x[1] - x[0] ** 3 + p[2] * ca.cos(p[0] * tau))
+    tau, x, p = ca.SX.sym("tau"), ca.SX.sym("x", 2), ca.SX.sym("p", 5)
+    acc = -p[1] * x[1] - p[3] * x[0] - p[4] * x[0] ** 3 + p[2] * ca.cos(p[0] * tau)
+    xdot = ca.vertcat(x[1], acc)
     f = ca.Function("rhs", [tau, x, p], [xdot])
     return f, ca.Function("jacobian", [tau, x, p], [ca.jacobian(xdot, x)])

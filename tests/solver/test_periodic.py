@@ -1,0 +1,157 @@
+"""Shooting, Floquet multipliers and continuation against closed forms and brute force."""
+
+import numpy as np
+import pytest
+from gearsym.solver.continuation import continue_orbit, switch_period_doubling
+from gearsym.solver.flow import FlowMap
+from gearsym.solver.shooting import shoot
+from gearsym.solver.simulate import simulate
+from gearsym.solver.system import System
+from scipy.linalg import expm
+
+from .conftest import HERE
+from .test_simulate import closed_form_steady_state
+
+DUFFING = HERE / "duffing_model.py"
+
+
+def test_linear_orbit_and_multipliers_match_the_closed_forms(linear_system):
+    # A linear system with constant coefficients x' = A x + b(tau): the periodic orbit is
+    # the closed-form steady state and the monodromy is expm(A T), so the multipliers are
+    # exp(eig(A) T).
+    T = linear_system.period
+    exact = closed_form_steady_state(linear_system, np.array([0.0]))[:, 0]
+    orbit = shoot(linear_system, exact + 0.05, 1)
+    assert orbit.residual < 1e-10
+    assert np.max(np.abs(orbit.x0 - exact)) < 1e-8
+    A = linear_system.jacobian(0.0, np.zeros(linear_system.n))
+    expected = np.sort_complex(np.linalg.eigvals(expm(A * T)))
+    got = np.sort_complex(orbit.floquet.multipliers)
+    assert np.max(np.abs(got - expected)) < 1e-8
+    assert orbit.floquet.stable
+
+
+def test_reference_period_one_orbit_to_the_issue_tolerances():
+    # f1 = 0.1, lambda = 0.8: residual below 1e-10, the three monodromy routes agree to
+    # 1e-6, and Liouville's formula det M = exp(int trace J) holds to 1e-8.
+    system = System.load("reference_light", **{"lambda": 0.8})
+    guess = simulate(system, method="cvodes", transient=100, periods=1).poincare[:, 0]
+    orbit = shoot(system, guess, 1, t0=0.0)
+    assert orbit.residual < 1e-10
+    assert orbit.floquet.liouville_error < 1e-8
+    flow = FlowMap(system)
+    mats = [
+        flow.with_jacobian(orbit.x0, orbit.period, method=m)[1] for m in ("ad", "variational", "fd")
+    ]
+    scale = np.max(np.abs(mats[0]))
+    for a in range(3):
+        for b in range(a + 1, 3):
+            assert np.max(np.abs(mats[a] - mats[b])) / scale < 1e-6
+
+
+def test_multiple_shooting_finds_the_same_orbit():
+    system = System.load("reference_heavy", **{"lambda": 0.8})
+    guess = simulate(system, method="cvodes", transient=100, periods=1).poincare[:, 0]
+    single = shoot(system, guess, 1)
+    multiple = shoot(system, guess, 1, segments=5)
+    assert np.max(np.abs(single.x0 - multiple.x0)) < 1e-9
+    assert np.allclose(
+        np.sort(np.abs(single.floquet.multipliers)),
+        np.sort(np.abs(multiple.floquet.multipliers)),
+        atol=1e-8,
+    )
+
+
+def _fold_sweep(system, start, stop, step, state):
+    """Brute force: step omega upward from the resonant branch; return the step where the
+    amplitude collapses (the jump down past the fold)."""
+    previous = None
+    for w in np.arange(start, stop, step):
+        run = simulate(
+            system.with_values(omega=w),
+            state,
+            method="cvodes",
+            transient=150,
+            periods=2,
+            samples_per_period=32,
+        )
+        amp = np.ptp(run.coordinate("x")) / 2
+        if previous is not None and amp < 0.5 * previous:
+            return w - step, w
+        previous, state = amp, run.x_final
+    return None
+
+
+def test_fold_of_a_hardening_duffing_oscillator_against_brute_force():
+    # x'' + 0.1 x' + x + x^3 = 0.5 cos(omega tau): the resonant branch of a hardening
+    # oscillator ends in a fold, where an upward sweep jumps down (Nayfeh and Mook 1979,
+    # "Nonlinear Oscillations", ch. 4).  The jump is found by simulation alone.
+    system = System.load(DUFFING, k=0.1, B=0.5, a=1.0, c=1.0, omega=1.0)
+    run = simulate(system, np.zeros(2), method="cvodes", transient=300, periods=1)
+    branch = continue_orbit(system, "omega", 1.0, 2.5, run.poincare[:, 0], ds=0.05, ds_max=0.1)
+    folds = [b.value for b in branch.bifurcations if b.kind == "fold"]
+    upper = max(folds)
+    # Climb the resonant branch coarsely, then bracket the jump finely.
+    state = run.x_final
+    for w in np.arange(1.0, upper - 0.05, 0.05):
+        state = simulate(
+            system.with_values(omega=w), state, method="cvodes", transient=100, periods=1
+        ).x_final
+    lo, hi = _fold_sweep(system, upper - 0.05, upper + 0.05, 0.005, state)
+    assert lo - 0.005 <= upper <= hi + 1e-9, (upper, lo, hi)
+    multiplier = [b.multiplier for b in branch.bifurcations if b.value == upper][0]
+    assert abs(multiplier - 1.0) < 1e-3
+
+
+def _period_two(system, state):
+    run = simulate(system, state, method="cvodes", transient=1500, periods=8)
+    pts = run.poincare
+    return np.max(np.abs(pts[:, 1:] - pts[:, :-1])) > 1e-3, run.x_final
+
+
+def test_period_doubling_of_the_twin_well_oscillator_against_brute_force():
+    # x'' + 0.3 x' - x + x^3 = B cos(1.2 tau) (Guckenheimer and Holmes 1983, section 2.2):
+    # the period-1 orbit doubles as B grows.  Independent location: bisection on B with
+    # long simulations that tell period 1 from period 2.
+    system = System.load(DUFFING, k=0.3, a=-1.0, c=1.0, omega=1.2, B=0.2)
+    run = simulate(system, np.array([1.0, 0.0]), method="cvodes", transient=300, periods=1)
+    branch = continue_orbit(system, "B", 0.2, 0.27, run.poincare[:, 0], ds=0.01, ds_max=0.02)
+    pd = [b for b in branch.bifurcations if b.kind == "period-doubling"]
+    assert len(pd) == 1 and abs(pd[0].multiplier + 1.0) < 1e-3
+    lo, hi = 0.24, 0.27
+    state = run.x_final
+    while hi - lo > 1e-3:
+        mid = (lo + hi) / 2
+        doubled, _ = _period_two(system.with_values(B=mid), state)
+        lo, hi = (lo, mid) if doubled else (mid, hi)
+    assert lo - 1e-3 <= pd[0].value <= hi + 1e-3, (pd[0].value, lo, hi)
+
+
+def test_branch_switching_follows_the_period_two_orbit():
+    system = System.load(DUFFING, k=0.3, a=-1.0, c=1.0, omega=1.2, B=0.2)
+    run = simulate(system, np.array([1.0, 0.0]), method="cvodes", transient=300, periods=1)
+    branch = continue_orbit(system, "B", 0.2, 0.27, run.poincare[:, 0], ds=0.01, ds_max=0.02)
+    pd = next(b for b in branch.bifurcations if b.kind == "period-doubling")
+    doubled = switch_period_doubling(system, "B", pd, 1, 0.28, ds=0.005, ds_max=0.01)
+    assert doubled.n == 2 and doubled.stable[0]
+    # A genuine period-2 orbit: after one forcing period it is elsewhere.
+    sys0 = system.with_values(B=doubled.values[0])
+    half = FlowMap(sys0)(doubled.states[0], sys0.period)
+    assert np.max(np.abs(half - doubled.states[0])) > 1e-3
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("module", ["reference_light", "reference_heavy"])
+def test_continuation_over_lambda_matches_the_brute_force_windows(module):
+    from gearsym.solver.reproduce import stable_coverage
+    from gearsym.solver.sweep import sweep
+
+    system = System.load(module)
+    lam = np.linspace(0.0, 1.0, 11)
+    settings = dict(method="cvodes", transient=150, periods=8, lyapunov_periods=0)
+    sweeps = [sweep(system, "lambda", lam, backward=b, **settings) for b in (False, True)]
+    start = sweeps[0].points[0]
+    x0 = np.array([start["poincare"][s][0] for s in system.states])
+    branch = continue_orbit(system, "lambda", 0.0, 1.0, x0, ds=0.03, ds_max=0.12)
+    covered, total, missed = stable_coverage([branch], sweeps)
+    assert total > 0 and covered == total, missed
