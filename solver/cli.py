@@ -318,6 +318,15 @@ def _cmd_shoot(args) -> int:
     except ShootingError as err:
         raise _Fail(f"shoot: {err}; residuals {[f'{r:.2g}' for r in err.history]}") from None
     data = orbit.describe()
+    if args.out:
+        from gearsym.solver import plots
+        from gearsym.solver._json import dumps as _dumps
+
+        out = Path(args.out)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "orbit.json").write_text(_dumps(data, indent=1), encoding="utf-8")
+        plots.multipliers_figure(orbit.floquet.multipliers, out / "multipliers.png",
+                                 title=f"{system.name}: period-{orbit.n} orbit")  # fmt: skip
     if args.compare_monodromy:
         from gearsym.solver.flow import FlowMap
 
@@ -334,7 +343,7 @@ def _cmd_shoot(args) -> int:
         return 0
     fl = orbit.floquet
     print(f"{system.name}: period-{orbit.n} orbit, residual {orbit.residual:.2e} after "
-          f"{orbit.iterations} Newton iteration(s) ({args.monodromy} monodromy, "
+          f"{orbit.iterations} Newton iteration(s) ({args.monodromy or 'default'} monodromy, "
           f"{args.segments} segment(s))")  # fmt: skip
     print("  x0: " + ", ".join(f"{k} = {v:.10g}" for k, v in data["x0"].items()))
     print("  multipliers: " + ", ".join(f"{m.real:+.6f}{m.imag:+.6f}i (|{abs(m):.6f}|)"
@@ -386,6 +395,16 @@ def _cmd_continue(args) -> int:
     state = system.coordinates[0]
     plots.branch_figure(branches, out / "branches.png", 0, state,
                         title=f"{system.name}: continuation in {args.param}")  # fmt: skip
+    for k, br in enumerate(branches):
+        for b in br.bifurcations:
+            lam = b.value
+            sys_b = system.with_values(**{args.param: lam})
+            from gearsym.solver.flow import FlowMap
+
+            _, M, _ = FlowMap(sys_b).with_jacobian(b.x0, br.n * sys_b.period)
+            plots.multipliers_figure(np.linalg.eigvals(M),
+                                     out / f"multipliers_{k}_{b.kind}_{lam:.6g}.png",
+                                     title=f"{b.kind} at {args.param} = {lam:.6g}")  # fmt: skip
     for br in branches:
         stable = sum(br.stable)
         print(f"period-{br.n} branch: {len(br.values)} points, {stable} stable; {br.message}")
@@ -510,7 +529,9 @@ def _parser() -> argparse.ArgumentParser:
     sh.add_argument("--set", action="append", metavar="KEY=VALUE")
     sh.add_argument("--period", type=int, default=1, help="n: the orbit's period is n T")
     sh.add_argument("--segments", type=int, default=1, help="multiple shooting segments")
-    sh.add_argument("--monodromy", choices=("ad", "variational", "fd"), default="ad")
+    sh.add_argument("--monodromy", choices=("ad", "variational", "fd"), default=None,
+                    help="monodromy route (default: ad; variational with located "
+                    "crossings for a dead zone)")  # fmt: skip
     sh.add_argument(
         "--compare-monodromy",
         action="store_true",
@@ -518,6 +539,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     sh.add_argument("--settle", type=int, default=300, help="periods simulated for the guess")
     sh.add_argument("--json", action="store_true")
+    sh.add_argument("--out", metavar="DIR", help="also write orbit.json and multipliers.png")
     sh.set_defaults(func=_cmd_shoot)
 
     co = sub.add_parser("continue", help="continue a periodic orbit in a parameter",

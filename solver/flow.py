@@ -12,6 +12,13 @@ period of a periodic orbit: the monodromy matrix) comes from
 
 Every route also integrates ``trace J`` along the trajectory, for Liouville's formula
 ``det Phi = exp(int trace J dtau)``.
+
+With the dead-zone backlash the force law has kinks at ``|u| = 1``.  The vector field
+stays continuous there, so the fundamental matrix needs no saltation jump, but an
+integrator that steps over a kink loses its order.  ``FlowMap(system, locate=True)`` (the
+default for dead-zone models) therefore integrates the plain flow and the variational
+equations with SciPy's DOP853, stopping and restarting at every crossing; the ``"ad"``
+route stays on CVODES, whose error control is all it has against the kinks.
 """
 
 from __future__ import annotations
@@ -34,7 +41,54 @@ class FlowMap:
     system: System
     rtol: float = 1e-11
     atol: float = 1e-13
+    locate: bool | None = None  # None: locate crossings when the backlash is a dead zone
     _cache: dict = field(default_factory=dict, repr=False)
+
+    def __post_init__(self):
+        if self.locate is None:
+            self.locate = self.system.backlash == "dead-zone"
+
+    def _located(self, x0, duration, t0, p, with_phi: bool):
+        """DOP853 on (x, Phi, int trace J), restarted at every contact-boundary crossing."""
+        from scipy.integrate import solve_ivp
+
+        from .simulate import _boundary_event
+
+        sys_, n = self.system, self.system.n
+        m = len(sys_.coordinates)
+        p = sys_.p if p is None else p
+        rhs, jac = sys_.module.rhs, sys_.module.jacobian
+
+        def f(t, z):
+            x = z[:n]
+            J = jac(t, x, p)
+            out = [rhs(t, x, p)]
+            if with_phi:
+                out.append((J @ z[n : n + n * n].reshape(n, n)).ravel())
+            out.append([np.trace(J)])
+            return np.concatenate(out)
+
+        z = np.concatenate([x0, np.eye(n).ravel() if with_phi else [], [0.0]])
+        t, t_end = t0, t0 + duration
+        offset: dict[int, float] = {}
+        edges = [(i, e) for i in range(m) for e in (1.0, -1.0)]
+        for _ in range(100_000):
+            events = [_boundary_event(i, e, offset.get(k, 0.0)) for k, (i, e) in enumerate(edges)]
+            sol = solve_ivp(f, (t, t_end), z, method="DOP853", rtol=self.rtol, atol=self.atol,
+                            events=events)  # fmt: skip
+            if sol.status == -1:
+                raise RuntimeError(f"DOP853 failed at tau = {t:.6g}: {sol.message}")
+            z = sol.y[:, -1]
+            if sol.status == 0:
+                break
+            t = float(sol.t[-1])
+            offset = {k: np.copysign(1e-10, z[m + i]) for k, (i, e) in enumerate(edges)
+                      if abs(z[i] - e) <= 1e-9}  # fmt: skip
+        else:
+            raise RuntimeError("too many contact-boundary crossings in one flow interval")
+        xf = z[:n]
+        Phi = z[n : n + n * n].reshape(n, n) if with_phi else None
+        return xf, Phi, float(z[-1])
 
     def _integrator(self, kind: str, duration: float):
         key = (kind, round(duration, 14))
@@ -70,13 +124,20 @@ class FlowMap:
 
     def __call__(self, x0, duration: float, t0: float = 0.0, p=None) -> np.ndarray:
         """End state after ``duration`` from ``x0`` at ``t0``."""
+        if self.locate:
+            return self._located(np.asarray(x0, float), duration, t0, p, False)[0]
         F = self._integrator("plain", duration)
         pp = np.concatenate([self.system.p if p is None else p, [t0]])
         return np.asarray(F(x0=np.asarray(x0, float), p=pp)["xf"]).ravel()
 
     def with_jacobian(self, x0, duration: float, t0: float = 0.0, p=None,
-                      method: str = "ad", fd_step: float = 1e-5):  # fmt: skip
-        """(end state, d end / d start, int trace J) over ``duration`` from ``x0``."""
+                      method: str | None = None, fd_step: float = 1e-5):  # fmt: skip
+        """(end state, d end / d start, int trace J) over ``duration`` from ``x0``.
+
+        ``method`` defaults to ``"variational"`` when crossings are located (dead zone),
+        else ``"ad"``."""
+        if method is None:
+            method = "variational" if self.locate else "ad"
         if method not in MONODROMY_METHODS:
             raise ValueError(f"unknown monodromy method '{method}'; methods: "
                              f"{', '.join(MONODROMY_METHODS)}")  # fmt: skip
@@ -86,6 +147,18 @@ class FlowMap:
         if method == "ad":
             xf, M, q = self._integrator("ad", duration)(x0, pp)
             return np.asarray(xf).ravel(), np.asarray(M), float(q)
+        if method == "variational" and self.locate:
+            return self._located(x0, duration, t0, p, True)
+        if method == "fd" and self.locate:
+            xf, _, q = self._located(x0, duration, t0, p, False)
+            M = np.empty((n, n))
+            for j in range(n):
+                e = np.zeros(n)
+                e[j] = fd_step
+                plus = self._located(x0 + e, duration, t0, p, False)[0]
+                minus = self._located(x0 - e, duration, t0, p, False)[0]
+                M[:, j] = (plus - minus) / (2 * fd_step)
+            return xf, M, q
         if method == "variational":
             z0 = np.concatenate([x0, np.eye(n).ravel(order="F")])
             out = self._integrator("variational", duration)(x0=z0, p=pp)

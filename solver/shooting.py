@@ -117,13 +117,15 @@ def shoot(
     segments: int = 1,
     tol: float = 1e-11,
     max_iter: int = 30,
-    monodromy: str = "ad",
+    monodromy: str | None = None,
     flow: FlowMap | None = None,
 ) -> Orbit:
     """Newton shooting for the period-n orbit near ``x0`` (at time ``t0``).
 
     ``segments`` > 1 uses multiple shooting: the initial segment states come from
     integrating the guess.  Converged when the residual's max-norm is below ``tol``.
+    ``monodromy`` picks the route (``ad``, ``variational``, ``fd``); by default the
+    flow's own (located variational equations for a dead zone, else AD).
     """
     if n < 1 or segments < 1:
         raise ValueError("period multiple n and segments must be >= 1")

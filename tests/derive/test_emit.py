@@ -7,7 +7,15 @@ from gearsym.derive.build import project_root, shipped_targets
 from gearsym.derive.emit import emit_module
 from gearsym.solver import load_generated
 
-NAMES = ["reference_light", "reference_heavy", "reference_linear", "diso", "siso", "tiso"]
+NAMES = [
+    "reference_dead_zone",
+    "reference_light",
+    "reference_heavy",
+    "reference_linear",
+    "diso",
+    "siso",
+    "tiso",
+]
 
 
 @pytest.mark.parametrize("name", NAMES)

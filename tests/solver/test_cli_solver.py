@@ -146,3 +146,58 @@ def test_a_failing_point_is_recorded_and_the_sweep_goes_on(tmp_path, capsys):
     statuses = [p["status"] for p in data["points"]]
     assert statuses[-1] == "ok" and statuses[0] in ("failed", "divergent")
     assert "did not finish normally" in capsys.readouterr().out
+
+
+def test_shoot_json_reports_the_orbit_and_its_multipliers(tmp_path, capsys):
+    code = main(
+        [
+            "shoot",
+            "reference-light",
+            "--set",
+            "lambda=0.8",
+            "--settle",
+            "100",
+            "--compare-monodromy",
+            "--json",
+            "--out",
+            str(tmp_path),
+        ]
+    )
+    assert code == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["residual"] < 1e-10 and data["newton_iterations"] >= 1
+    assert set(data["x0"]) == {"u", "v", "du", "dv"} and data["period_tau"] > 0
+    fl = data["floquet"]
+    assert len(fl["multipliers"]) == 4 and fl["stable"] is True
+    assert fl["liouville_relative_error"] < 1e-8
+    assert max(data["monodromy_agreement"].values()) < 1e-6
+    assert (tmp_path / "multipliers.png").stat().st_size > 1000
+
+
+@pytest.mark.slow
+def test_continue_lists_the_folds_of_the_light_load_branch(tmp_path, capsys):
+    code = main(
+        [
+            "continue",
+            "reference-light",
+            "--param",
+            "lambda",
+            "--from",
+            "0",
+            "--to",
+            "1",
+            "--step",
+            "0.04",
+            "--settle",
+            "150",
+            "--out",
+            str(tmp_path),
+        ]
+    )
+    assert code == 0
+    out = capsys.readouterr().out
+    assert sum(line.lstrip().startswith("fold ") for line in out.splitlines()) == 2
+    branches = json.loads((tmp_path / "branches.json").read_text())
+    folds = sorted(b["value"] for b in branches[0]["bifurcations"])
+    # The hysteresis window of the brute-force sweeps, [0.3, 0.8], lies between them.
+    assert 0.25 < folds[0] < 0.3 and 0.8 < folds[1] < 0.85

@@ -155,3 +155,17 @@ def test_continuation_over_lambda_matches_the_brute_force_windows(module):
     branch = continue_orbit(system, "lambda", 0.0, 1.0, x0, ds=0.03, ds_max=0.12)
     covered, total, missed = stable_coverage([branch], sweeps)
     assert total > 0 and covered == total, missed
+
+
+def test_dead_zone_multipliers_converge_with_located_crossings():
+    # Continuous vector field, kinked force law: no saltation, but the crossings must be
+    # located for the monodromy to converge with the tolerance (docs/deadzone-multipliers.md).
+    system = System.load("reference_dead_zone", f1=0.05, **{"lambda": 1.0})
+    guess = simulate(system, method="RK45", transient=150, periods=1).poincare[:, 0]
+    ref = shoot(system, guess, 1, flow=FlowMap(system, rtol=1e-12, atol=1e-14))
+    exact = np.sort_complex(ref.floquet.multipliers)
+    errors = []
+    for rtol in (1e-6, 1e-8, 1e-10):
+        _, M, _ = FlowMap(system, rtol=rtol, atol=rtol * 1e-2).with_jacobian(ref.x0, system.period)
+        errors.append(np.max(np.abs(np.sort_complex(np.linalg.eigvals(M)) - exact)))
+    assert errors[0] > errors[1] > errors[2] and errors[2] < 1e-8, errors
