@@ -205,9 +205,7 @@ def _cmd_simulate(args) -> int:
     if args.out:
         from gearsym.solver import plots
 
-        out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "point.json").write_text(dumps(data, indent=1), encoding="utf-8")
+        out = _write_json(args.out, "point.json", data)
         plots.point_figure(result.trajectory, out / "point.png", title=system.name)
     if args.json:
         print(dumps(data, indent=1))
@@ -292,6 +290,16 @@ def _cmd_reproduce(args) -> int:
     return 0
 
 
+def _write_json(folder: str, name: str, data) -> Path:
+    """Write ``data`` as ``folder/name`` (no NaN: see solver._json); return the folder."""
+    from gearsym.solver._json import dumps
+
+    out = Path(folder)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / name).write_text(dumps(data, indent=1), encoding="utf-8")
+    return out
+
+
 def _orbit_guess(system, n: int, settle: int):
     """A starting state on the attractor at tau = 0 (mod nT), from a simulation."""
     from gearsym.solver.simulate import simulate
@@ -320,11 +328,8 @@ def _cmd_shoot(args) -> int:
     data = orbit.describe()
     if args.out:
         from gearsym.solver import plots
-        from gearsym.solver._json import dumps as _dumps
 
-        out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "orbit.json").write_text(_dumps(data, indent=1), encoding="utf-8")
+        out = _write_json(args.out, "orbit.json", data)
         plots.multipliers_figure(orbit.floquet.multipliers, out / "multipliers.png",
                                  title=f"{system.name}: period-{orbit.n} orbit")  # fmt: skip
     if args.compare_monodromy:
