@@ -257,13 +257,16 @@ def _cmd_sweep(args) -> int:
     system = _system(args.scene, _parse_set(args.set))
     out = Path(args.out or f"sweep_{system.name}_{args.param}")
     bar = Progress(len(values), f"{args.param}", enabled=not args.quiet)
+    stored = len(list((out / "store" / "points").glob("[0-9]*.json")))
     try:
         result = sweep(system, args.param, values, continuation=not args.independent,
-                       backward=args.backward, executor=args.executor,
-                       progress=bar, **_analysis_settings(args))  # fmt: skip
+                       backward=args.backward, executor=args.executor, progress=bar,
+                       store=out / "store", **_analysis_settings(args))  # fmt: skip
     except (SimulationError, ValueError) as err:
         raise _Fail(f"sweep: {err}") from None
     failed = [p["value"] for p in result.points if p["status"] != "ok"]
+    if stored:
+        print(f"resumed: {stored} of {len(values)} points came from {out / 'store'}")
     path = result.save(out / "sweep.json")
     fig = plots.bifurcation_diagram([result], list(system.coordinates), out / "bifurcation.png",
                                     title=f"{system.name}: {args.param} sweep")  # fmt: skip

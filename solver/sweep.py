@@ -29,7 +29,7 @@ from .point import analyse_point
 from .simulate import SimulationError
 from .system import System
 
-__all__ = ["SweepResult", "sweep", "sweep_many", "Progress"]
+__all__ = ["Progress", "SweepResult", "SweepStoreError", "sweep", "sweep_many"]
 
 EXECUTORS = ("serial", "processes")
 
@@ -150,7 +150,11 @@ def _failed(system: System, value: float, error: Exception) -> dict:
 
 @dataclass(frozen=True)
 class _Chain:
-    """One worker task: a continuation chain, or a single independent point."""
+    """One worker task: a continuation chain, or a single independent point.
+
+    ``indices`` are the points' positions in the sweep's order; with a ``store`` each
+    finished point is written there at once (atomically), so nothing computed is lost.
+    """
 
     module: str
     base_values: dict
@@ -159,18 +163,25 @@ class _Chain:
     x0: list | None
     settings: dict
     continuation: bool
+    indices: list = field(default_factory=list)
+    store: str | None = None
 
 
 def _run_chain(chain: _Chain, on_point=None) -> list[dict]:
     system = System.load(chain.module, **chain.base_values)
     state = None if chain.x0 is None else np.asarray(chain.x0, dtype=float)
     out = []
-    for value in chain.values:
-        try:
-            point_system = system.with_values(**{chain.parameter: value})
-            point = _summary(analyse_point(point_system, state, **chain.settings), value)
-        except (SimulationError, ValueError, FloatingPointError) as err:
-            point = _failed(system, value, err)
+    for k, value in enumerate(chain.values):
+        for attempt in (1, 2):  # a failed point is tried once more, then recorded
+            try:
+                point_system = system.with_values(**{chain.parameter: value})
+                point = _summary(analyse_point(point_system, state, **chain.settings), value)
+                break
+            except (SimulationError, ValueError, FloatingPointError) as err:
+                point = _failed(system, value, err)
+                point["attempts"] = attempt
+        if chain.store is not None:
+            store_point(Path(chain.store), chain.indices[k], point)
         out.append(point)
         if chain.continuation and point["status"] == "ok":
             state = np.asarray(point["x_final"])
@@ -179,8 +190,57 @@ def _run_chain(chain: _Chain, on_point=None) -> list[dict]:
     return out
 
 
+class SweepStoreError(ValueError):
+    """A sweep folder that cannot be resumed (another model, or another sweep)."""
+
+
+STORE_FORMAT = 1
+
+
+def store_point(store: Path, index: int, point: dict) -> None:
+    """Write one finished point atomically (temporary file, then rename)."""
+    folder = store / "points"
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{index:05d}.json"
+    tmp = folder / f".{index:05d}.json.{os.getpid()}.tmp"
+    tmp.write_text(dumps(point), encoding="utf-8")
+    os.replace(tmp, path)
+
+
+def _open_store(store: Path, manifest: dict) -> dict[int, dict]:
+    """Create the store, or check that it holds this very sweep; return its points."""
+    store.mkdir(parents=True, exist_ok=True)
+    path = store / "manifest.json"
+    if path.exists():
+        old = json.loads(path.read_text(encoding="utf-8"))
+        if old.get("model_hash") != manifest["model_hash"]:
+            raise SweepStoreError(
+                f"{store} was written by another model version (hash "
+                f"{str(old.get('model_hash'))[:12]}, this model {manifest['model_hash'][:12]}); "
+                "choose another output folder or delete it"
+            )
+        differs = [k for k in manifest if old.get(k) != manifest[k]]
+        if differs:
+            raise SweepStoreError(
+                f"{store} holds another sweep ({', '.join(differs)} differ); choose another "
+                "output folder or delete it"
+            )
+    else:
+        tmp = store / ".manifest.json.tmp"
+        tmp.write_text(dumps(manifest, indent=1), encoding="utf-8")
+        os.replace(tmp, path)
+    done = {}
+    for f in sorted((store / "points").glob("[0-9]*.json")):
+        try:
+            done[int(f.stem)] = json.loads(f.read_text(encoding="utf-8"))
+        except (ValueError, OSError):
+            f.unlink(missing_ok=True)  # a torn file cannot exist (atomic writes); be safe
+    return done
+
+
 def _plan(system: System, parameter: str, values, *, continuation: bool, backward: bool,
-          x0, settings: dict) -> list[_Chain]:  # fmt: skip
+          x0, settings: dict, done: dict | None = None,
+          store: Path | None = None) -> list[_Chain]:  # fmt: skip
     values = np.asarray(values, dtype=float)
     if values.ndim != 1 or values.size == 0 or not np.all(np.isfinite(values)):
         raise ValueError("sweep values must be a non-empty list of finite numbers")
@@ -190,10 +250,23 @@ def _plan(system: System, parameter: str, values, *, continuation: bool, backwar
         raise ValueError(err.args[0]) from None
     order = [float(v) for v in (values[::-1] if backward else values)]
     x0 = None if x0 is None else [float(v) for v in x0]
+    done = done or {}
     base = (module_ref(system), dict(system.values), parameter)
+    where = None if store is None else str(store)
     if continuation:
-        return [_Chain(*base, order, x0, settings, True)]
-    return [_Chain(*base, [v], x0, settings, False) for v in order]
+        # Resume after the last finished point, from the last state that was reached.
+        k = 0
+        while k in done:
+            k += 1
+        for j in range(k - 1, -1, -1):
+            if done[j].get("status") == "ok":
+                x0 = done[j]["x_final"]
+                break
+        if k == len(order):
+            return []
+        return [_Chain(*base, order[k:], x0, settings, True, list(range(k, len(order))), where)]
+    return [_Chain(*base, [v], x0, settings, False, [i], where)
+            for i, v in enumerate(order) if i not in done]  # fmt: skip
 
 
 def _execute(chains: list[_Chain], executor: str, workers: int | None,
@@ -205,7 +278,7 @@ def _execute(chains: list[_Chain], executor: str, workers: int | None,
         if progress:
             progress.step(f"{chains[0].parameter}={point['value']:.4g}")
 
-    if executor == "serial" or len(chains) == 1:
+    if executor == "serial" or len(chains) <= 1:
         return [_run_chain(c, on_point=tick) for c in chains]
     results = []
     with ProcessPoolExecutor(max_workers=workers or os.cpu_count()) as pool:
@@ -241,19 +314,46 @@ def sweep(
     executor: str = "serial",
     workers: int | None = None,
     progress: Progress | None = None,
+    store: Path | None = None,
     **settings,
 ) -> SweepResult:
     """Sweep ``parameter`` over ``values`` (see module docstring); ``settings`` go to
-    :func:`analyse_point` (method, rtol, transient, periods, ...).  A point whose
-    integration fails is recorded as ``failed`` with its error."""
+    :func:`analyse_point` (method, rtol, transient, periods, ...).
+
+    A point whose integration fails is tried once more, then recorded as ``failed`` with
+    its error.  With ``store`` (a folder) every finished point is written there at once;
+    running the same sweep into the same folder again resumes where it stopped, and a
+    folder written by another model version or another sweep is refused.
+    """
+    direction = ("backward" if backward else "forward") if continuation else "independent"
+    x0_list = None if x0 is None else [float(v) for v in x0]
+    values = np.asarray(values, dtype=float)
+    done: dict[int, dict] = {}
+    if store is not None:
+        manifest = {
+            "format": STORE_FORMAT,
+            "model": system.name,
+            "model_hash": system.model_hash,
+            "parameter": parameter,
+            "values": [float(v) for v in values],
+            "direction": direction,
+            "base_values": {k: float(v) for k, v in system.values.items()},
+            "settings": json.loads(dumps(settings)),
+            "x0": x0_list,
+        }
+        done = _open_store(Path(store), manifest)
     chains = _plan(system, parameter, values, continuation=continuation, backward=backward,
-                   x0=x0, settings=settings)  # fmt: skip
-    points = [p for chunk in _execute(chains, executor, workers, progress) for p in chunk]
+                   x0=x0, settings=settings, done=done, store=store)  # fmt: skip
+    if progress is not None:
+        for _ in done:
+            progress.step("(stored)")
+    found = dict(done)
+    for chain, points in zip(chains, _execute(chains, executor, workers, progress), strict=True):
+        found.update(zip(chain.indices, points, strict=True))
+    points = [found[i] for i in range(values.size)]
     if backward:
         points = points[::-1]
-    direction = ("backward" if backward else "forward") if continuation else "independent"
-    settings = dict(settings, x0=None if x0 is None else [float(v) for v in x0])
-    return _result(system, parameter, values, direction, settings, points)
+    return _result(system, parameter, values, direction, dict(settings, x0=x0_list), points)
 
 
 def sweep_many(jobs: list[dict], *, executor: str = "processes", workers: int | None = None,
@@ -263,9 +363,15 @@ def sweep_many(jobs: list[dict], *, executor: str = "processes", workers: int | 
     plans = []
     for job in jobs:
         settings = _job_settings(job)
-        (chain,) = _plan(job["system"], job["parameter"], job["values"], continuation=True,
-                         backward=job.get("backward", False), x0=job.get("x0"),
-                         settings=settings)  # fmt: skip
+        (chain,) = _plan(
+            job["system"],
+            job["parameter"],
+            job["values"],
+            continuation=True,
+            backward=job.get("backward", False),
+            x0=job.get("x0"),
+            settings=settings,
+        )  # fmt: skip
         plans.append(chain)
     results = []
     for job, points in zip(jobs, _execute(plans, executor, workers, progress), strict=True):
