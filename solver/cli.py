@@ -188,7 +188,8 @@ def _analysis_settings(args) -> dict:
         if getattr(args, name) < (0 if name == "transient" else 1):
             raise _Fail(f"--{name} must be a whole number >= {0 if name == 'transient' else 1}")
     return dict(method=args.method, rtol=args.rtol, atol=args.atol, transient=args.transient,
-                periods=args.periods, lyapunov_periods=args.lyapunov_periods)  # fmt: skip
+                periods=args.periods, lyapunov_periods=args.lyapunov_periods,
+                on_invalid=args.on_invalid)  # fmt: skip
 
 
 def _cmd_simulate(args) -> int:
@@ -215,13 +216,19 @@ def _cmd_simulate(args) -> int:
           f"{tr.wall_time:.2f} s, status {tr.status}")  # fmt: skip
     if result.lyapunov is not None:
         print(f"  largest Lyapunov exponent {result.lyapunov.exponent:.5f} per unit tau")
+    if tr.status != "ok":
+        print(f"  {tr.message}")
+
+    def num(v, fmt=".4f"):
+        return "n/a" if v is None else format(v, fmt)
+
     for c, k in result.classification.items():
         e = data["extremes"][c]
         peaks = ", ".join(f"{p['frequency']:.3g}" for p in data["spectra"][c]["peaks"][:4])
         shares = data["meshing_states"][c]
-        print(f"  {c}: {k.motion:<15} range [{e['min']:.4f}, {e['max']:.4f}]  peaks at {peaks}"
-              f"  forward/separated/backward {shares['forward']:.2f}/{shares['separated']:.2f}/"
-              f"{shares['backward']:.2f}")  # fmt: skip
+        print(f"  {c}: {k.motion:<15} range [{num(e['min'])}, {num(e['max'])}]  peaks at "
+              f"{peaks or 'n/a'}  forward/separated/backward {num(shares['forward'], '.2f')}/"
+              f"{num(shares['separated'], '.2f')}/{num(shares['backward'], '.2f')}")  # fmt: skip
     if tr.left_valid_range is not None:
         t, c, v = tr.left_valid_range
         print(f"  warning: {c} = {v:.3g} at tau = {t:.6g} is outside the backlash model's "
@@ -433,6 +440,9 @@ def _analysis_options(sub) -> None:
     sub.add_argument("--atol", type=float, default=1e-10)
     sub.add_argument("--transient", type=int, default=300, help="periods discarded")
     sub.add_argument("--periods", type=int, default=100, help="periods sampled")
+    sub.add_argument("--on-invalid", choices=("warn", "error"), default="warn",
+                     help="when a coordinate leaves the backlash model's valid range: warn "
+                     "and go on, or stop the run there (status 'invalid')")  # fmt: skip
     sub.add_argument("--lyapunov-periods", type=int, default=200,
                      help="periods for the largest Lyapunov exponent (0: skip)")  # fmt: skip
 

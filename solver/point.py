@@ -58,11 +58,13 @@ def analyse_point(
     samples_per_period: int = 64,
     lyapunov_periods: int = 200,
     steps_per_period: int = 512,
+    on_invalid: str = "warn",
 ) -> PointResult:
     """Simulate, estimate the largest exponent from the end state, classify each mesh."""
     tr = simulate(
         system, x0, method=method, rtol=rtol, atol=atol, transient=transient, periods=periods,
         samples_per_period=samples_per_period, steps_per_period=steps_per_period,
+        on_invalid=on_invalid,
     )  # fmt: skip
     lyap = None
     if tr.status == "ok" and lyapunov_periods > 0:
@@ -75,6 +77,10 @@ def analyse_point(
             lyap = None
     tol = classification_tolerance(method, rtol)
     verdicts = {}
+    if tr.status == "invalid":
+        why = {"why": tr.message}
+        return PointResult(tr, None, {c: Classification("undetermined", None, why)
+                                      for c in system.coordinates})  # fmt: skip
     for c in system.coordinates:
         i, j = system.index(c), system.index(f"d{c}")
         points = tr.poincare[[i, j]]

@@ -124,6 +124,7 @@ def simulate(
     steps_per_period: int = 512,
     max_step: float | None = None,
     bound: float = 1e3,
+    on_invalid: str = "warn",
 ) -> Trajectory:
     """Integrate ``system`` from ``x0`` and sample the response after a transient.
 
@@ -145,9 +146,16 @@ def simulate(
         Samples per period in the window (a power of two suits the FFT).
     bound : float
         A state beyond this magnitude ends the run as ``divergent``.
+    on_invalid : {"warn", "error"}
+        What to do when a mesh coordinate leaves the backlash model's valid range (a
+        polynomial fit, say): ``warn`` records the first exit (time, coordinate, value)
+        and goes on; ``error`` stops there with status ``invalid`` (samples after the exit
+        are not computed).
     """
     if method not in METHODS:
         raise ValueError(f"unknown method '{method}'; methods: {', '.join(METHODS)}")
+    if on_invalid not in ("warn", "error"):
+        raise ValueError(f"on_invalid must be 'warn' or 'error', got {on_invalid!r}")
     for name, value in (("transient", transient), ("periods", periods)):
         if not (isinstance(value, int) and value >= 0):
             raise ValueError(f"{name} must be a whole number >= 0, got {value!r}")
@@ -178,16 +186,25 @@ def simulate(
     grid = t_start + T * np.arange(periods * samples_per_period + 1) / samples_per_period
     started = time.perf_counter()
     if method in SCIPY_METHODS:
-        run = _scipy_run(system, x0, t0, grid, method, rtol, atol, max_step, bound)
+        run = _scipy_run(system, x0, t0, grid, method, rtol, atol, max_step, bound, on_invalid)
     else:
         run = _casadi_run(
             system, x0, t0, grid, method, rtol, atol, steps_per_period, samples_per_period, bound
         )
-    x, status, message, nfev, nsteps, crossings = run
+    x, status, message, nfev, nsteps, crossings, exit_ = run
+    if exit_ is None:
+        exit_ = _first_exit(system, grid, x)
+    if exit_ is not None and on_invalid == "error" and status == "ok":
+        t_x, c_x, v_x = exit_
+        x[:, grid > t_x] = np.nan
+        status = "invalid"
+        message = (f"{c_x} = {v_x:.6g} at tau = {t_x:.6g} is outside the backlash model's "
+                   f"valid range |{c_x}| <= {system.valid_range:g}")  # fmt: skip
     x_final = x[:, -1].copy()
     # Keep the window without its closing sample: exactly `periods` whole periods.
     t_out, x_out = grid[:-1], x[:, :-1]
-    status, message = _check_bound(t_out, x_out, status, message, bound)
+    if status != "invalid":
+        status, message = _check_bound(t_out, x_out, status, message, bound)
     return Trajectory(
         system=system,
         method=method,
@@ -206,7 +223,7 @@ def simulate(
         nsteps=nsteps,
         wall_time=time.perf_counter() - started,
         boundary_crossings=crossings,
-        left_valid_range=_first_exit(system, t_out, x_out),
+        left_valid_range=exit_,
         options={"steps_per_period": steps_per_period} if method in ("rk", "collocation") else {},
     )
 
@@ -237,7 +254,7 @@ def _first_exit(system: System, t, x):
     if a is None:
         return None
     m = len(system.coordinates)
-    out = np.abs(x[:m]) > a
+    out = np.abs(x[:m]) > a * (1 + 1e-12)
     if not np.any(out):
         return None
     k = int(np.argmax(np.any(out, axis=0)))
@@ -248,7 +265,7 @@ def _first_exit(system: System, t, x):
 # -- SciPy -------------------------------------------------------------------------------
 
 
-def _scipy_run(system, x0, t0, grid, method, rtol, atol, max_step, bound):
+def _scipy_run(system, x0, t0, grid, method, rtol, atol, max_step, bound, on_invalid="warn"):
     fun = system.rhs
     opts = {"rtol": rtol, "atol": atol}
     if method in ("Radau", "LSODA"):
@@ -261,14 +278,24 @@ def _scipy_run(system, x0, t0, grid, method, rtol, atol, max_step, bound):
     nfev = nsteps = crossings = stalls = 0
     offset: dict[int, float] = {}
     t_end = grid[-1]
+    exit_ = None
+    valid = _valid_event(system, terminal=on_invalid == "error")
     while True:
         events = [_boundary_event(i, edge, offset.get(k, 0.0))
                   for k, (i, edge) in enumerate(boundaries)] + [_escape_event(bound)]  # fmt: skip
+        if valid is not None and (exit_ is None or on_invalid == "error"):
+            events.append(valid)
         sol = solve_ivp(fun, (t, t_end), y, method=method, dense_output=True, events=events,
                         **opts)  # fmt: skip
         nfev += sol.nfev
         if sol.status == -1:
             raise SimulationError(f"{method} failed at tau = {t:.6g}: {sol.message}")
+        if valid is not None and exit_ is None and len(sol.t_events) > len(boundaries) + 1:
+            hits = sol.t_events[len(boundaries) + 1]
+            if hits.size:
+                y_x = sol.y_events[len(boundaries) + 1][0]
+                i = int(np.argmax(np.abs(y_x[: len(system.coordinates)])))
+                exit_ = (float(hits[0]), system.coordinates[i], float(y_x[i]))
         nsteps += sol.t.size - 1
         # Samples that fall in this segment, from the method's own dense output.
         lo = np.searchsorted(grid, t, side="left")
@@ -276,12 +303,14 @@ def _scipy_run(system, x0, t0, grid, method, rtol, atol, max_step, bound):
         if hi > lo:
             x[:, lo:hi] = sol.sol(grid[lo:hi])
         if sol.status == 0:
-            return x, "ok", "", nfev, nsteps, crossings
+            return x, "ok", "", nfev, nsteps, crossings, exit_
         k = next(k for k, te in enumerate(sol.t_events) if te.size)
+        if k == len(boundaries) + 1:  # left the valid range, with on_invalid="error"
+            return x, "ok", "", nfev, nsteps, crossings, exit_
         t_e, y_e = float(sol.t_events[k][0]), sol.y_events[k][0]
         if k == len(boundaries):
             message = f"a state passed |x| = {bound:g} at tau = {t_e:.6g}"
-            return x, "divergent", message, nfev, nsteps, crossings
+            return x, "divergent", message, nfev, nsteps, crossings, exit_
         # Restart on the contact boundary.  Every boundary the state sits on (the one just
         # crossed, and any other within a hair) is shifted a hair behind the motion, so
         # that it does not fire again at once but does fire on the way back.
@@ -315,6 +344,22 @@ def _boundary_event(i: int, edge: float, offset: float):
     return event
 
 
+def _valid_event(system: System, terminal: bool):
+    """Zero where a mesh coordinate reaches the backlash model's valid range (None if the
+    model is valid everywhere)."""
+    a = system.valid_range
+    if a is None:
+        return None
+    m = len(system.coordinates)
+
+    def valid(t, y):  # touching the edge of the range is still inside it
+        return a * (1 + 1e-12) - np.max(np.abs(y[:m]))
+
+    valid.terminal = terminal
+    valid.direction = -1
+    return valid
+
+
 def _escape_event(bound: float):
     def escape(t, y):
         return bound - np.max(np.abs(y))
@@ -336,20 +381,26 @@ def _casadi_run(system, x0, t0, grid, method, rtol, atol, steps, spp, bound):
     dae = {"x": xs, "p": ps, "t": tau, "ode": f(tau, xs, ps)}
     T = system.period
 
+    # Failures are reported once, as a SimulationError; CasADi's and SUNDIALS's own
+    # per-step warnings would only flood the terminal.
+    quiet = {"show_eval_warnings": False}
+
     def options(periods: int) -> dict:
         if method == "cvodes":
-            return {"reltol": rtol, "abstol": atol, "max_num_steps": 1_000_000}
+            return quiet | {"reltol": rtol, "abstol": atol, "max_num_steps": 1_000_000,
+                            "disable_internal_warnings": True}  # fmt: skip
         # CasADi spreads number_of_finite_elements over the whole horizon, so it is
         # `steps` per forcing period times the periods covered (collocation: elements of
         # four points each, i.e. steps / 4 elements per period).
         per_period = steps if method == "rk" else steps // 4
-        opts = {"number_of_finite_elements": per_period * periods}
+        opts = quiet | {"number_of_finite_elements": per_period * periods}
         if method == "collocation":
             opts["interpolation_order"] = 4
             opts["rootfinder_options"] = {"error_on_fail": True}
         return opts
 
     nfev = nsteps = 0
+    exit_ = None
     try:
         y = np.asarray(x0, dtype=float)
         transient = int(round((grid[0] - t0) / T))
@@ -363,7 +414,8 @@ def _casadi_run(system, x0, t0, grid, method, rtol, atol, steps, spp, bound):
                 bad = np.argmax(~np.all(np.isfinite(ends) & (np.abs(ends) <= bound), axis=0))
                 out = np.full((system.n, grid.size), np.nan)
                 message = f"a state passed |x| = {bound:g} in transient period {bad + 1}"
-                return out, "divergent", message, nfev, nsteps, None
+                return out, "divergent", message, nfev, nsteps, None, None
+            exit_ = _first_exit(system, t0 + T * np.arange(1, transient + 1), ends)
             y = ends[:, -1]
         window = int(round((grid[-1] - grid[0]) / T))
         F = ca.integrator("window", method, dae, grid[0], grid[1:], options(window))
@@ -371,10 +423,29 @@ def _casadi_run(system, x0, t0, grid, method, rtol, atol, steps, spp, bound):
         work = _casadi_work(F, method)
         nfev, nsteps = nfev + work[0], nsteps + work[1]
     except RuntimeError as err:
-        first = str(err).strip().splitlines()[-1][:200]
-        raise SimulationError(f"{method} failed: {first}") from None
+        raise SimulationError(_casadi_failure(method, str(err))) from None
     x = np.concatenate([y[:, None], rest], axis=1)
-    return x, "ok", "", nfev, nsteps, None
+    return x, "ok", "", nfev, nsteps, None, exit_
+
+
+def _casadi_failure(method: str, text: str) -> str:
+    """One readable line from a CasADi/SUNDIALS error (no source paths)."""
+    import re
+
+    flag = re.search(r"\b(CV_[A-Z_]+)\b", text)
+    if flag:
+        why = {
+            "CV_TOO_MUCH_WORK": "too many steps: the state may be growing without bound, "
+            "or the problem needs another method",
+            "CV_CONV_FAILURE": "the corrector did not converge (a stiff or diverging run)",
+            "CV_ERR_FAILURE": "the error test failed repeatedly (a kink or a blow-up)",
+        }
+        return f"{method} stopped ({flag.group(1)}): {why.get(flag.group(1), 'see SUNDIALS')}"
+    if "rootfinder" in text:
+        return (f"{method}: the Newton iteration inside a collocation step failed; use more "
+                "steps per period or another method")  # fmt: skip
+    last = [ln for ln in text.strip().splitlines() if ln.strip()][-1]
+    return f"{method} failed: {last.split(': ')[-1][:160]}"
 
 
 def _casadi_work(F, method: str) -> tuple[int, int]:

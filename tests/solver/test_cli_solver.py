@@ -93,25 +93,25 @@ def test_reproduce_quick_writes_the_report(tmp_path, capsys):
         assert (tmp_path / name).stat().st_size > 1000
 
 
-@pytest.mark.parametrize(
-    "argv,fragment",
-    [
-        (
-            ["simulate", "reference-light", "--set", "omega=0"],
-            "omega (the excitation frequency) must be > 0",
-        ),
-        (["sweep", "reference-light", "--param", "lambda", "--range", "nan:1:3"], "must be finite"),
-        (
-            ["sweep", "reference-light", "--param", "lambda", "--range", "0:1:2:7"],
-            "expected START:STOP:NUM",
-        ),
-        (["sweep", "reference-light", "--param", "lambda", "--range", "0:1:1"], "NUM must be >= 2"),
-        (
-            ["sweep", "reference-light", "--param", "lamda", "--range", "0:1:3"],
-            "unknown parameter(s) ['lamda']",
-        ),
-    ],
-)
+BAD_COMMANDS = [
+    (
+        ["simulate", "reference-light", "--set", "omega=0"],
+        "omega (the excitation frequency) must be > 0",
+    ),
+    (["sweep", "reference-light", "--param", "lambda", "--range", "nan:1:3"], "must be finite"),
+    (
+        ["sweep", "reference-light", "--param", "lambda", "--range", "0:1:2:7"],
+        "expected START:STOP:NUM",
+    ),
+    (["sweep", "reference-light", "--param", "lambda", "--range", "0:1:1"], "NUM must be >= 2"),
+    (
+        ["sweep", "reference-light", "--param", "lamda", "--range", "0:1:3"],
+        "unknown parameter(s) ['lamda']",
+    ),
+]
+
+
+@pytest.mark.parametrize("argv,fragment", BAD_COMMANDS)
 def test_solver_commands_fail_in_one_line(argv, fragment, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err
