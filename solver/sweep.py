@@ -148,6 +148,18 @@ def _failed(system: System, value: float, error: Exception) -> dict:
     }
 
 
+def _checked(system: System, parameter: str, values) -> np.ndarray:
+    """The sweep values as an array, after checking them and the parameter's name."""
+    values = np.asarray(values, dtype=float)
+    if values.ndim != 1 or values.size == 0 or not np.all(np.isfinite(values)):
+        raise ValueError("sweep values must be a non-empty list of finite numbers")
+    try:
+        system.with_values(**{parameter: float(values[0])})  # an unknown name fails here
+    except KeyError as err:
+        raise ValueError(err.args[0]) from None
+    return values
+
+
 @dataclass(frozen=True)
 class _Chain:
     """One worker task: a continuation chain, or a single independent point.
@@ -241,13 +253,7 @@ def _open_store(store: Path, manifest: dict) -> dict[int, dict]:
 def _plan(system: System, parameter: str, values, *, continuation: bool, backward: bool,
           x0, settings: dict, done: dict | None = None,
           store: Path | None = None) -> list[_Chain]:  # fmt: skip
-    values = np.asarray(values, dtype=float)
-    if values.ndim != 1 or values.size == 0 or not np.all(np.isfinite(values)):
-        raise ValueError("sweep values must be a non-empty list of finite numbers")
-    try:
-        system.with_values(**{parameter: float(values[0])})  # an unknown name fails here
-    except KeyError as err:
-        raise ValueError(err.args[0]) from None
+    values = _checked(system, parameter, values)
     order = [float(v) for v in (values[::-1] if backward else values)]
     x0 = None if x0 is None else [float(v) for v in x0]
     done = done or {}
@@ -327,7 +333,7 @@ def sweep(
     """
     direction = ("backward" if backward else "forward") if continuation else "independent"
     x0_list = None if x0 is None else [float(v) for v in x0]
-    values = np.asarray(values, dtype=float)
+    values = _checked(system, parameter, values)  # before any folder is created
     done: dict[int, dict] = {}
     if store is not None:
         manifest = {
