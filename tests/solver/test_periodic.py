@@ -169,3 +169,33 @@ def test_dead_zone_multipliers_converge_with_located_crossings():
         _, M, _ = FlowMap(system, rtol=rtol, atol=rtol * 1e-2).with_jacobian(ref.x0, system.period)
         errors.append(np.max(np.abs(np.sort_complex(np.linalg.eigvals(M)) - exact)))
     assert errors[0] > errors[1] > errors[2] and errors[2] < 1e-8, errors
+
+
+def test_known_nonlinear_orbit_and_its_multipliers():
+    # x = A cos(tau) solves the designed Duffing oscillator exactly (tests/solver/
+    # designed_model.py).  Its multipliers come from Hill's equation
+    # y'' + k y' + 3 A^2 cos^2(tau) y = 0, integrated here independently with SciPy, and
+    # their product is exp(-k T) exactly (Liouville).
+    from scipy.integrate import solve_ivp
+
+    k, A = 0.1, 1.5
+    system = System.load(HERE / "designed_model.py", k=k, A=A)
+    # The orbit is only as accurate as the flow: integrate it at reference tolerance.
+    flow = FlowMap(system, rtol=1e-13, atol=1e-15)
+    orbit = shoot(system, np.array([A + 0.1, 0.05]), 1, flow=flow)
+    assert np.max(np.abs(orbit.x0 - [A, 0.0])) < 1e-9
+
+    def hill(t, z):
+        Y = z.reshape(2, 2)
+        J = np.array([[0.0, 1.0], [-3 * A**2 * np.cos(t) ** 2, -k]])
+        return (J @ Y).ravel()
+
+    T = 2 * np.pi
+    Y = (
+        solve_ivp(hill, (0, T), np.eye(2).ravel(), method="DOP853", rtol=1e-12, atol=1e-14)
+        .y[:, -1]
+        .reshape(2, 2)
+    )
+    expected = np.sort_complex(np.linalg.eigvals(Y))
+    assert np.max(np.abs(np.sort_complex(orbit.floquet.multipliers) - expected)) < 1e-8
+    assert abs(np.prod(orbit.floquet.multipliers).real - np.exp(-k * T)) < 1e-9
