@@ -312,10 +312,15 @@ def _write_json(folder: str, name: str, data) -> Path:
 
 def _orbit_guess(system, n: int, settle: int):
     """A starting state on the attractor at tau = 0 (mod nT), from a simulation."""
-    from gearsym.solver.simulate import simulate
+    from gearsym.solver.simulate import SimulationError, simulate
 
-    run = simulate(system, method="cvodes", transient=settle * n, periods=n,
-                   samples_per_period=1)  # fmt: skip
+    if n < 1 or settle < 0:
+        raise _Fail(f"--period must be >= 1 and --settle >= 0 (got {n} and {settle})")
+    try:
+        run = simulate(system, method="cvodes", transient=settle * n, periods=n,
+                       samples_per_period=1)  # fmt: skip
+    except (SimulationError, ValueError) as err:
+        raise _Fail(f"the simulation that gives the initial guess failed: {err}") from None
     if run.status != "ok":
         raise _Fail(f"the simulation that gives the initial guess ended {run.status}: "
                     f"{run.message}")  # fmt: skip
@@ -366,7 +371,7 @@ def _cmd_shoot(args) -> int:
     losing = {"fold": "+1 (fold)", "period-doubling": "-1 (period doubling)",
               "neimark-sacker": "a complex pair (Neimark-Sacker)"}[fl.kind]  # fmt: skip
     print(f"  {'stable' if fl.stable else 'unstable'}; the largest multiplier is on the side of "
-          f"{losing}; Liouville relative error {fl.liouville_error:.2e}")  # fmt: skip
+          f"{losing}; Liouville error |log det M - ∫ tr J| = {fl.liouville_error:.2e}")  # fmt: skip
     for k, v in data.get("monodromy_agreement", {}).items():
         print(f"  monodromy {k}: {v:.2e} (max difference / max entry)")
     return 0
@@ -381,6 +386,10 @@ def _cmd_continue(args) -> int:
     for name in ("from_", "to"):
         if not math.isfinite(getattr(args, name)):
             raise _Fail(f"--{name.rstrip('_')} must be a finite number")
+    if not (args.step > 0 and math.isfinite(args.step)):
+        raise _Fail(f"--step must be a positive number, got {args.step}")
+    if args.period < 1:
+        raise _Fail(f"--period must be >= 1, got {args.period}")
     system = _system(args.scene, _parse_set(args.set))
     try:
         start = system.with_values(**{args.param: args.from_})
@@ -394,6 +403,8 @@ def _cmd_continue(args) -> int:
                                    n=args.period, ds=args.step, ds_max=4 * args.step)]  # fmt: skip
     except ShootingError as err:
         raise _Fail(f"continue: the first orbit was not found: {err}") from None
+    except ValueError as err:
+        raise _Fail(f"continue: {err}") from None
     if args.switch:
         for bif in list(branches[0].bifurcations):
             if bif.kind == "period-doubling":

@@ -134,7 +134,7 @@ def _correct(prob: _Problem, z_pred, t, tol=1e-10, max_iter=8):
         A = np.vstack([np.hstack([M - np.eye(N), dG[:, None]]), t[None, :]])
         z = z - np.linalg.solve(A, H)
     G, M, dG, q = prob.jacobian(z[:-1], z[-1])
-    if np.max(np.abs(G)) < tol:
+    if max(np.max(np.abs(G)), abs(t @ (z - z_pred))) < tol:
         return z, max_iter, M, q, dG
     raise ShootingError("corrector did not converge", [])
 
@@ -158,6 +158,11 @@ def continue_orbit(
     The first orbit is found by shooting; the branch ends at ``stop``, after
     ``max_points`` points, or when the step falls below ``ds_min``.
     """
+    if not (ds > 0 and ds_min > 0 and ds_max >= ds_min):
+        raise ValueError(f"steps must be positive (ds = {ds}, ds_min = {ds_min}, "
+                         f"ds_max = {ds_max})")  # fmt: skip
+    if n < 1:
+        raise ValueError(f"the period multiple n must be >= 1, got {n}")
     prob = _Problem(system, parameter, n)
     first = shoot(prob.system(start), x0, n)
     z = np.concatenate([first.x0, [start]])
@@ -181,7 +186,8 @@ def continue_orbit(
     while len(branch.values) < max_points:
         try:
             z_new, iters, M_new, q_new, dG_new = _correct(prob, z + ds * t, t)
-        except (ShootingError, np.linalg.LinAlgError, RuntimeError):
+        except (ShootingError, np.linalg.LinAlgError, RuntimeError, ValueError):
+            # ValueError: the step reached parameter values the model refuses (omega <= 0).
             ds /= 2
             if ds < ds_min:
                 branch.message = f"step fell below {ds_min:g} at {parameter} = {z[-1]:.6g}"
@@ -197,11 +203,20 @@ def continue_orbit(
             found = _locate(prob, z, t, ds, k, kind, tests[k], locate_tol)
             if kind != "neimark-sacker" or abs(abs(found.multiplier) - 1.0) < 1e-3:
                 branch.bifurcations.append(found)
-        z, t, tests = z_new, t_new, tests_new
-        record(z, floquet(M_new, q_new))
-        if not lo - 1e-12 <= z[-1] <= hi + 1e-12:
+        if not lo - 1e-12 <= z_new[-1] <= hi + 1e-12:
+            # Land on the end of the range: shoot at the end value from the state
+            # interpolated between the last two points (the point past it is not kept).
+            end = hi if z_new[-1] > hi else lo
+            w = (end - z[-1]) / (z_new[-1] - z[-1]) if z_new[-1] != z[-1] else 1.0
+            try:
+                last = shoot(prob.system(end), z[:-1] + w * (z_new[:-1] - z[:-1]), n)
+                record(np.concatenate([last.x0, [end]]), last.floquet)
+            except (ShootingError, ValueError, RuntimeError):
+                pass
             branch.message = f"reached the end of [{lo:g}, {hi:g}]"
             break
+        z, t, tests = z_new, t_new, tests_new
+        record(z, floquet(M_new, q_new))
         ds = min(ds * 1.5, ds_max) if iters <= 3 else max(ds / 1.5, ds_min)
     else:
         branch.message = f"stopped after {max_points} points"
@@ -217,7 +232,7 @@ def _locate(prob, z0, t0, ds, k, kind, f0, tol) -> Bifurcation:
         mid = (a + b) / 2
         try:
             z_try, _, M_try, _, _ = _correct(prob, z0 + mid * t0, t0, max_iter=12)
-        except (ShootingError, np.linalg.LinAlgError, RuntimeError):
+        except (ShootingError, np.linalg.LinAlgError, RuntimeError, ValueError):
             break  # keep the bracket reached so far
         z_mid, M = z_try, M_try
         f = _tests(M)[k]
@@ -282,7 +297,7 @@ def switch_period_doubling(system: System, parameter: str, bif: Bifurcation, n: 
                     # Continue with the section at tau = 0 (mod 2nT), like the parent branch.
                     x_start = FlowMap(here)(orbit.x0, (-orbit.t0) % (2 * n * here.period),
                                             orbit.t0)  # fmt: skip
-                end = stop if side == toward else bif.value - side * abs(stop - bif.value)
+                end = stop if side == toward else bif.value + side * abs(stop - bif.value)
                 return continue_orbit(system, parameter, lam, end, x_start, n=2 * n, **kwargs)
     raise ShootingError(
         f"no period-{2 * n} orbit found next to the period doubling at "

@@ -169,7 +169,7 @@ def test_shoot_json_reports_the_orbit_and_its_multipliers(tmp_path, capsys):
     assert set(data["x0"]) == {"u", "v", "du", "dv"} and data["period_tau"] > 0
     fl = data["floquet"]
     assert len(fl["multipliers"]) == 4 and fl["stable"] is True
-    assert fl["liouville_relative_error"] < 1e-8
+    assert fl["liouville_error"] < 1e-8
     assert max(data["monodromy_agreement"].values()) < 1e-6
     assert (tmp_path / "multipliers.png").stat().st_size > 1000
 
@@ -201,3 +201,79 @@ def test_continue_lists_the_folds_of_the_light_load_branch(tmp_path, capsys):
     folds = sorted(b["value"] for b in branches[0]["bifurcations"])
     # The hysteresis window of the brute-force sweeps, [0.3, 0.8], lies between them.
     assert 0.25 < folds[0] < 0.3 and 0.8 < folds[1] < 0.85
+
+
+@pytest.mark.parametrize(
+    "argv,fragment",
+    [
+        (
+            [
+                "continue",
+                "reference-light",
+                "--param",
+                "lambda",
+                "--from",
+                "0.5",
+                "--to",
+                "0.6",
+                "--step",
+                "0",
+            ],
+            "--step must be a positive number",
+        ),
+        (
+            [
+                "continue",
+                "reference-light",
+                "--param",
+                "lambda",
+                "--from",
+                "0.5",
+                "--to",
+                "0.6",
+                "--period",
+                "0",
+            ],
+            "--period must be >= 1",
+        ),
+        (["shoot", "reference-light", "--settle", "-1"], "--settle >= 0"),
+    ],
+)
+def test_orbit_commands_fail_in_one_line(argv, fragment, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and fragment in err, err
+
+
+def test_continuing_into_refused_parameter_values_ends_the_branch(tmp_path, capsys):
+    # omega must stay > 0: the branch stops with a message instead of a traceback.
+    code = main(
+        [
+            "continue",
+            "reference-light",
+            "--param",
+            "omega",
+            "--from",
+            "0.3",
+            "--to",
+            "0.0",
+            "--step",
+            "0.1",
+            "--settle",
+            "50",
+            "--out",
+            str(tmp_path),
+        ]
+    )
+    assert code == 0
+    out = capsys.readouterr().out
+    assert "step fell below" in out or "reached the end" in out
+
+
+def test_long_periods_do_not_break_the_liouville_check(capsys):
+    # omega = 0.002 (a period of 3142): det M is about exp(-377); the check compares
+    # logarithms and reports null when round-off has taken det M (no division by zero).
+    argv = ["shoot", "reference-light", "--set", "omega=0.002", "--settle", "2", "--json"]
+    assert main(argv) == 0
+    error = json.loads(capsys.readouterr().out)["floquet"]["liouville_error"]
+    assert error is None or error >= 0
