@@ -85,6 +85,10 @@ class Table:
     def error(self, name: str, message: str) -> InputError:
         return InputError(self.source, self.key(name), message)
 
+    def where(self, name: str) -> str:
+        """``source: key`` for messages that are not errors (warnings)."""
+        return f"{self.source}: {self.key(name)}"
+
     def has(self, name: str) -> bool:
         """Whether ``name`` is present; it counts as a known key from then on."""
         self._seen.add(name)

@@ -18,6 +18,8 @@ from .audit import audit_page, index_page
 from .emit import emit_module, write_atomic
 from .model import Model, derive_model
 from .scene import builtin_root, load_target
+from .stiffness_report import stiffness_page
+from .topology import load_topology
 
 __all__ = [
     "Built",
@@ -28,6 +30,7 @@ __all__ = [
     "project_root",
     "shipped_targets",
     "write_files",
+    "write_stiffness_figure",
 ]
 
 
@@ -80,7 +83,34 @@ def build_files(
         )
     if index:
         files["docs/derivation.md"] = index_page(models, "gearsym derive")
+        files[STIFFNESS_PAGE] = stiffness_page(
+            load_topology(_reference_topology()), "gearsym derive", Path(STIFFNESS_FIGURE).name
+        )
     return Built(tuple(models), files)
+
+
+STIFFNESS_PAGE = "docs/stiffness.md"
+STIFFNESS_FIGURE = "docs/stiffness.png"
+
+
+def _reference_topology() -> Path:
+    return builtin_root() / "topologies" / "diso.toml"
+
+
+def write_stiffness_figure(root: Path) -> Path:
+    """Draw ``docs/stiffness.png`` (k(t) of the reference stage's first mesh)."""
+    from .stiffness_report import _pem, plot_mesh
+
+    topology = load_topology(_reference_topology())
+    mesh = topology.meshes[0]
+    path = Path(root) / STIFFNESS_FIGURE
+    path.parent.mkdir(parents=True, exist_ok=True)
+    plot_mesh(
+        _pem(topology, mesh, 200, 3),
+        path,
+        f"{topology.name}: mesh {mesh.id} ({mesh.driver} drives {mesh.driven})",
+    )
+    return path
 
 
 def write_files(files: dict[str, str], root: Path) -> list[Path]:
@@ -103,6 +133,8 @@ def check(root: Path | None = None) -> list[str]:
             stale.append(f"{rel} (missing)")
         elif path.read_text(encoding="utf-8") != text:
             stale.append(f"{rel} (differs)")
+    if not (root / STIFFNESS_FIGURE).exists():
+        stale.append(f"{STIFFNESS_FIGURE} (missing)")
     owned = set(built.files)
     for folder, pattern in (("generated", "*.py"), ("docs/derivation", "*.md")):
         for path in sorted((root / folder).glob(pattern)):

@@ -15,12 +15,14 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
 
 from ._input import Table, load_toml, nearest
 from .geometry import GearGeometry, PairGeometry, gear_geometry, pair_geometry
+from .pem import pem_stiffness
 from .stiffness import MeshStiffness, contact_line_stiffness
 
 __all__ = [
@@ -197,8 +199,35 @@ def _gear(t: Table, materials: dict[str, Material]) -> Gear:
             + nearest(mat_name, materials)
             + f"; materials: {', '.join(sorted(materials))}",
         )
-    geometry = gear_geometry(teeth, mn, alpha_n, beta, shift)
-    bore = t.number("bore_radius_mm", 0.0, low=0.0) * 1e-3
+    dedendum = t.number("rack_dedendum", 1.25, low=1.0, high=1.6)
+    rack_root = t.number("rack_root_radius", 0.38, low=0.0, high=0.6)
+    try:
+        geometry = gear_geometry(teeth, mn, alpha_n, beta, shift, 1.0, dedendum, rack_root)
+    except ValueError as err:
+        raise t.error("rack_root_radius", str(err)) from None
+    sa = geometry.tip_thickness
+    if sa <= 0.0:
+        raise t.error(
+            "profile_shift",
+            f"{teeth} teeth with profile shift {shift:g} are pointed (tip thickness "
+            f"{sa * 1e3:.3f} mm); lower the profile shift",
+        )
+    if sa < 0.2 * mn:
+        warnings.warn(
+            f"{t.where('profile_shift')}: tip thickness {sa * 1e3:.3f} mm is below 0.2 mn; the "
+            "tip is nearly pointed -- lower the profile shift",
+            stacklevel=2,
+        )
+    if geometry.undercut:
+        warnings.warn(
+            f"{t.where('teeth')}: {teeth} teeth with profile shift {shift:g} are undercut by the "
+            "generating rack; the tooth-stiffness models assume a full involute -- raise "
+            "profile_shift",
+            stacklevel=2,
+        )
+    # Default bore: h_f = r_f / r_int = 3, inside the range of the fillet-foundation formula
+    # (Sainsot et al. 2004: 1.4 <= h_f <= 7).
+    bore = t.number("bore_radius_mm", geometry.root_radius / 3.0 * 1e3, low=0.0) * 1e-3
     if bore >= geometry.root_radius:
         raise t.error(
             "bore_radius_mm",
@@ -223,8 +252,10 @@ def _gear(t: Table, materials: dict[str, Material]) -> Gear:
     )
 
 
-def _stiffness(t: Table, pair: PairGeometry) -> MeshStiffness:
-    source = t.string("source", choices=("harmonics", "contact-line"))
+def _stiffness(t: Table, pair: PairGeometry, gears: tuple[Gear, Gear]) -> MeshStiffness:
+    source = t.string("source", choices=("harmonics", "contact-line", "potential-energy"))
+    if source == "potential-energy":
+        return _pem_stiffness(t, pair, gears)
     mean = t.number("mean_N_per_m", low=0, low_open=True)
     if source == "harmonics":
         cos = t.numbers("cos_N_per_m", [])
@@ -237,6 +268,53 @@ def _stiffness(t: Table, pair: PairGeometry) -> MeshStiffness:
     t.finish()
     return contact_line_stiffness(
         mean, pair.transverse_contact_ratio, pair.axial_contact_ratio, harmonics
+    )
+
+
+def _pem_stiffness(t: Table, pair: PairGeometry, gears: tuple[Gear, Gear]) -> MeshStiffness:
+    """Sliced potential-energy stiffness (``derive/pem.py``); the Fourier coefficients are
+    rounded to 9 significant digits so that generated files do not depend on the last bits
+    of the FFT."""
+    slices = t.integer("slices", 200, low=1, high=100000)
+    harmonics = t.integer("harmonics", 10, low=0, high=64)
+    samples = t.integer("samples", 2048, low=64, high=1 << 20)
+    if 2 * harmonics >= samples:
+        raise t.error("samples", f"needs more than {2 * harmonics} samples per mesh period")
+    t.finish()
+    for gear in gears:
+        if gear.geometry.undercut:
+            raise t.error(
+                "source",
+                f"gear '{gear.id}' is undercut; the potential-energy tooth model assumes a full "
+                "involute -- raise its profile_shift or give the stiffness as harmonics",
+            )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            res = pem_stiffness(
+                pair,
+                [(g.material.youngs_modulus, g.material.poisson_ratio) for g in gears],
+                [g.bore_radius for g in gears],
+                slices=slices,
+                harmonics=harmonics,
+                samples=samples,
+                names=tuple(g.id for g in gears),
+            )
+        except ValueError as err:
+            raise t.error(
+                "source", f"the potential-energy method cannot be applied: {err}"
+            ) from None
+    for w in caught:
+        warnings.warn(f"{t.where('source')}: {w.message}", stacklevel=3)
+
+    def r9(x: float) -> float:
+        return float(f"{x:.9g}")
+
+    return MeshStiffness(
+        r9(res.mean),
+        tuple(r9(c) for c in res.cos),
+        tuple(r9(c) for c in res.sin),
+        "potential-energy",
     )
 
 
@@ -254,6 +332,30 @@ def _check_contact(t: Table, pair: PairGeometry, ends: list[str]) -> None:
                 f"involute interference: the tip of '{other}' reaches below the base circle of "
                 f"'{gear}' ({length * 1e3:.3f} mm of contact path against {available * 1e3:.3f} "
                 "mm available); use more teeth or a positive profile shift",
+            )
+    for tip, root, a, b in (
+        (pair.driver, pair.driven, ends[0], ends[1]),
+        (pair.driven, pair.driver, ends[1], ends[0]),
+    ):
+        clearance = pair.centre_distance - tip.tip_radius - root.root_radius
+        if clearance < 0.0:
+            raise t.error(
+                "driven",
+                f"the tip of '{a}' runs {-clearance * 1e3:.3f} mm into the root circle of "
+                f"'{b}' (negative tip clearance); lower the profile shifts or deepen the "
+                "rack_dedendum",
+            )
+    (sap1, _), (sap2, _) = pair.active_radii
+    for sap, geo, gear, other in (
+        (sap1, pair.driver, ends[0], ends[1]),
+        (sap2, pair.driven, ends[1], ends[0]),
+    ):
+        if sap < geo.form_radius * (1 - 1e-12):
+            raise t.error(
+                "driven",
+                f"tip interference: the tip of '{other}' meets '{gear}' at radius "
+                f"{sap * 1e3:.3f} mm, below its form circle ({geo.form_radius * 1e3:.3f} mm), "
+                "in the fillet; use a positive profile shift on it or a smaller rack_root_radius",
             )
     if pair.total_contact_ratio < 1.0:
         raise t.error(
@@ -372,7 +474,7 @@ def parse_topology(data: dict, source: str) -> Topology:
                 f"'{coordinate}' is reserved; avoid {', '.join(sorted(_RESERVED))} and g1, g3, ...",
             )
         backlash = mt.number("half_backlash_um", low=0, low_open=True) * 1e-6
-        stiffness = _stiffness(mt.table("stiffness"), pair)
+        stiffness = _stiffness(mt.table("stiffness"), pair, (g1, g2))
         te = _transmission_error(mt.table("transmission_error", None))
         phase, phase_source = _phase(mt, meshes, ends, by_id)
         mt.finish()

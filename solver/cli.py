@@ -46,6 +46,7 @@ def _cmd_derive(args) -> int:
         project_root,
         shipped_targets,
         write_files,
+        write_stiffness_figure,
     )
     from gearsym.derive.scene import resolve_target
 
@@ -76,6 +77,8 @@ def _cmd_derive(args) -> int:
     built = build_files(paths, index=shipped, overrides=_parse_set(args.set))
     root = Path(args.out) if args.out else project_root()
     written = [] if args.dry_run else write_files(built.files, root)
+    if shipped and not args.dry_run:
+        written.append(write_stiffness_figure(root))
     if args.json:
         print(describe_json(built.models))
         return 0
@@ -190,6 +193,94 @@ def _analysis_settings(args) -> dict:
     return dict(method=args.method, rtol=args.rtol, atol=args.atol, transient=args.transient,
                 periods=args.periods, lyapunov_periods=args.lyapunov_periods,
                 on_invalid=args.on_invalid)  # fmt: skip
+
+
+def _cmd_stiffness(args) -> int:
+    import json
+    import warnings
+
+    from gearsym.derive._input import load_toml, nearest
+    from gearsym.derive.scene import load_scene, resolve_target
+    from gearsym.derive.stiffness_report import mesh_report, plot_mesh
+    from gearsym.derive.topology import load_topology
+
+    if args.slices < 1 or args.slices > 100000:
+        raise _Fail(f"--slices {args.slices}: give a number of slices from 1 to 100000")
+    if not 0 <= args.harmonics <= 64:
+        raise _Fail(f"--harmonics {args.harmonics}: give 0 to 64 harmonics")
+    path = resolve_target(args.target)
+    data = load_toml(path)
+    topology = load_scene(path).topology if "scene" in data else load_topology(path)
+    meshes = topology.meshes
+    if args.mesh:
+        ids = [m.id for m in meshes]
+        if args.mesh not in ids:
+            raise _Fail(
+                f"--mesh {args.mesh}: no such mesh in {topology.name}"
+                + nearest(args.mesh, ids)
+                + f"; meshes: {', '.join(ids)}"
+            )
+        meshes = [m for m in meshes if m.id == args.mesh]
+    reports = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for mesh in meshes:
+            rep, res = mesh_report(topology, mesh, slices=args.slices, harmonics=args.harmonics)
+            reports.append(rep)
+            if args.plot:
+                plot = Path(args.plot)
+                if len(meshes) > 1:
+                    plot = plot.with_name(f"{plot.stem}_{mesh.id}{plot.suffix or '.png'}")
+                plot_mesh(res, plot, f"{topology.name}: mesh {mesh.id}")
+                rep["plot"] = str(plot)
+    if args.json:
+        print(json.dumps({"topology": topology.name, "meshes": reports}, indent=2))
+        return 0
+    for rep in reports:
+        cr, pem, iso = rep["contact_ratio"], rep["pem"], rep["iso6336"]
+        print(
+            f"mesh {rep['mesh']} ({rep['driver']} drives {rep['driven']}), "
+            f"b = {rep['face_width_mm']:g} mm"
+        )
+        print(
+            f"  contact ratios: transverse {cr['transverse']:.4f}, axial {cr['axial']:.4f}, "
+            f"total {cr['total']:.4f}"
+        )
+        print(
+            f"  PEM ({pem['slices']} slices): km = {pem['mean_N_per_m']:.5e} N/m "
+            f"(normal line of action; transverse {pem['mean_transverse_N_per_m']:.5e}), "
+            f"k in [{pem['min_N_per_m']:.4e}, {pem['max_N_per_m']:.4e}]"
+        )
+        for h in pem["harmonics"]:
+            print(
+                f"    k_{h['order']}: cos {h['cos_N_per_m']:+.5e}, sin {h['sin_N_per_m']:+.5e} "
+                f"N/m, |k_{h['order']}|/km = {h['ratio']:.5f}"
+            )
+        print(
+            f"    fit residual: RMS {pem['fit_residual_rms']:.2e}, max "
+            f"{pem['fit_residual_max']:.2e} of km"
+        )
+        print(
+            f"  ISO 6336-1 method B: c'th = {iso['c_th']:.3f}, c' = {iso['c_prime']:.3f}, "
+            f"c_gamma_alpha = {iso['c_gamma_alpha']:.3f}, c_gamma_beta = "
+            f"{iso['c_gamma_beta']:.3f} N/(mm um); k = c_gamma_alpha b = "
+            f"{iso['k_from_c_gamma_alpha_N_per_m']:.5e} N/m"
+        )
+        print(f"  PEM / ISO = {rep['pem_over_iso']:.4f}")
+        print(
+            f"  phase lag {rep['phase']['rad']:.6f} rad ({rep['phase']['source']}); "
+            f"transmission error {rep['transmission_error']['amplitude_um']} um"
+        )
+        conv = ", ".join(
+            f"N={r['slices']}: |k_1|/km={r['ratios'][0]:.5f}" if r["ratios"] else f"N={r['slices']}"
+            for r in rep["convergence"]
+        )
+        print(f"  convergence: {conv}")
+        for w in rep["warnings"]:
+            print(f"  warning: {w}")
+        if "plot" in rep:
+            print(f"  wrote {rep['plot']}")
+    return 0
 
 
 def _cmd_simulate(args) -> int:
@@ -518,6 +609,39 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--continuous", action="store_true", help="continuous L2 fit instead of samples")
     b.add_argument("--json", action="store_true", help="print JSON")
     b.set_defaults(func=_cmd_backlash)
+
+    st = sub.add_parser("stiffness", help="mesh stiffness from gear geometry (PEM and ISO 6336)",
+                        description="Time-varying mesh stiffness of each mesh of a topology "
+                        "(or a scene's topology) by the sliced potential-energy method, its "
+                        "Fourier fit, the ISO 6336-1 method B cross-check, the layout phase "
+                        "and the transmission error.")  # fmt: skip
+    st.add_argument(
+        "target",
+        metavar="PAIR_OR_SCENE",
+        help="a topology or scene: .toml path or built-in name (e.g. diso)",
+    )
+    st.add_argument("--mesh", metavar="ID", help="only this mesh")
+    st.add_argument(
+        "--slices",
+        type=int,
+        default=200,
+        metavar="N",
+        help="transverse slices across the face width (default 200)",
+    )
+    st.add_argument(
+        "--harmonics",
+        type=int,
+        default=3,
+        metavar="H",
+        help="harmonics in the Fourier fit (default 3)",
+    )
+    st.add_argument("--json", action="store_true", help="print everything as JSON")
+    st.add_argument(
+        "--plot",
+        metavar="FILE",
+        help="draw k(t), its harmonic fit and one tooth pair (FILE_<mesh> for several meshes)",
+    )
+    st.set_defaults(func=_cmd_stiffness)
 
     si = sub.add_parser("simulate", help="simulate one operating point and classify it",
                         description="Simulate a scene, discard the transient, and report the "

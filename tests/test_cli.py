@@ -5,7 +5,13 @@ import subprocess
 import sys
 
 import pytest
-from gearsym.derive.build import build_files, check, shipped_targets, write_files
+from gearsym.derive.build import (
+    build_files,
+    check,
+    shipped_targets,
+    write_files,
+    write_stiffness_figure,
+)
 from gearsym.solver.cli import main
 
 
@@ -23,6 +29,8 @@ def test_derive_check_is_clean_on_the_checkout(capsys):
 
 def test_check_names_a_stale_file(tmp_path):
     write_files(build_files(shipped_targets(), index=True).files, tmp_path)
+    assert check(tmp_path) == ["docs/stiffness.png (missing)"]
+    write_stiffness_figure(tmp_path)
     assert check(tmp_path) == []
     target = tmp_path / "generated" / "siso.py"
     target.write_text(target.read_text() + "# edited by hand\n")
@@ -117,3 +125,36 @@ def test_console_script_runs_without_traceback_on_bad_input(tmp_path):
     assert "Traceback" not in proc.stderr
     assert proc.stderr.count("\n") == 1
     assert "scene.topology: is required but missing" in proc.stderr
+
+
+def test_stiffness_command_reports_pem_iso_and_phase(tmp_path, capsys):
+    # Acceptance of the stiffness issue on the reference gears: contact ratios 1.76 / 0.69
+    # / 2.45 (the study's Table 1), km within 25 % of ISO 6336-1's c_gamma_alpha b, the
+    # layout phase 2 pi / 3 of diso.toml's 120 deg (100 teeth * 120/360 = 33 1/3).
+    import json
+    import math
+
+    plot = tmp_path / "k.png"
+    assert main(["stiffness", "diso", "--json", "--plot", str(plot)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    pg, qg = out["meshes"]
+    cr = pg["contact_ratio"]
+    assert (round(cr["transverse"], 2), round(cr["axial"], 2), round(cr["total"], 2)) == (
+        1.76,
+        0.69,
+        2.45,
+    )
+    assert 0.75 <= pg["pem_over_iso"] <= 1.25
+    assert (
+        pg["pem_over_iso"]
+        == pg["pem"]["mean_N_per_m"] / pg["iso6336"]["k_from_c_gamma_alpha_N_per_m"]
+    )
+    assert len(pg["pem"]["harmonics"]) == 3
+    assert [r["slices"] for r in pg["convergence"]] == [10, 50, 200, 1000]
+    assert qg["phase"]["rad"] == pytest.approx(2 * math.pi / 3, rel=1e-12)
+    assert qg["transmission_error"]["amplitude_um"] == [5.0]
+    assert (tmp_path / "k_pg.png").stat().st_size > 0
+    assert (tmp_path / "k_qg.png").stat().st_size > 0
+    assert main(["stiffness", "reference-light", "--mesh", "pg", "--harmonics", "5"]) == 0
+    text = capsys.readouterr().out
+    assert "k_5:" in text and "PEM / ISO" in text

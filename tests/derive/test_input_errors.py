@@ -79,9 +79,28 @@ TOPOLOGY_CASES = [
     ),
     (
         "unknown stiffness source",
-        'source = "contact-line"',
+        'source = "potential-energy"',
         'source = "pem"',
-        "mesh[0].stiffness.source: 'pem' is not one of 'harmonics', 'contact-line'",
+        "mesh[0].stiffness.source: 'pem' is not one of 'harmonics', 'contact-line', "
+        "'potential-energy'",
+    ),
+    (
+        "too few samples for the harmonics",
+        "slices = 200, harmonics = 10 }",
+        "slices = 200, harmonics = 40, samples = 64 }",
+        "mesh[0].stiffness.samples: needs more than 80 samples per mesh period",
+    ),
+    (
+        "zero slices",
+        "slices = 200, harmonics = 10 }",
+        "slices = 0, harmonics = 10 }",
+        "mesh[0].stiffness.slices: must be >= 1, got 0",
+    ),
+    (
+        "rack root radius too large",
+        'id = "p"\n',
+        'id = "p"\nrack_root_radius = 0.9\n',
+        "gear[0].rack_root_radius: must be <= 0.6, got 0.9",
     ),
     (
         "negative half backlash",
@@ -149,8 +168,8 @@ TOPOLOGY_CASES = [
     ),
     (
         "vanishing stiffness",
-        "mean_N_per_m = 1.0e9",
-        "mean_N_per_m = 1e-320",
+        '{ source = "potential-energy", slices = 200, harmonics = 10 }',
+        '{ source = "harmonics", mean_N_per_m = 1e-320 }',
         "is not finite; check the stiffness",
     ),
     (
@@ -371,7 +390,7 @@ def test_layout_rule_refuses_an_idler(tmp_path, capsys):
 def test_more_harmonics_than_the_mesh_gives(files, capsys, root):
     tmp, topo, scene = files
     topo = topo.replace(
-        'stiffness = { source = "contact-line", mean_N_per_m = 1.0e9, harmonics = 10 }',
+        'stiffness = { source = "potential-energy", slices = 200, harmonics = 10 }',
         'stiffness = { source = "harmonics", mean_N_per_m = 1.0e9, cos_N_per_m = [1e7], '
         "sin_N_per_m = [0.0] }",
     )
@@ -398,3 +417,72 @@ def test_negative_profile_shifts_say_what_is_wrong(tmp_path, capsys):
     assert_one_line_error(
         code, err, path, "(x1 + x2 = -2) leave no positive working pressure angle"
     )
+
+
+def test_undercut_gear_with_the_energy_method_is_refused(tmp_path, capsys):
+    # 12 teeth of a 20 deg rack without profile shift are undercut (limit 17): the
+    # potential-energy tooth assumes a full involute; the loader warns, the method refuses.
+    path = tmp_path / "undercut.toml"
+    path.write_text(
+        '[topology]\nname = "undercut"\n'
+        '[[gear]]\nid = "p"\nteeth = 12\nnormal_module_mm = 4\nface_width_mm = 40\n'
+        "profile_shift = 0.0\n"
+        '[[gear]]\nid = "g"\nteeth = 12\nnormal_module_mm = 4\nface_width_mm = 40\n'
+        "profile_shift = 0.6\n"
+        '[[mesh]]\nid = "pg"\ndriver = "p"\ndriven = "g"\ncoordinate = "u"\n'
+        'half_backlash_um = 50\nstiffness = { source = "potential-energy" }\n'
+    )
+    with pytest.warns(UserWarning, match=r"gear\[0\].teeth: 12 teeth .* are undercut"):
+        code, err = derive(capsys, path)
+    assert_one_line_error(code, err, path, "mesh[0].stiffness.source: gear 'p' is undercut")
+
+
+def test_mating_tip_in_the_fillet_is_refused(tmp_path, capsys):
+    # A large rack tip rounding raises the form circle above the point where the mating
+    # tip meets the flank: the contact would run into the fillet.
+    path = tmp_path / "fillet.toml"
+    gear = "normal_module_mm = 4\nface_width_mm = 40\nrack_dedendum = 1.1\nrack_root_radius = 0.6\n"
+    path.write_text(
+        '[topology]\nname = "fillet"\n'
+        '[[gear]]\nid = "p"\nteeth = 30\n'
+        + gear
+        + '[[gear]]\nid = "g"\nteeth = 90\n'
+        + gear
+        + '[[mesh]]\nid = "pg"\ndriver = "p"\ndriven = "g"\ncoordinate = "u"\n'
+        'half_backlash_um = 50\nstiffness = { source = "harmonics", mean_N_per_m = 1e9 }\n'
+    )
+    code, err = derive(capsys, path)
+    assert_one_line_error(code, err, path, "tip interference: the tip of 'g' meets 'p'")
+
+
+def _pair_file(tmp_path, pinion, gear):
+    path = tmp_path / "pair.toml"
+    common = "normal_module_mm = 4\nface_width_mm = 40\n"
+    path.write_text(
+        '[topology]\nname = "pair"\n'
+        f'[[gear]]\nid = "p"\n{pinion}\n'
+        + common
+        + f'[[gear]]\nid = "g"\n{gear}\n'
+        + common
+        + '[[mesh]]\nid = "pg"\ndriver = "p"\ndriven = "g"\ncoordinate = "u"\n'
+        'half_backlash_um = 50\nstiffness = { source = "harmonics", mean_N_per_m = 1e9 }\n'
+    )
+    return path
+
+
+def test_pointed_teeth_are_refused(tmp_path, capsys):
+    path = _pair_file(tmp_path, "teeth = 8\nprofile_shift = 1.5", "teeth = 60")
+    code, err = derive(capsys, path)
+    assert_one_line_error(
+        code, err, path, "gear[0].profile_shift: 8 teeth with profile shift 1.5 are pointed"
+    )
+
+
+def test_negative_tip_clearance_is_refused(tmp_path, capsys):
+    # Without tip shortening, large positive shifts on both gears push each tip into the
+    # other's root circle.
+    path = _pair_file(
+        tmp_path, "teeth = 20\nprofile_shift = 0.6", "teeth = 25\nprofile_shift = 1.0"
+    )
+    code, err = derive(capsys, path)
+    assert_one_line_error(code, err, path, "negative tip clearance")

@@ -94,6 +94,10 @@ def test_reproduce_quick_writes_the_report(tmp_path, capsys):
 
 
 BAD_COMMANDS = [
+    (["stiffness", "diso", "--slices", "0"], "--slices 0: give a number of slices"),
+    (["stiffness", "diso", "--harmonics", "-1"], "--harmonics -1: give 0 to 64 harmonics"),
+    (["stiffness", "diso", "--mesh", "pq"], "--mesh pq: no such mesh in diso (did you mean 'qg'?)"),
+    (["stiffness", "disso"], "disso"),
     (
         [
             "continue",
