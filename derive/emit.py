@@ -19,6 +19,7 @@ from pathlib import Path
 import sympy as sp
 from sympy.printing.str import StrPrinter
 
+from .emit_c import c_source
 from .model import Model
 
 __all__ = ["CodePrinter", "emit_module", "operation_count", "write_atomic"]
@@ -188,6 +189,11 @@ def emit_module(model: Model, command: str) -> str:
         + ", ".join(f"{k!r}: {fmt(v)}" for k, v in model.scene_parameters.items())
         + "}",
         f"OPERATIONS = {model.operations!r}",
+        "",
+        "# The right-hand side in C for the compiled integrators (solver/native.py).",
+        "C_SOURCE = r\"\"\"",
+        c_source(model).rstrip("\n"),
+        '"""',
         "",
         "",
         "def rhs(tau, x, p):",

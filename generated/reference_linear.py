@@ -55,6 +55,64 @@ FEATURES = {'stiffness_harmonics': 0, 'backlash': 'linear', 'transmission_error'
 SCENE_PARAMETERS = {'omega': 0.5, 'damping_ratio': 0.03, 'f1': 0.1, 'lambda': 0.1}
 OPERATIONS = {'rhs': 14, 'rhs_and_jacobian': 20}
 
+# The right-hand side in C for the compiled integrators (solver/native.py).
+C_SOURCE = r"""
+/* reference_linear: right-hand side for the compiled integrators (gearsym derive). */
+#define GS_NX 4
+#define GS_NP 9
+#define GS_NQ 1
+
+static void gs_prep(const double *p, double *q)
+{
+    (void)p; (void)q;
+}
+
+static inline void gs_rhs(double tau, const double *x, const double *p, const double *q, double *dx)
+{
+    const double u = x[0];
+    const double v = x[1];
+    const double du = x[2];
+    const double dv = x[3];
+    const double f_u = p[1];
+    const double f_v = p[2];
+    const double xi_u_u = p[3];
+    const double xi_v_v = p[4];
+    const double kappa_u_u = p[5];
+    const double kappa_u_v = p[6];
+    const double kappa_v_u = p[7];
+    const double kappa_v_v = p[8];
+    dx[0] = du;
+    dx[1] = dv;
+    dx[2] = -2*du*xi_u_u + f_u - kappa_u_u*u - kappa_u_v*v;
+    dx[3] = -2*dv*xi_v_v + f_v - kappa_v_u*u - kappa_v_v*v;
+    (void)tau; (void)p; (void)q;
+}
+
+static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
+{
+#pragma GCC ivdep
+    for (int j = 0; j < n; ++j) {
+        const double u = X[0*n + j];
+        const double v = X[1*n + j];
+        const double du = X[2*n + j];
+        const double dv = X[3*n + j];
+        const double f_u = P[1*n + j];
+        const double f_v = P[2*n + j];
+        const double xi_u_u = P[3*n + j];
+        const double xi_v_v = P[4*n + j];
+        const double kappa_u_u = P[5*n + j];
+        const double kappa_u_v = P[6*n + j];
+        const double kappa_v_u = P[7*n + j];
+        const double kappa_v_v = P[8*n + j];
+        DX[0*n + j] = du;
+        DX[1*n + j] = dv;
+        DX[2*n + j] = -2*du*xi_u_u + f_u - kappa_u_u*u - kappa_u_v*v;
+        DX[3*n + j] = -2*dv*xi_v_v + f_v - kappa_v_u*u - kappa_v_v*v;
+    }
+    (void)tau; (void)P; (void)Q;
+}
+"""
+
 
 def rhs(tau, x, p):
     """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); result (n,) or (n, N)."""

@@ -7,7 +7,11 @@ Back ends by name (:data:`METHODS`):
   (and its Jacobian for the implicit ones);
 * CasADi ``integrator``: ``cvodes`` (SUNDIALS, adaptive), ``rk`` (fixed-step RK4 with
   ``steps_per_period`` steps), ``collocation`` (fixed-step implicit Legendre collocation)
-  -- on the CasADi graph of the same equations.
+  -- on the CasADi graph of the same equations;
+* compiled (``solver/native.py``): ``dop853``, ``dopri5`` (SciPy's DOP853/RK45 step
+  control in C on the generated C right-hand side) and ``rk4`` (fixed step,
+  ``steps_per_period`` steps) -- the fastest; without a C compiler they fall back to NumPy
+  with a warning.
 
 The run is split into a transient of ``transient`` forcing periods, discarded, and a
 sampled window of ``periods`` periods with ``samples_per_period`` samples each, aligned
@@ -34,7 +38,8 @@ __all__ = ["METHODS", "SimulationError", "Trajectory", "simulate"]
 
 SCIPY_METHODS = ("RK45", "DOP853", "LSODA", "Radau")
 CASADI_METHODS = ("cvodes", "rk", "collocation")
-METHODS = SCIPY_METHODS + CASADI_METHODS
+NATIVE_METHODS = ("dop853", "dopri5", "rk4")
+METHODS = SCIPY_METHODS + CASADI_METHODS + NATIVE_METHODS
 
 
 class SimulationError(RuntimeError):
@@ -163,7 +168,7 @@ def simulate(
         raise ValueError("periods and samples_per_period must be >= 1")
     if not (isinstance(samples_per_period, int) and isinstance(steps_per_period, int)):
         raise ValueError("samples_per_period and steps_per_period must be whole numbers")
-    unit = {"rk": 1, "collocation": 4}.get(method)
+    unit = {"rk": 1, "rk4": 1, "collocation": 4}.get(method)
     if unit and (steps_per_period < unit * samples_per_period
                  or steps_per_period % (unit * samples_per_period)):  # fmt: skip
         raise ValueError(
@@ -173,7 +178,7 @@ def simulate(
         )
     if not math.isfinite(system.omega) or system.omega <= 0:
         raise ValueError(f"omega must be a positive number, got {system.omega:g}")
-    if method in SCIPY_METHODS and rtol < 100 * np.finfo(float).eps:
+    if method in SCIPY_METHODS + NATIVE_METHODS and rtol < 100 * np.finfo(float).eps:
         raise ValueError(f"rtol {rtol:g} is below what SciPy honours (2.2e-14); use cvodes "
                          "or a larger rtol")  # fmt: skip
     if not (rtol > 0 and atol > 0):
@@ -187,6 +192,9 @@ def simulate(
     started = time.perf_counter()
     if method in SCIPY_METHODS:
         run = _scipy_run(system, x0, t0, grid, method, rtol, atol, max_step, bound, on_invalid)
+    elif method in NATIVE_METHODS:
+        run = _native_run(system, x0, t0, transient, periods, method, rtol, atol,
+                          steps_per_period, samples_per_period, bound)  # fmt: skip
     else:
         run = _casadi_run(
             system, x0, t0, grid, method, rtol, atol, steps_per_period, samples_per_period, bound
@@ -224,7 +232,9 @@ def simulate(
         wall_time=time.perf_counter() - started,
         boundary_crossings=crossings,
         left_valid_range=exit_,
-        options={"steps_per_period": steps_per_period} if method in ("rk", "collocation") else {},
+        options=(
+            {"steps_per_period": steps_per_period} if method in ("rk", "rk4", "collocation") else {}
+        ),
     )
 
 
@@ -426,6 +436,40 @@ def _casadi_run(system, x0, t0, grid, method, rtol, atol, steps, spp, bound):
         raise SimulationError(_casadi_failure(method, str(err))) from None
     x = np.concatenate([y[:, None], rest], axis=1)
     return x, "ok", "", nfev, nsteps, None, exit_
+
+
+def _native_run(system, x0, t0, transient, periods, method, rtol, atol, steps, spp, bound):
+    from .native import run_batch
+
+    res = run_batch(system.module, system.p[None, :], np.asarray(x0, float)[None, :],
+                    method=method, rtol=rtol, atol=atol, t0=t0, transient=transient,
+                    periods=periods, samples_per_period=spp, steps_per_period=steps,
+                    bound=bound, lockstep=False)  # fmt: skip
+    x = res.x[0].T.copy()
+    status = res.status[0]
+    nfev, nsteps = int(res.nfev[0]), int(res.nsteps[0])
+    if status == "ok":
+        return x, "ok", "", nfev, nsteps, None, None
+    t_fail = float(res.t_fail[0])
+    if status == "divergent":
+        return (
+            x,
+            "divergent",
+            f"a state passed |x| = {bound:g} at tau = {t_fail:.6g}",
+            nfev,
+            nsteps,
+            None,
+            None,
+        )
+    return (
+        x,
+        "failed",
+        f"{method} stopped at tau = {t_fail:.6g}: {status}",
+        nfev,
+        nsteps,
+        None,
+        None,
+    )
 
 
 def _casadi_failure(method: str, text: str) -> str:

@@ -1,0 +1,469 @@
+/* gearsym compiled integrators: Dormand-Prince 5(4), DOP853 and classic RK4, many parameter
+ * points per call, stroboscopic/uniform sampling after a transient.
+ *
+ * The step-size control follows SciPy's RK45 and DOP853 (Hairer, Norsett and Wanner,
+ * "Solving Ordinary Differential Equations I", II.4 and II.10): RMS error norm with
+ * scale atol + rtol max(|y|, |y_new|), safety 0.9, factor in [0.2, 10], no growth right after
+ * a rejection, and the same initial-step selection.  Steps are clipped to land on every
+ * sample time; after a clipped step the unclipped proposal is kept.
+ *
+ * The model (gs_prep, gs_rhs, GS_NX, GS_NP, GS_NQ) and the Butcher tables (taken from
+ * SciPy's coefficient arrays) are inserted above this text by solver/native.py.
+ */
+
+#include <math.h>
+#include <string.h>
+
+#define GS_OK 0
+#define GS_DIVERGENT 1
+#define GS_TOO_MANY_STEPS 2
+#define GS_NOT_FINITE 3
+#define GS_STEP_TOO_SMALL 4
+
+typedef struct {
+    int ns;           /* stages */
+    const double *A;  /* ns x ns, row-major */
+    const double *B;  /* ns */
+    const double *C;  /* ns */
+    const double *E;  /* ns + 1 (RK45) or NULL */
+    const double *E3; /* ns + 1 (DOP853) or NULL */
+    const double *E5; /* ns + 1 (DOP853) or NULL */
+    int error_order;
+} gs_tableau;
+
+#define GS_MAXS 13
+
+static double gs_rms(const double *v, const double *scale)
+{
+    double s = 0.0;
+    for (int i = 0; i < GS_NX; ++i) {
+        const double r = v[i] / scale[i];
+        s += r * r;
+    }
+    return sqrt(s / GS_NX);
+}
+
+/* One explicit RK step: fills K[0..ns] (K[ns] = f(t + h, y_new)) and y_new. */
+static void gs_step(const gs_tableau *T, double t, const double *y, const double *f, double h,
+                    const double *p, const double *q, double K[GS_MAXS + 1][GS_NX],
+                    double *ynew)
+{
+    double yt[GS_NX];
+    memcpy(K[0], f, sizeof(double) * GS_NX);
+    for (int s = 1; s < T->ns; ++s) {
+        for (int i = 0; i < GS_NX; ++i) {
+            double acc = 0.0;
+            for (int j = 0; j < s; ++j) acc += T->A[s * T->ns + j] * K[j][i];
+            yt[i] = y[i] + h * acc;
+        }
+        gs_rhs(t + T->C[s] * h, yt, p, q, K[s]);
+    }
+    for (int i = 0; i < GS_NX; ++i) {
+        double acc = 0.0;
+        for (int j = 0; j < T->ns; ++j) acc += T->B[j] * K[j][i];
+        ynew[i] = y[i] + h * acc;
+    }
+    gs_rhs(t + h, ynew, p, q, K[T->ns]);
+}
+
+static double gs_error_norm(const gs_tableau *T, double K[GS_MAXS + 1][GS_NX], double h,
+                            const double *scale)
+{
+    double e[GS_NX];
+    if (T->E) {
+        for (int i = 0; i < GS_NX; ++i) {
+            double acc = 0.0;
+            for (int j = 0; j <= T->ns; ++j) acc += T->E[j] * K[j][i];
+            e[i] = acc * h;
+        }
+        return gs_rms(e, scale);
+    }
+    double e5 = 0.0, e3 = 0.0;
+    for (int i = 0; i < GS_NX; ++i) {
+        double a5 = 0.0, a3 = 0.0;
+        for (int j = 0; j <= T->ns; ++j) {
+            a5 += T->E5[j] * K[j][i];
+            a3 += T->E3[j] * K[j][i];
+        }
+        a5 /= scale[i];
+        a3 /= scale[i];
+        e5 += a5 * a5;
+        e3 += a3 * a3;
+    }
+    if (e5 == 0.0 && e3 == 0.0) return 0.0;
+    return fabs(h) * e5 / sqrt((e5 + 0.01 * e3) * GS_NX);
+}
+
+static double gs_initial_step(double t0, const double *y0, const double *f0, double length,
+                              int order, double rtol, double atol, const double *p,
+                              const double *q, long long *nfev)
+{
+    double scale[GS_NX], tmp[GS_NX], y1[GS_NX], f1[GS_NX];
+    for (int i = 0; i < GS_NX; ++i) scale[i] = atol + fabs(y0[i]) * rtol;
+    const double d0 = gs_rms(y0, scale), d1 = gs_rms(f0, scale);
+    double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
+    if (h0 > length) h0 = length;
+    for (int i = 0; i < GS_NX; ++i) y1[i] = y0[i] + h0 * f0[i];
+    gs_rhs(t0 + h0, y1, p, q, f1);
+    *nfev += 1;
+    for (int i = 0; i < GS_NX; ++i) tmp[i] = f1[i] - f0[i];
+    const double d2 = gs_rms(tmp, scale) / h0;
+    const double dm = d1 > d2 ? d1 : d2;
+    const double h1 = dm <= 1e-15 ? fmax(1e-6, h0 * 1e-3) : pow(0.01 / dm, 1.0 / (order + 1));
+    double h = 100 * h0;
+    if (h1 < h) h = h1;
+    if (length < h) h = length;
+    return h;
+}
+
+static int gs_check(const double *y, double bound)
+{
+    for (int i = 0; i < GS_NX; ++i) {
+        if (!isfinite(y[i])) return GS_NOT_FINITE;
+        if (fabs(y[i]) > bound) return GS_DIVERGENT;
+    }
+    return GS_OK;
+}
+
+/* Advance (t, y, f) to `target` with the adaptive method. */
+static int gs_adaptive_to(const gs_tableau *T, double *t, double *y, double *f, double *h_abs,
+                          double target, double rtol, double atol, const double *p,
+                          const double *q, double bound, long long max_steps, long long *nfev,
+                          long long *nsteps)
+{
+    double K[GS_MAXS + 1][GS_NX], ynew[GS_NX], scale[GS_NX];
+    const double exponent = -1.0 / (T->error_order + 1);
+    while (*t < target) {
+        const double min_step = 10.0 * fabs(nextafter(*t, INFINITY) - *t);
+        double h = *h_abs < min_step ? min_step : *h_abs;
+        int rejected = 0;
+        for (;;) {
+            if (h < min_step) return GS_STEP_TOO_SMALL;
+            double t_new = *t + h;
+            int clipped = 0;
+            if (t_new >= target) {
+                t_new = target;
+                clipped = 1;
+            }
+            const double hh = t_new - *t;
+            gs_step(T, *t, y, f, hh, p, q, K, ynew);
+            *nfev += T->ns;
+            for (int i = 0; i < GS_NX; ++i) {
+                const double a = fabs(y[i]), b = fabs(ynew[i]);
+                scale[i] = atol + (a > b ? a : b) * rtol;
+            }
+            const double err = gs_error_norm(T, K, hh, scale);
+            if (err < 1.0) {
+                double factor = err == 0.0 ? 10.0 : 0.9 * pow(err, exponent);
+                if (factor > 10.0) factor = 10.0;
+                if (rejected && factor > 1.0) factor = 1.0;
+                const double next = hh * factor;
+                /* keep the unclipped proposal after a step shortened to hit a sample */
+                *h_abs = clipped && !rejected && h > next ? h : next;
+                *t = t_new;
+                memcpy(y, ynew, sizeof(double) * GS_NX);
+                memcpy(f, K[T->ns], sizeof(double) * GS_NX);
+                break;
+            }
+            double factor = 0.9 * pow(err, exponent);
+            if (!(factor > 0.2)) factor = 0.2; /* also catches a NaN error norm */
+            h = hh * factor;
+            rejected = 1;
+        }
+        *nsteps += 1;
+        const int c = gs_check(y, bound);
+        if (c != GS_OK) return c;
+        if (*nsteps > max_steps) return GS_TOO_MANY_STEPS;
+    }
+    return GS_OK;
+}
+
+static void gs_rk4_step(double t, double *y, double h, const double *p, const double *q)
+{
+    double k1[GS_NX], k2[GS_NX], k3[GS_NX], k4[GS_NX], yt[GS_NX];
+    gs_rhs(t, y, p, q, k1);
+    for (int i = 0; i < GS_NX; ++i) yt[i] = y[i] + 0.5 * h * k1[i];
+    gs_rhs(t + 0.5 * h, yt, p, q, k2);
+    for (int i = 0; i < GS_NX; ++i) yt[i] = y[i] + 0.5 * h * k2[i];
+    gs_rhs(t + 0.5 * h, yt, p, q, k3);
+    for (int i = 0; i < GS_NX; ++i) yt[i] = y[i] + h * k3[i];
+    gs_rhs(t + h, yt, p, q, k4);
+    for (int i = 0; i < GS_NX; ++i) y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+}
+
+/* method: 0 = Dormand-Prince 5(4), 1 = DOP853, 2 = RK4 with rk4_steps steps per period.
+ * P: npts x GS_NP, X0: npts x GS_NX, OUT: npts x (n_sample*spp + 1) x GS_NX.
+ * Sample k of point i is at t0 + (n_transient + k/spp) period. */
+int gs_run(int method, int npts, const double *P, const double *X0, double t0, double period,
+           int n_transient, int n_sample, int spp, double rtol, double atol, int rk4_steps,
+           double bound, long long max_steps, double *OUT, long long *NFEV, long long *NSTEP,
+           int *STATUS, double *TFAIL)
+{
+    static const gs_tableau RK45 = {6, GS_RK45_A, GS_RK45_B, GS_RK45_C, GS_RK45_E, 0, 0, 4};
+    static const gs_tableau DOP853 = {12, GS_DOP853_A, GS_DOP853_B, GS_DOP853_C, 0,
+                                      GS_DOP853_E3, GS_DOP853_E5, 7};
+    const gs_tableau *T = method == 0 ? &RK45 : &DOP853;
+    const int n_out = n_sample * spp + 1;
+    for (int i = 0; i < npts; ++i) {
+        const double *p = P + (long)i * GS_NP;
+        double q[GS_NQ], y[GS_NX], f[GS_NX];
+        double *out = OUT + (long)i * n_out * GS_NX;
+        long long nfev = 0, nsteps = 0;
+        int status = GS_OK;
+        double t = t0;
+        gs_prep(p, q);
+        memcpy(y, X0 + (long)i * GS_NX, sizeof(double) * GS_NX);
+        double h_abs = 0.0;
+        const double t_end = t0 + (double)(n_transient + n_sample) * period;
+        if (method != 2) {
+            gs_rhs(t, y, p, q, f);
+            nfev += 1;
+            h_abs = gs_initial_step(t, y, f, t_end - t0, T->error_order, rtol, atol, p, q,
+                                    &nfev);
+        }
+        int k = 0;
+        long long done = 0; /* RK4 steps taken */
+        for (; k < n_out; ++k) {
+            const double target =
+                t0 + ((double)n_transient * spp + k) * period / (double)spp;
+            if (method == 2) {
+                /* steps are laid on the global grid t0 + j period / rk4_steps */
+                const long long upto =
+                    ((long long)n_transient * spp + k) * (long long)rk4_steps / spp;
+                const double h = period / rk4_steps;
+                for (; done < upto; ++done) {
+                    gs_rk4_step(t0 + done * h, y, h, p, q);
+                    nfev += 4;
+                    nsteps += 1;
+                    status = gs_check(y, bound);
+                    if (status != GS_OK) {
+                        t = t0 + (done + 1) * h;
+                        break;
+                    }
+                }
+                if (status == GS_OK) t = target;
+            } else {
+                status = gs_adaptive_to(T, &t, y, f, &h_abs, target, rtol, atol, p, q, bound,
+                                        max_steps, &nfev, &nsteps);
+            }
+            if (status != GS_OK) break;
+            memcpy(out + (long)k * GS_NX, y, sizeof(double) * GS_NX);
+        }
+        for (; k < n_out; ++k)
+            for (int j = 0; j < GS_NX; ++j) out[(long)k * GS_NX + j] = NAN;
+        NFEV[i] = nfev;
+        NSTEP[i] = nsteps;
+        STATUS[i] = status;
+        TFAIL[i] = status == GS_OK ? NAN : t;
+    }
+    return 0;
+}
+
+/* Right-hand-side evaluations only (for the throughput benchmark): n calls at one point. */
+double gs_rhs_loop(const double *p, const double *x0, long long n, double dt)
+{
+    double q[GS_NQ], x[GS_NX], dx[GS_NX], acc = 0.0;
+    gs_prep(p, q);
+    memcpy(x, x0, sizeof(double) * GS_NX);
+    for (long long k = 0; k < n; ++k) {
+        gs_rhs(k * dt, x, p, q, dx);
+        x[0] += 1e-12 * dx[GS_NX - 1];
+        acc += dx[GS_NX - 1];
+    }
+    return acc;
+}
+
+/* ---- Lockstep integration: a group of points shares time and step size. ----
+ * The excitation terms are computed once per stage for the group (gs_rhs_batch) and the
+ * per-point arithmetic vectorises.  The error norm of the group is the largest of its
+ * points' norms, so every point meets the tolerance.  A point that diverges or turns
+ * non-finite is marked, frozen and left out of the error norm. */
+#include <stdlib.h>
+
+int gs_run_lockstep(int method, int npts, int group, const double *P, const double *X0,
+                    double t0, double period, int n_transient, int n_sample, int spp,
+                    double rtol, double atol, double bound, long long max_steps, double *OUT,
+                    long long *NFEV, long long *NSTEP, int *STATUS, double *TFAIL)
+{
+    static const gs_tableau RK45 = {6, GS_RK45_A, GS_RK45_B, GS_RK45_C, GS_RK45_E, 0, 0, 4};
+    static const gs_tableau DOP853 = {12, GS_DOP853_A, GS_DOP853_B, GS_DOP853_C, 0,
+                                      GS_DOP853_E3, GS_DOP853_E5, 7};
+    const gs_tableau *T = method == 0 ? &RK45 : &DOP853;
+    const int ns = T->ns, n_out = n_sample * spp + 1;
+    const double exponent = -1.0 / (T->error_order + 1);
+    if (group < 1) group = 1;
+    const int G = group;
+    double *Pg = malloc(sizeof(double) * GS_NP * G), *Qg = malloc(sizeof(double) * GS_NQ * G);
+    double *Y = malloc(sizeof(double) * GS_NX * G), *YT = malloc(sizeof(double) * GS_NX * G);
+    double *YN = malloc(sizeof(double) * GS_NX * G);
+    double *K = malloc(sizeof(double) * (GS_MAXS + 1) * GS_NX * G);
+    int *alive = malloc(sizeof(int) * G);
+    double *E5s = malloc(sizeof(double) * G), *E3s = malloc(sizeof(double) * G);
+    if (!Pg || !Qg || !Y || !YT || !YN || !K || !alive || !E5s || !E3s) return -1;
+    for (int g0 = 0; g0 < npts; g0 += G) {
+        const int n = npts - g0 < G ? npts - g0 : G;
+        long long nfev = 0, nsteps = 0;
+        double h_abs = INFINITY, t = t0;
+        const double t_end = t0 + (double)(n_transient + n_sample) * period;
+        for (int j = 0; j < n; ++j) {
+            const double *p = P + (long)(g0 + j) * GS_NP;
+            double q[GS_NQ], f[GS_NX];
+            gs_prep(p, q);
+            for (int k = 0; k < GS_NP; ++k) Pg[k * n + j] = p[k];
+            for (int k = 0; k < GS_NQ; ++k) Qg[k * n + j] = q[k];
+            for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = X0[(long)(g0 + j) * GS_NX + i];
+            gs_rhs(t0, X0 + (long)(g0 + j) * GS_NX, p, q, f);
+            const double h0 = gs_initial_step(t0, X0 + (long)(g0 + j) * GS_NX, f, t_end - t0,
+                                              T->error_order, rtol, atol, p, q, &nfev);
+            if (h0 < h_abs) h_abs = h0;
+            alive[j] = 1;
+            STATUS[g0 + j] = GS_OK;
+            TFAIL[g0 + j] = NAN;
+        }
+        nfev = nfev / (n > 0 ? n : 1) + 1;
+        gs_rhs_batch(t0, n, Y, Pg, Qg, K); /* K[0] = f(t0, y0) */
+        int group_status = GS_OK;
+        for (int ko = 0; ko < n_out; ++ko) {
+            const double target = t0 + ((double)n_transient * spp + ko) * period / (double)spp;
+            while (t < target && group_status == GS_OK) {
+                const double min_step = 10.0 * fabs(nextafter(t, INFINITY) - t);
+                double h = h_abs < min_step ? min_step : h_abs;
+                int rejected = 0;
+                for (;;) {
+                    if (h < min_step) {
+                        group_status = GS_STEP_TOO_SMALL;
+                        break;
+                    }
+                    double t_new = t + h;
+                    int clipped = 0;
+                    if (t_new >= target) {
+                        t_new = target;
+                        clipped = 1;
+                    }
+                    const double hh = t_new - t;
+                    const long S = (long)GS_NX * n;
+                    for (int s = 1; s < ns; ++s) {
+                        for (long e = 0; e < S; ++e) {
+                            double acc = 0.0;
+                            for (int r = 0; r < s; ++r) acc += T->A[s * ns + r] * K[r * S + e];
+                            YT[e] = Y[e] + hh * acc;
+                        }
+                        gs_rhs_batch(t + T->C[s] * hh, n, YT, Pg, Qg, K + s * S);
+                    }
+                    for (long e = 0; e < S; ++e) {
+                        double acc = 0.0;
+                        for (int r = 0; r < ns; ++r) acc += T->B[r] * K[r * S + e];
+                        YN[e] = Y[e] + hh * acc;
+                    }
+                    gs_rhs_batch(t + hh, n, YN, Pg, Qg, K + ns * S);
+                    nfev += ns;
+                    /* per-point error norms, structure-of-arrays */
+                    for (int j = 0; j < n; ++j) E5s[j] = E3s[j] = 0.0;
+                    for (int i = 0; i < GS_NX; ++i) {
+                        const double *y0 = Y + (long)i * n, *y1 = YN + (long)i * n;
+                        for (int j = 0; j < n; ++j) {
+                            double a5 = 0.0, a3 = 0.0;
+                            const long e = (long)i * n + j;
+                            if (T->E) {
+                                for (int r = 0; r <= ns; ++r) a5 += T->E[r] * K[r * S + e];
+                                a5 *= hh;
+                            } else {
+                                for (int r = 0; r <= ns; ++r) {
+                                    a5 += T->E5[r] * K[r * S + e];
+                                    a3 += T->E3[r] * K[r * S + e];
+                                }
+                            }
+                            const double a = fabs(y0[j]), b = fabs(y1[j]);
+                            const double sc = atol + (a > b ? a : b) * rtol;
+                            a5 /= sc;
+                            a3 /= sc;
+                            E5s[j] += a5 * a5;
+                            E3s[j] += a3 * a3;
+                        }
+                    }
+                    double err = 0.0;
+                    for (int j = 0; j < n; ++j) {
+                        if (!alive[j]) continue;
+                        double ej;
+                        if (T->E) {
+                            ej = sqrt(E5s[j] / GS_NX);
+                        } else {
+                            ej = (E5s[j] == 0.0 && E3s[j] == 0.0)
+                                     ? 0.0
+                                     : fabs(hh) * E5s[j] / sqrt((E5s[j] + 0.01 * E3s[j]) * GS_NX);
+                        }
+                        if (!(ej <= err)) err = ej; /* NaN propagates as a rejection */
+                    }
+                    if (err < 1.0) {
+                        double factor = err == 0.0 ? 10.0 : 0.9 * pow(err, exponent);
+                        if (factor > 10.0) factor = 10.0;
+                        if (rejected && factor > 1.0) factor = 1.0;
+                        const double next = hh * factor;
+                        h_abs = clipped && !rejected && h > next ? h : next;
+                        t = t_new;
+                        memcpy(Y, YN, sizeof(double) * S);
+                        memcpy(K, K + ns * S, sizeof(double) * S); /* FSAL */
+                        break;
+                    }
+                    double factor = 0.9 * pow(err, exponent);
+                    if (!(factor > 0.2)) factor = 0.2;
+                    h = hh * factor;
+                    rejected = 1;
+                }
+                nsteps += 1;
+                if (nsteps > max_steps && group_status == GS_OK) group_status = GS_TOO_MANY_STEPS;
+                for (int j = 0; j < n; ++j) {
+                    if (!alive[j]) continue;
+                    double yj[GS_NX];
+                    for (int i = 0; i < GS_NX; ++i) yj[i] = Y[i * n + j];
+                    const int c = gs_check(yj, bound);
+                    if (c != GS_OK) {
+                        alive[j] = 0;
+                        STATUS[g0 + j] = c;
+                        TFAIL[g0 + j] = t;
+                        for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = 0.0;
+                        gs_rhs_batch(t, n, Y, Pg, Qg, K); /* refresh FSAL stage */
+                    }
+                }
+            }
+            for (int j = 0; j < n; ++j) {
+                double *out = OUT + ((long)(g0 + j) * n_out + ko) * GS_NX;
+                const int ok = alive[j] && group_status == GS_OK;
+                for (int i = 0; i < GS_NX; ++i) out[i] = ok ? Y[i * n + j] : NAN;
+            }
+        }
+        for (int j = 0; j < n; ++j) {
+            NFEV[g0 + j] = nfev;
+            NSTEP[g0 + j] = nsteps;
+            if (STATUS[g0 + j] == GS_OK && group_status != GS_OK) {
+                STATUS[g0 + j] = group_status;
+                TFAIL[g0 + j] = t;
+            }
+        }
+    }
+    free(Pg); free(Qg); free(Y); free(YT); free(YN); free(K); free(alive); free(E5s); free(E3s);
+    return 0;
+}
+
+/* One right-hand-side evaluation (tests compare it with the NumPy code). */
+void gs_eval(double tau, const double *x, const double *p, double *dx)
+{
+    double q[GS_NQ];
+    gs_prep(p, q);
+    gs_rhs(tau, x, p, q, dx);
+}
+
+/* The batched form on n points (structure of arrays; tests compare it too). */
+void gs_eval_batch(double tau, int n, const double *X, const double *P, double *DX)
+{
+    double *Q = malloc(sizeof(double) * GS_NQ * (n > 0 ? n : 1));
+    double p[GS_NP], q[GS_NQ];
+    if (!Q) return;
+    for (int j = 0; j < n; ++j) {
+        for (int k = 0; k < GS_NP; ++k) p[k] = P[k * n + j];
+        gs_prep(p, q);
+        for (int k = 0; k < GS_NQ; ++k) Q[k * n + j] = q[k];
+    }
+    gs_rhs_batch(tau, n, X, P, Q, DX);
+    free(Q);
+}

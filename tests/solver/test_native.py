@@ -1,0 +1,127 @@
+"""The compiled batched integrators against the NumPy code and SciPy's integrators."""
+
+import importlib
+import warnings
+
+import numpy as np
+import pytest
+from gearsym.solver import native
+from gearsym.solver.simulate import default_initial_state, simulate
+from gearsym.solver.system import System
+
+pytestmark = pytest.mark.skipif(native.compiler() is None, reason="no C compiler")
+
+SHIPPED = ["reference_light", "reference_dead_zone", "reference_linear", "siso", "tiso"]
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_c_right_hand_side_equals_the_numpy_one(name):
+    # The C code (trig harmonics by recurrence, phases hoisted) and the NumPy code are
+    # printed from the same SymPy expressions: they agree to rounding.
+    system = System.load(name)
+    lib, _ = native.library(system.module)
+    rng = np.random.default_rng(1)
+    n = system.n
+    for _ in range(20):
+        x = rng.uniform(-2.5, 2.5, n)
+        tau = rng.uniform(0, 200)
+        dx = np.empty(n)
+        lib.gs_eval(tau, x, np.ascontiguousarray(system.p), dx)
+        np.testing.assert_allclose(dx, system.rhs(tau, x), rtol=1e-12, atol=1e-12)
+    # the batched (structure-of-arrays) form, several points sharing omega
+    X = rng.uniform(-2.5, 2.5, (n, 7))
+    P = np.repeat(system.p[:, None], 7, axis=1)
+    P[1] = np.linspace(0.0, 0.5, 7)  # a load differs between points
+    DX = np.empty_like(X)
+    lib.gs_eval_batch(3.7, 7, np.ascontiguousarray(X), np.ascontiguousarray(P), DX)
+    np.testing.assert_allclose(DX, system.module.rhs(3.7, X, P), rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("native_method,scipy_method", [("dop853", "DOP853"), ("dopri5", "RK45")])
+def test_same_poincare_points_as_scipy(native_method, scipy_method):
+    # Same algorithm and step control as SciPy's solve_ivp: the Poincare points of the
+    # stable period-1 orbit at lambda = 0.8 agree well within the tolerance.
+    system = System.load("reference_light", **{"lambda": 0.8})
+    x0 = default_initial_state(system)
+    kw = dict(rtol=1e-8, atol=1e-10, transient=50, periods=10, samples_per_period=4)
+    a = simulate(system, x0, method=native_method, **kw)
+    b = simulate(system, x0, method=scipy_method, **kw)
+    assert a.status == b.status == "ok"
+    np.testing.assert_allclose(a.x, b.x, atol=1e-7)
+    assert a.nfev > 0 and a.nsteps > 0
+
+
+def test_rk4_converges_at_fourth_order():
+    # Observed order of the fixed-step RK4 against a tight DOP853 run: halving the step
+    # divides the error by about 2^4 (theory 4).
+    system = System.load("reference_light", **{"lambda": 0.5})
+    x0 = default_initial_state(system)
+    kw = dict(transient=0, periods=4, samples_per_period=1)
+    ref = simulate(system, x0, method="dop853", rtol=1e-13, atol=1e-14, **kw).x
+    errors = [
+        np.max(np.abs(simulate(system, x0, method="rk4", steps_per_period=s, **kw).x - ref))
+        for s in (64, 128, 256)
+    ]
+    orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert np.all(np.abs(orders - 4.0) < 0.35), orders
+
+
+def test_lockstep_batch_agrees_with_point_by_point():
+    # Lockstep groups share the step (the smallest any point needs): same points to within
+    # the tolerance at stable period-1 orbits.
+    module = System.load("reference_light").module
+    lam = np.linspace(0.6, 1.0, 9)
+    P = np.array([module.parameters(**{"lambda": v}) for v in lam])
+    x0 = default_initial_state(System.load("reference_light"))
+    X0 = np.repeat(x0[None, :], len(lam), axis=0)
+    kw = dict(method="dop853", transient=60, periods=5, samples_per_period=1)
+    one = native.run_batch(module, P, X0, lockstep=False, **kw)
+    many = native.run_batch(module, P, X0, lockstep=True, group=4, **kw)
+    assert one.status == many.status == ("ok",) * len(lam)
+    np.testing.assert_allclose(many.x, one.x, atol=1e-7)
+
+
+def test_a_diverging_point_does_not_spoil_its_group():
+    module = System.load("reference_light").module
+    good = module.parameters(**{"lambda": 0.8})
+    bad = module.parameters(**{"lambda": 0.8, "damping_ratio": -0.5})
+    P = np.array([good, bad, good])
+    x0 = default_initial_state(System.load("reference_light"))
+    X0 = np.repeat(x0[None, :], 3, axis=0)
+    res = native.run_batch(module, P, X0, method="dop853", transient=40, periods=2, group=3)
+    assert res.status == ("ok", "divergent", "ok")
+    assert np.isfinite(res.t_fail[1]) and np.all(np.isnan(res.x[1, -1]))
+    alone = native.run_batch(module, P[:1], X0[:1], method="dop853", transient=40, periods=2)
+    np.testing.assert_allclose(res.x[0], alone.x[0], atol=1e-7)
+
+
+def test_library_is_cached_on_disk(tmp_path, monkeypatch):
+    monkeypatch.setenv("GEARSYM_CACHE", str(tmp_path))
+    module = System.load("siso").module
+    native._loaded.clear()
+    _, first = native.library(module)
+    native._loaded.clear()
+    _, second = native.library(module)
+    assert first["compiled"] and not second["compiled"]
+    assert first["path"] == second["path"] and first["path"].startswith(str(tmp_path))
+
+
+def test_without_a_compiler_numpy_takes_over_with_a_warning(monkeypatch):
+    monkeypatch.setenv("GEARSYM_CC", "none")
+    importlib.reload(native)
+    try:
+        module = System.load("reference_light").module
+        P = np.array([module.parameters(**{"lambda": v}) for v in (0.7, 0.9)])
+        x0 = default_initial_state(System.load("reference_light"))
+        X0 = np.repeat(x0[None, :], 2, axis=0)
+        with pytest.warns(UserWarning, match="no C compiler found.*NumPy"):
+            res = native.run_batch(module, P, X0, method="dop853", transient=30, periods=3)
+        assert res.backend == "numpy"
+        monkeypatch.delenv("GEARSYM_CC")
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            compiled = native.run_batch(module, P, X0, method="dop853", transient=30, periods=3)
+        assert compiled.backend == "native"
+        np.testing.assert_allclose(res.x, compiled.x, atol=1e-6)
+    finally:
+        importlib.reload(native)
