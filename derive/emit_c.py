@@ -92,24 +92,34 @@ def _reduce_trig(exprs, tau):
     return [e.xreplace(replace) for e in exprs], bases, q_defs
 
 
-def c_source(model: Model) -> str:
-    """C text of ``gs_prep`` and ``gs_rhs`` for ``model``."""
+def c_source(model: Model, variational: bool = False) -> str:
+    """C text of ``gs_prep`` and ``gs_rhs`` for ``model``; with ``variational`` for the
+    state extended by a tangent vector ``w``: ``(x, w)' = (F(tau, x), J(tau, x) w)``."""
     printer = _Printer()
     tau = (
         next(s for e in model.rhs for s in e.free_symbols if s.name == "tau")
         if any(s.name == "tau" for e in model.rhs for s in e.free_symbols)
         else sp.Symbol("tau")
     )
-    exprs, bases, q_defs = _reduce_trig(list(model.rhs), tau)
-    n, m = len(model.states), len(model.parameters)
+    states = list(model.state_symbols)
+    exprs = list(model.rhs)
+    if variational:
+        n0 = len(states)
+        w = [sp.Symbol(f"w{i}") for i in range(n0)]
+        jac = list(model.jacobian)
+        exprs += [sp.Add(*[jac[i * n0 + j] * w[j] for j in range(n0)]) for i in range(n0)]
+        states += w
+    exprs, bases, q_defs = _reduce_trig(exprs, tau)
+    n, m = len(states), len(model.parameters)
     params = {s: k for k, s in enumerate(model.parameter_symbols)}
 
     def unpack(symbols, used, indent="    "):
         return [f"{indent}const double {s.name} = p[{params[s]}];" for s in symbols if s in used]
 
     prep_used = set().union(*(e.free_symbols for e in q_defs)) if q_defs else set()
+    what = " with the variational equations" if variational else ""
     lines = [
-        f"/* {model.name}: right-hand side for the compiled integrators (gearsym derive). */",
+        f"/* {model.name}: right-hand side{what} for the compiled integrators (gearsym derive). */",
         f"#define GS_NX {n}",
         f"#define GS_NP {m}",
         f"#define GS_NQ {max(len(q_defs), 1)}",
@@ -129,7 +139,7 @@ def c_source(model: Model) -> str:
     used = set().union(
         *(e.free_symbols for _, e in replacements), *(e.free_symbols for e in reduced)
     )
-    for k, s in enumerate(model.state_symbols):
+    for k, s in enumerate(states):
         if s in used:
             lines.append(f"    const double {s.name} = x[{k}];")
     base_used = set()
@@ -174,7 +184,7 @@ def c_source(model: Model) -> str:
     if q_defs:
         lines.append("        double q[GS_NQ];")
         lines.append("        for (int k = 0; k < GS_NQ; ++k) q[k] = Q[k*n + j];")
-    for k, s in enumerate(model.state_symbols):
+    for k, s in enumerate(states):
         if s in used:
             lines.append(f"        const double {s.name} = X[{k}*n + j];")
     for s in model.parameter_symbols:

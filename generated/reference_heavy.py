@@ -242,6 +242,197 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
 }
 """
 
+# The same with the variational equations (x, w)' = (F, J w), for Lyapunov exponents.
+C_SOURCE_VARIATIONAL = r"""
+/* reference_heavy: right-hand side with the variational equations for the compiled integrators (gearsym derive). */
+#define GS_NX 8
+#define GS_NP 32
+#define GS_NQ 10
+
+static void gs_prep(const double *p, double *q)
+{
+    const double phi_v = p[23];
+    const double psi_u_1 = p[25];
+    const double psi_v_1 = p[27];
+    q[0] = cos(phi_v);
+    q[1] = -sin(phi_v);
+    q[2] = cos(2*phi_v);
+    q[3] = -sin(2*phi_v);
+    q[4] = cos(3*phi_v);
+    q[5] = -sin(3*phi_v);
+    q[6] = cos(psi_u_1);
+    q[7] = sin(psi_u_1);
+    q[8] = cos(phi_v - psi_v_1);
+    q[9] = -sin(phi_v - psi_v_1);
+    (void)p; (void)q;
+}
+
+static inline void gs_rhs(double tau, const double *x, const double *p, const double *q, double *dx)
+{
+    const double u = x[0];
+    const double v = x[1];
+    const double du = x[2];
+    const double dv = x[3];
+    const double w0 = x[4];
+    const double w1 = x[5];
+    const double w2 = x[6];
+    const double w3 = x[7];
+    const double omega = p[0];
+    const double f_u = p[1];
+    const double f_v = p[2];
+    const double xi_u_u = p[3];
+    const double xi_u_v = p[4];
+    const double xi_v_u = p[5];
+    const double xi_v_v = p[6];
+    const double kappa_u_u = p[7];
+    const double kappa_u_v = p[8];
+    const double kappa_v_u = p[9];
+    const double kappa_v_v = p[10];
+    const double kc_u_1 = p[11];
+    const double ks_u_1 = p[12];
+    const double kc_u_2 = p[13];
+    const double ks_u_2 = p[14];
+    const double kc_u_3 = p[15];
+    const double ks_u_3 = p[16];
+    const double kc_v_1 = p[17];
+    const double ks_v_1 = p[18];
+    const double kc_v_2 = p[19];
+    const double ks_v_2 = p[20];
+    const double kc_v_3 = p[21];
+    const double ks_v_3 = p[22];
+    const double E_u_1 = p[24];
+    const double E_v_1 = p[26];
+    const double g1 = p[28];
+    const double g3 = p[29];
+    const double g5 = p[30];
+    const double g7 = p[31];
+    const double th0 = (omega)*tau;
+    const double C0_1 = cos(th0), S0_1 = sin(th0);
+    const double C0_2 = C0_1*C0_1 - S0_1*S0_1;
+    const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
+    const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
+    const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
+    const double t_0 = 2*du;
+    const double t_1 = 2*dv;
+    const double t_2 = ((omega)*(omega));
+    const double t_3 = ((u)*(u));
+    const double t_4 = g5 + g7*t_3;
+    const double t_5 = g3 + t_3*t_4;
+    const double t_6 = C0_1*kc_u_1 + C0_2*kc_u_2 + C0_3*kc_u_3 + S0_1*ks_u_1 + S0_2*ks_u_2 + S0_3*ks_u_3 + 1;
+    const double t_7 = t_6*(g1 + t_3*t_5);
+    const double t_8 = kappa_u_u*t_7;
+    const double t_9 = ((v)*(v));
+    const double t_10 = g5 + g7*t_9;
+    const double t_11 = g3 + t_10*t_9;
+    const double t_12 = kc_v_1*(C0_1*q[0] - S0_1*q[1]) + kc_v_2*(C0_2*q[2] - S0_2*q[3]) + kc_v_3*(C0_3*q[4] - S0_3*q[5]) + ks_v_1*(C0_1*q[1] + S0_1*q[0]) + ks_v_2*(C0_2*q[3] + S0_2*q[2]) + ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1;
+    const double t_13 = t_12*(g1 + t_11*t_9);
+    const double t_14 = kappa_u_v*t_13;
+    const double t_15 = kappa_v_u*t_7;
+    const double t_16 = kappa_v_v*t_13;
+    const double t_17 = 2*w2;
+    const double t_18 = 2*w3;
+    const double t_19 = 2*u;
+    const double t_20 = 2*g7;
+    const double t_21 = t_6*u*(t_19*t_5 + t_3*(t_19*t_4 + t_20*((u)*(u)*(u))));
+    const double t_22 = 2*v;
+    const double t_23 = t_12*v*(t_11*t_22 + t_9*(t_10*t_22 + t_20*((v)*(v)*(v))));
+    dx[0] = du;
+    dx[1] = dv;
+    dx[2] = -E_u_1*t_2*(C0_1*q[6] - S0_1*q[7]) + f_u - t_0*xi_u_u - t_1*xi_u_v - t_14*v - t_8*u;
+    dx[3] = -E_v_1*t_2*(C0_1*q[8] - S0_1*q[9]) + f_v - t_0*xi_v_u - t_1*xi_v_v - t_15*u - t_16*v;
+    dx[4] = w2;
+    dx[5] = w3;
+    dx[6] = -t_17*xi_u_u - t_18*xi_u_v + w0*(-kappa_u_u*t_21 - t_8) + w1*(-kappa_u_v*t_23 - t_14);
+    dx[7] = -t_17*xi_v_u - t_18*xi_v_v + w0*(-kappa_v_u*t_21 - t_15) + w1*(-kappa_v_v*t_23 - t_16);
+    (void)tau; (void)p; (void)q;
+}
+
+static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
+{
+    const double th0 = (P[0*n])*tau;
+    const double C0_1 = cos(th0), S0_1 = sin(th0);
+    const double C0_2 = C0_1*C0_1 - S0_1*S0_1;
+    const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
+    const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
+    const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
+#pragma GCC ivdep
+    for (int j = 0; j < n; ++j) {
+        double q[GS_NQ];
+        for (int k = 0; k < GS_NQ; ++k) q[k] = Q[k*n + j];
+        const double u = X[0*n + j];
+        const double v = X[1*n + j];
+        const double du = X[2*n + j];
+        const double dv = X[3*n + j];
+        const double w0 = X[4*n + j];
+        const double w1 = X[5*n + j];
+        const double w2 = X[6*n + j];
+        const double w3 = X[7*n + j];
+        const double omega = P[0*n + j];
+        const double f_u = P[1*n + j];
+        const double f_v = P[2*n + j];
+        const double xi_u_u = P[3*n + j];
+        const double xi_u_v = P[4*n + j];
+        const double xi_v_u = P[5*n + j];
+        const double xi_v_v = P[6*n + j];
+        const double kappa_u_u = P[7*n + j];
+        const double kappa_u_v = P[8*n + j];
+        const double kappa_v_u = P[9*n + j];
+        const double kappa_v_v = P[10*n + j];
+        const double kc_u_1 = P[11*n + j];
+        const double ks_u_1 = P[12*n + j];
+        const double kc_u_2 = P[13*n + j];
+        const double ks_u_2 = P[14*n + j];
+        const double kc_u_3 = P[15*n + j];
+        const double ks_u_3 = P[16*n + j];
+        const double kc_v_1 = P[17*n + j];
+        const double ks_v_1 = P[18*n + j];
+        const double kc_v_2 = P[19*n + j];
+        const double ks_v_2 = P[20*n + j];
+        const double kc_v_3 = P[21*n + j];
+        const double ks_v_3 = P[22*n + j];
+        const double E_u_1 = P[24*n + j];
+        const double E_v_1 = P[26*n + j];
+        const double g1 = P[28*n + j];
+        const double g3 = P[29*n + j];
+        const double g5 = P[30*n + j];
+        const double g7 = P[31*n + j];
+        const double t_0 = 2*du;
+        const double t_1 = 2*dv;
+        const double t_2 = ((omega)*(omega));
+        const double t_3 = ((u)*(u));
+        const double t_4 = g5 + g7*t_3;
+        const double t_5 = g3 + t_3*t_4;
+        const double t_6 = C0_1*kc_u_1 + C0_2*kc_u_2 + C0_3*kc_u_3 + S0_1*ks_u_1 + S0_2*ks_u_2 + S0_3*ks_u_3 + 1;
+        const double t_7 = t_6*(g1 + t_3*t_5);
+        const double t_8 = kappa_u_u*t_7;
+        const double t_9 = ((v)*(v));
+        const double t_10 = g5 + g7*t_9;
+        const double t_11 = g3 + t_10*t_9;
+        const double t_12 = kc_v_1*(C0_1*q[0] - S0_1*q[1]) + kc_v_2*(C0_2*q[2] - S0_2*q[3]) + kc_v_3*(C0_3*q[4] - S0_3*q[5]) + ks_v_1*(C0_1*q[1] + S0_1*q[0]) + ks_v_2*(C0_2*q[3] + S0_2*q[2]) + ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1;
+        const double t_13 = t_12*(g1 + t_11*t_9);
+        const double t_14 = kappa_u_v*t_13;
+        const double t_15 = kappa_v_u*t_7;
+        const double t_16 = kappa_v_v*t_13;
+        const double t_17 = 2*w2;
+        const double t_18 = 2*w3;
+        const double t_19 = 2*u;
+        const double t_20 = 2*g7;
+        const double t_21 = t_6*u*(t_19*t_5 + t_3*(t_19*t_4 + t_20*((u)*(u)*(u))));
+        const double t_22 = 2*v;
+        const double t_23 = t_12*v*(t_11*t_22 + t_9*(t_10*t_22 + t_20*((v)*(v)*(v))));
+        DX[0*n + j] = du;
+        DX[1*n + j] = dv;
+        DX[2*n + j] = -E_u_1*t_2*(C0_1*q[6] - S0_1*q[7]) + f_u - t_0*xi_u_u - t_1*xi_u_v - t_14*v - t_8*u;
+        DX[3*n + j] = -E_v_1*t_2*(C0_1*q[8] - S0_1*q[9]) + f_v - t_0*xi_v_u - t_1*xi_v_v - t_15*u - t_16*v;
+        DX[4*n + j] = w2;
+        DX[5*n + j] = w3;
+        DX[6*n + j] = -t_17*xi_u_u - t_18*xi_u_v + w0*(-kappa_u_u*t_21 - t_8) + w1*(-kappa_u_v*t_23 - t_14);
+        DX[7*n + j] = -t_17*xi_v_u - t_18*xi_v_v + w0*(-kappa_v_u*t_21 - t_15) + w1*(-kappa_v_v*t_23 - t_16);
+    }
+    (void)tau; (void)P; (void)Q;
+}
+"""
+
 
 def rhs(tau, x, p):
     """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); result (n,) or (n, N)."""

@@ -113,6 +113,84 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
 }
 """
 
+# The same with the variational equations (x, w)' = (F, J w), for Lyapunov exponents.
+C_SOURCE_VARIATIONAL = r"""
+/* reference_linear: right-hand side with the variational equations for the compiled integrators (gearsym derive). */
+#define GS_NX 8
+#define GS_NP 9
+#define GS_NQ 1
+
+static void gs_prep(const double *p, double *q)
+{
+    (void)p; (void)q;
+}
+
+static inline void gs_rhs(double tau, const double *x, const double *p, const double *q, double *dx)
+{
+    const double u = x[0];
+    const double v = x[1];
+    const double du = x[2];
+    const double dv = x[3];
+    const double w0 = x[4];
+    const double w1 = x[5];
+    const double w2 = x[6];
+    const double w3 = x[7];
+    const double f_u = p[1];
+    const double f_v = p[2];
+    const double xi_u_u = p[3];
+    const double xi_v_v = p[4];
+    const double kappa_u_u = p[5];
+    const double kappa_u_v = p[6];
+    const double kappa_v_u = p[7];
+    const double kappa_v_v = p[8];
+    const double t_0 = 2*xi_u_u;
+    const double t_1 = 2*xi_v_v;
+    dx[0] = du;
+    dx[1] = dv;
+    dx[2] = -du*t_0 + f_u - kappa_u_u*u - kappa_u_v*v;
+    dx[3] = -dv*t_1 + f_v - kappa_v_u*u - kappa_v_v*v;
+    dx[4] = w2;
+    dx[5] = w3;
+    dx[6] = -kappa_u_u*w0 - kappa_u_v*w1 - t_0*w2;
+    dx[7] = -kappa_v_u*w0 - kappa_v_v*w1 - t_1*w3;
+    (void)tau; (void)p; (void)q;
+}
+
+static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
+{
+#pragma GCC ivdep
+    for (int j = 0; j < n; ++j) {
+        const double u = X[0*n + j];
+        const double v = X[1*n + j];
+        const double du = X[2*n + j];
+        const double dv = X[3*n + j];
+        const double w0 = X[4*n + j];
+        const double w1 = X[5*n + j];
+        const double w2 = X[6*n + j];
+        const double w3 = X[7*n + j];
+        const double f_u = P[1*n + j];
+        const double f_v = P[2*n + j];
+        const double xi_u_u = P[3*n + j];
+        const double xi_v_v = P[4*n + j];
+        const double kappa_u_u = P[5*n + j];
+        const double kappa_u_v = P[6*n + j];
+        const double kappa_v_u = P[7*n + j];
+        const double kappa_v_v = P[8*n + j];
+        const double t_0 = 2*xi_u_u;
+        const double t_1 = 2*xi_v_v;
+        DX[0*n + j] = du;
+        DX[1*n + j] = dv;
+        DX[2*n + j] = -du*t_0 + f_u - kappa_u_u*u - kappa_u_v*v;
+        DX[3*n + j] = -dv*t_1 + f_v - kappa_v_u*u - kappa_v_v*v;
+        DX[4*n + j] = w2;
+        DX[5*n + j] = w3;
+        DX[6*n + j] = -kappa_u_u*w0 - kappa_u_v*w1 - t_0*w2;
+        DX[7*n + j] = -kappa_v_u*w0 - kappa_v_v*w1 - t_1*w3;
+    }
+    (void)tau; (void)P; (void)Q;
+}
+"""
+
 
 def rhs(tau, x, p):
     """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); result (n,) or (n, N)."""

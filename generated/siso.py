@@ -150,6 +150,109 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
 }
 """
 
+# The same with the variational equations (x, w)' = (F, J w), for Lyapunov exponents.
+C_SOURCE_VARIATIONAL = r"""
+/* siso: right-hand side with the variational equations for the compiled integrators (gearsym derive). */
+#define GS_NX 4
+#define GS_NP 16
+#define GS_NQ 2
+
+static void gs_prep(const double *p, double *q)
+{
+    const double psi_u_1 = p[11];
+    q[0] = cos(psi_u_1);
+    q[1] = sin(psi_u_1);
+    (void)p; (void)q;
+}
+
+static inline void gs_rhs(double tau, const double *x, const double *p, const double *q, double *dx)
+{
+    const double u = x[0];
+    const double du = x[1];
+    const double w0 = x[2];
+    const double w1 = x[3];
+    const double omega = p[0];
+    const double f_u = p[1];
+    const double xi_u_u = p[2];
+    const double kappa_u_u = p[3];
+    const double kc_u_1 = p[4];
+    const double ks_u_1 = p[5];
+    const double kc_u_2 = p[6];
+    const double ks_u_2 = p[7];
+    const double kc_u_3 = p[8];
+    const double ks_u_3 = p[9];
+    const double E_u_1 = p[10];
+    const double g1 = p[12];
+    const double g3 = p[13];
+    const double g5 = p[14];
+    const double g7 = p[15];
+    const double th0 = (omega)*tau;
+    const double C0_1 = cos(th0), S0_1 = sin(th0);
+    const double C0_2 = C0_1*C0_1 - S0_1*S0_1;
+    const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
+    const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
+    const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
+    const double t_0 = 2*xi_u_u;
+    const double t_1 = ((u)*(u));
+    const double t_2 = g5 + g7*t_1;
+    const double t_3 = g3 + t_1*t_2;
+    const double t_4 = kappa_u_u*(C0_1*kc_u_1 + C0_2*kc_u_2 + C0_3*kc_u_3 + S0_1*ks_u_1 + S0_2*ks_u_2 + S0_3*ks_u_3 + 1);
+    const double t_5 = t_4*(g1 + t_1*t_3);
+    const double t_6 = 2*u;
+    dx[0] = du;
+    dx[1] = -E_u_1*((omega)*(omega))*(C0_1*q[0] - S0_1*q[1]) - du*t_0 + f_u - t_5*u;
+    dx[2] = w1;
+    dx[3] = -t_0*w1 + w0*(-t_4*u*(t_1*(2*g7*((u)*(u)*(u)) + t_2*t_6) + t_3*t_6) - t_5);
+    (void)tau; (void)p; (void)q;
+}
+
+static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
+{
+    const double th0 = (P[0*n])*tau;
+    const double C0_1 = cos(th0), S0_1 = sin(th0);
+    const double C0_2 = C0_1*C0_1 - S0_1*S0_1;
+    const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
+    const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
+    const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
+#pragma GCC ivdep
+    for (int j = 0; j < n; ++j) {
+        double q[GS_NQ];
+        for (int k = 0; k < GS_NQ; ++k) q[k] = Q[k*n + j];
+        const double u = X[0*n + j];
+        const double du = X[1*n + j];
+        const double w0 = X[2*n + j];
+        const double w1 = X[3*n + j];
+        const double omega = P[0*n + j];
+        const double f_u = P[1*n + j];
+        const double xi_u_u = P[2*n + j];
+        const double kappa_u_u = P[3*n + j];
+        const double kc_u_1 = P[4*n + j];
+        const double ks_u_1 = P[5*n + j];
+        const double kc_u_2 = P[6*n + j];
+        const double ks_u_2 = P[7*n + j];
+        const double kc_u_3 = P[8*n + j];
+        const double ks_u_3 = P[9*n + j];
+        const double E_u_1 = P[10*n + j];
+        const double g1 = P[12*n + j];
+        const double g3 = P[13*n + j];
+        const double g5 = P[14*n + j];
+        const double g7 = P[15*n + j];
+        const double t_0 = 2*xi_u_u;
+        const double t_1 = ((u)*(u));
+        const double t_2 = g5 + g7*t_1;
+        const double t_3 = g3 + t_1*t_2;
+        const double t_4 = kappa_u_u*(C0_1*kc_u_1 + C0_2*kc_u_2 + C0_3*kc_u_3 + S0_1*ks_u_1 + S0_2*ks_u_2 + S0_3*ks_u_3 + 1);
+        const double t_5 = t_4*(g1 + t_1*t_3);
+        const double t_6 = 2*u;
+        DX[0*n + j] = du;
+        DX[1*n + j] = -E_u_1*((omega)*(omega))*(C0_1*q[0] - S0_1*q[1]) - du*t_0 + f_u - t_5*u;
+        DX[2*n + j] = w1;
+        DX[3*n + j] = -t_0*w1 + w0*(-t_4*u*(t_1*(2*g7*((u)*(u)*(u)) + t_2*t_6) + t_3*t_6) - t_5);
+    }
+    (void)tau; (void)P; (void)Q;
+}
+"""
+
 
 def rhs(tau, x, p):
     """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); result (n,) or (n, N)."""

@@ -344,6 +344,287 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
 }
 """
 
+# The same with the variational equations (x, w)' = (F, J w), for Lyapunov exponents.
+C_SOURCE_VARIATIONAL = r"""
+/* tiso: right-hand side with the variational equations for the compiled integrators (gearsym derive). */
+#define GS_NX 12
+#define GS_NP 52
+#define GS_NQ 18
+
+static void gs_prep(const double *p, double *q)
+{
+    const double phi_v = p[40];
+    const double phi_w = p[41];
+    const double psi_u_1 = p[43];
+    const double psi_v_1 = p[45];
+    const double psi_w_1 = p[47];
+    q[0] = cos(phi_v);
+    q[1] = -sin(phi_v);
+    q[2] = cos(phi_w);
+    q[3] = -sin(phi_w);
+    q[4] = cos(2*phi_v);
+    q[5] = -sin(2*phi_v);
+    q[6] = cos(2*phi_w);
+    q[7] = -sin(2*phi_w);
+    q[8] = cos(3*phi_v);
+    q[9] = -sin(3*phi_v);
+    q[10] = cos(3*phi_w);
+    q[11] = -sin(3*phi_w);
+    q[12] = cos(psi_u_1);
+    q[13] = sin(psi_u_1);
+    q[14] = cos(phi_v - psi_v_1);
+    q[15] = -sin(phi_v - psi_v_1);
+    q[16] = cos(phi_w - psi_w_1);
+    q[17] = -sin(phi_w - psi_w_1);
+    (void)p; (void)q;
+}
+
+static inline void gs_rhs(double tau, const double *x, const double *p, const double *q, double *dx)
+{
+    const double u = x[0];
+    const double v = x[1];
+    const double w = x[2];
+    const double du = x[3];
+    const double dv = x[4];
+    const double dw = x[5];
+    const double w0 = x[6];
+    const double w1 = x[7];
+    const double w2 = x[8];
+    const double w3 = x[9];
+    const double w4 = x[10];
+    const double w5 = x[11];
+    const double omega = p[0];
+    const double f_u = p[1];
+    const double f_v = p[2];
+    const double f_w = p[3];
+    const double xi_u_u = p[4];
+    const double xi_u_v = p[5];
+    const double xi_u_w = p[6];
+    const double xi_v_u = p[7];
+    const double xi_v_v = p[8];
+    const double xi_v_w = p[9];
+    const double xi_w_u = p[10];
+    const double xi_w_v = p[11];
+    const double xi_w_w = p[12];
+    const double kappa_u_u = p[13];
+    const double kappa_u_v = p[14];
+    const double kappa_u_w = p[15];
+    const double kappa_v_u = p[16];
+    const double kappa_v_v = p[17];
+    const double kappa_v_w = p[18];
+    const double kappa_w_u = p[19];
+    const double kappa_w_v = p[20];
+    const double kappa_w_w = p[21];
+    const double kc_u_1 = p[22];
+    const double ks_u_1 = p[23];
+    const double kc_u_2 = p[24];
+    const double ks_u_2 = p[25];
+    const double kc_u_3 = p[26];
+    const double ks_u_3 = p[27];
+    const double kc_v_1 = p[28];
+    const double ks_v_1 = p[29];
+    const double kc_v_2 = p[30];
+    const double ks_v_2 = p[31];
+    const double kc_v_3 = p[32];
+    const double ks_v_3 = p[33];
+    const double kc_w_1 = p[34];
+    const double ks_w_1 = p[35];
+    const double kc_w_2 = p[36];
+    const double ks_w_2 = p[37];
+    const double kc_w_3 = p[38];
+    const double ks_w_3 = p[39];
+    const double E_u_1 = p[42];
+    const double E_v_1 = p[44];
+    const double E_w_1 = p[46];
+    const double g1 = p[48];
+    const double g3 = p[49];
+    const double g5 = p[50];
+    const double g7 = p[51];
+    const double th0 = (omega)*tau;
+    const double C0_1 = cos(th0), S0_1 = sin(th0);
+    const double C0_2 = C0_1*C0_1 - S0_1*S0_1;
+    const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
+    const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
+    const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
+    const double t_0 = 2*du;
+    const double t_1 = 2*dv;
+    const double t_2 = 2*dw;
+    const double t_3 = ((omega)*(omega));
+    const double t_4 = ((u)*(u));
+    const double t_5 = g5 + g7*t_4;
+    const double t_6 = g3 + t_4*t_5;
+    const double t_7 = C0_1*kc_u_1 + C0_2*kc_u_2 + C0_3*kc_u_3 + S0_1*ks_u_1 + S0_2*ks_u_2 + S0_3*ks_u_3 + 1;
+    const double t_8 = t_7*(g1 + t_4*t_6);
+    const double t_9 = kappa_u_u*t_8;
+    const double t_10 = ((v)*(v));
+    const double t_11 = g5 + g7*t_10;
+    const double t_12 = g3 + t_10*t_11;
+    const double t_13 = kc_v_1*(C0_1*q[0] - S0_1*q[1]) + kc_v_2*(C0_2*q[4] - S0_2*q[5]) + kc_v_3*(C0_3*q[8] - S0_3*q[9]) + ks_v_1*(C0_1*q[1] + S0_1*q[0]) + ks_v_2*(C0_2*q[5] + S0_2*q[4]) + ks_v_3*(C0_3*q[9] + S0_3*q[8]) + 1;
+    const double t_14 = t_13*(g1 + t_10*t_12);
+    const double t_15 = kappa_u_v*t_14;
+    const double t_16 = ((w)*(w));
+    const double t_17 = g5 + g7*t_16;
+    const double t_18 = g3 + t_16*t_17;
+    const double t_19 = kc_w_1*(C0_1*q[2] - S0_1*q[3]) + kc_w_2*(C0_2*q[6] - S0_2*q[7]) + kc_w_3*(C0_3*q[10] - S0_3*q[11]) + ks_w_1*(C0_1*q[3] + S0_1*q[2]) + ks_w_2*(C0_2*q[7] + S0_2*q[6]) + ks_w_3*(C0_3*q[11] + S0_3*q[10]) + 1;
+    const double t_20 = t_19*(g1 + t_16*t_18);
+    const double t_21 = kappa_u_w*t_20;
+    const double t_22 = kappa_v_u*t_8;
+    const double t_23 = kappa_v_v*t_14;
+    const double t_24 = kappa_v_w*t_20;
+    const double t_25 = kappa_w_u*t_8;
+    const double t_26 = kappa_w_v*t_14;
+    const double t_27 = kappa_w_w*t_20;
+    const double t_28 = 2*w3;
+    const double t_29 = 2*w4;
+    const double t_30 = 2*w5;
+    const double t_31 = 2*u;
+    const double t_32 = 2*g7;
+    const double t_33 = t_7*u*(t_31*t_6 + t_4*(t_31*t_5 + t_32*((u)*(u)*(u))));
+    const double t_34 = 2*v;
+    const double t_35 = t_13*v*(t_10*(t_11*t_34 + t_32*((v)*(v)*(v))) + t_12*t_34);
+    const double t_36 = 2*w;
+    const double t_37 = t_19*w*(t_16*(t_17*t_36 + t_32*((w)*(w)*(w))) + t_18*t_36);
+    dx[0] = du;
+    dx[1] = dv;
+    dx[2] = dw;
+    dx[3] = -E_u_1*t_3*(C0_1*q[12] - S0_1*q[13]) + f_u - t_0*xi_u_u - t_1*xi_u_v - t_15*v - t_2*xi_u_w - t_21*w - t_9*u;
+    dx[4] = -E_v_1*t_3*(C0_1*q[14] - S0_1*q[15]) + f_v - t_0*xi_v_u - t_1*xi_v_v - t_2*xi_v_w - t_22*u - t_23*v - t_24*w;
+    dx[5] = -E_w_1*t_3*(C0_1*q[16] - S0_1*q[17]) + f_w - t_0*xi_w_u - t_1*xi_w_v - t_2*xi_w_w - t_25*u - t_26*v - t_27*w;
+    dx[6] = w3;
+    dx[7] = w4;
+    dx[8] = w5;
+    dx[9] = -t_28*xi_u_u - t_29*xi_u_v - t_30*xi_u_w + w0*(-kappa_u_u*t_33 - t_9) + w1*(-kappa_u_v*t_35 - t_15) + w2*(-kappa_u_w*t_37 - t_21);
+    dx[10] = -t_28*xi_v_u - t_29*xi_v_v - t_30*xi_v_w + w0*(-kappa_v_u*t_33 - t_22) + w1*(-kappa_v_v*t_35 - t_23) + w2*(-kappa_v_w*t_37 - t_24);
+    dx[11] = -t_28*xi_w_u - t_29*xi_w_v - t_30*xi_w_w + w0*(-kappa_w_u*t_33 - t_25) + w1*(-kappa_w_v*t_35 - t_26) + w2*(-kappa_w_w*t_37 - t_27);
+    (void)tau; (void)p; (void)q;
+}
+
+static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
+{
+    const double th0 = (P[0*n])*tau;
+    const double C0_1 = cos(th0), S0_1 = sin(th0);
+    const double C0_2 = C0_1*C0_1 - S0_1*S0_1;
+    const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
+    const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
+    const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
+#pragma GCC ivdep
+    for (int j = 0; j < n; ++j) {
+        double q[GS_NQ];
+        for (int k = 0; k < GS_NQ; ++k) q[k] = Q[k*n + j];
+        const double u = X[0*n + j];
+        const double v = X[1*n + j];
+        const double w = X[2*n + j];
+        const double du = X[3*n + j];
+        const double dv = X[4*n + j];
+        const double dw = X[5*n + j];
+        const double w0 = X[6*n + j];
+        const double w1 = X[7*n + j];
+        const double w2 = X[8*n + j];
+        const double w3 = X[9*n + j];
+        const double w4 = X[10*n + j];
+        const double w5 = X[11*n + j];
+        const double omega = P[0*n + j];
+        const double f_u = P[1*n + j];
+        const double f_v = P[2*n + j];
+        const double f_w = P[3*n + j];
+        const double xi_u_u = P[4*n + j];
+        const double xi_u_v = P[5*n + j];
+        const double xi_u_w = P[6*n + j];
+        const double xi_v_u = P[7*n + j];
+        const double xi_v_v = P[8*n + j];
+        const double xi_v_w = P[9*n + j];
+        const double xi_w_u = P[10*n + j];
+        const double xi_w_v = P[11*n + j];
+        const double xi_w_w = P[12*n + j];
+        const double kappa_u_u = P[13*n + j];
+        const double kappa_u_v = P[14*n + j];
+        const double kappa_u_w = P[15*n + j];
+        const double kappa_v_u = P[16*n + j];
+        const double kappa_v_v = P[17*n + j];
+        const double kappa_v_w = P[18*n + j];
+        const double kappa_w_u = P[19*n + j];
+        const double kappa_w_v = P[20*n + j];
+        const double kappa_w_w = P[21*n + j];
+        const double kc_u_1 = P[22*n + j];
+        const double ks_u_1 = P[23*n + j];
+        const double kc_u_2 = P[24*n + j];
+        const double ks_u_2 = P[25*n + j];
+        const double kc_u_3 = P[26*n + j];
+        const double ks_u_3 = P[27*n + j];
+        const double kc_v_1 = P[28*n + j];
+        const double ks_v_1 = P[29*n + j];
+        const double kc_v_2 = P[30*n + j];
+        const double ks_v_2 = P[31*n + j];
+        const double kc_v_3 = P[32*n + j];
+        const double ks_v_3 = P[33*n + j];
+        const double kc_w_1 = P[34*n + j];
+        const double ks_w_1 = P[35*n + j];
+        const double kc_w_2 = P[36*n + j];
+        const double ks_w_2 = P[37*n + j];
+        const double kc_w_3 = P[38*n + j];
+        const double ks_w_3 = P[39*n + j];
+        const double E_u_1 = P[42*n + j];
+        const double E_v_1 = P[44*n + j];
+        const double E_w_1 = P[46*n + j];
+        const double g1 = P[48*n + j];
+        const double g3 = P[49*n + j];
+        const double g5 = P[50*n + j];
+        const double g7 = P[51*n + j];
+        const double t_0 = 2*du;
+        const double t_1 = 2*dv;
+        const double t_2 = 2*dw;
+        const double t_3 = ((omega)*(omega));
+        const double t_4 = ((u)*(u));
+        const double t_5 = g5 + g7*t_4;
+        const double t_6 = g3 + t_4*t_5;
+        const double t_7 = C0_1*kc_u_1 + C0_2*kc_u_2 + C0_3*kc_u_3 + S0_1*ks_u_1 + S0_2*ks_u_2 + S0_3*ks_u_3 + 1;
+        const double t_8 = t_7*(g1 + t_4*t_6);
+        const double t_9 = kappa_u_u*t_8;
+        const double t_10 = ((v)*(v));
+        const double t_11 = g5 + g7*t_10;
+        const double t_12 = g3 + t_10*t_11;
+        const double t_13 = kc_v_1*(C0_1*q[0] - S0_1*q[1]) + kc_v_2*(C0_2*q[4] - S0_2*q[5]) + kc_v_3*(C0_3*q[8] - S0_3*q[9]) + ks_v_1*(C0_1*q[1] + S0_1*q[0]) + ks_v_2*(C0_2*q[5] + S0_2*q[4]) + ks_v_3*(C0_3*q[9] + S0_3*q[8]) + 1;
+        const double t_14 = t_13*(g1 + t_10*t_12);
+        const double t_15 = kappa_u_v*t_14;
+        const double t_16 = ((w)*(w));
+        const double t_17 = g5 + g7*t_16;
+        const double t_18 = g3 + t_16*t_17;
+        const double t_19 = kc_w_1*(C0_1*q[2] - S0_1*q[3]) + kc_w_2*(C0_2*q[6] - S0_2*q[7]) + kc_w_3*(C0_3*q[10] - S0_3*q[11]) + ks_w_1*(C0_1*q[3] + S0_1*q[2]) + ks_w_2*(C0_2*q[7] + S0_2*q[6]) + ks_w_3*(C0_3*q[11] + S0_3*q[10]) + 1;
+        const double t_20 = t_19*(g1 + t_16*t_18);
+        const double t_21 = kappa_u_w*t_20;
+        const double t_22 = kappa_v_u*t_8;
+        const double t_23 = kappa_v_v*t_14;
+        const double t_24 = kappa_v_w*t_20;
+        const double t_25 = kappa_w_u*t_8;
+        const double t_26 = kappa_w_v*t_14;
+        const double t_27 = kappa_w_w*t_20;
+        const double t_28 = 2*w3;
+        const double t_29 = 2*w4;
+        const double t_30 = 2*w5;
+        const double t_31 = 2*u;
+        const double t_32 = 2*g7;
+        const double t_33 = t_7*u*(t_31*t_6 + t_4*(t_31*t_5 + t_32*((u)*(u)*(u))));
+        const double t_34 = 2*v;
+        const double t_35 = t_13*v*(t_10*(t_11*t_34 + t_32*((v)*(v)*(v))) + t_12*t_34);
+        const double t_36 = 2*w;
+        const double t_37 = t_19*w*(t_16*(t_17*t_36 + t_32*((w)*(w)*(w))) + t_18*t_36);
+        DX[0*n + j] = du;
+        DX[1*n + j] = dv;
+        DX[2*n + j] = dw;
+        DX[3*n + j] = -E_u_1*t_3*(C0_1*q[12] - S0_1*q[13]) + f_u - t_0*xi_u_u - t_1*xi_u_v - t_15*v - t_2*xi_u_w - t_21*w - t_9*u;
+        DX[4*n + j] = -E_v_1*t_3*(C0_1*q[14] - S0_1*q[15]) + f_v - t_0*xi_v_u - t_1*xi_v_v - t_2*xi_v_w - t_22*u - t_23*v - t_24*w;
+        DX[5*n + j] = -E_w_1*t_3*(C0_1*q[16] - S0_1*q[17]) + f_w - t_0*xi_w_u - t_1*xi_w_v - t_2*xi_w_w - t_25*u - t_26*v - t_27*w;
+        DX[6*n + j] = w3;
+        DX[7*n + j] = w4;
+        DX[8*n + j] = w5;
+        DX[9*n + j] = -t_28*xi_u_u - t_29*xi_u_v - t_30*xi_u_w + w0*(-kappa_u_u*t_33 - t_9) + w1*(-kappa_u_v*t_35 - t_15) + w2*(-kappa_u_w*t_37 - t_21);
+        DX[10*n + j] = -t_28*xi_v_u - t_29*xi_v_v - t_30*xi_v_w + w0*(-kappa_v_u*t_33 - t_22) + w1*(-kappa_v_v*t_35 - t_23) + w2*(-kappa_v_w*t_37 - t_24);
+        DX[11*n + j] = -t_28*xi_w_u - t_29*xi_w_v - t_30*xi_w_w + w0*(-kappa_w_u*t_33 - t_25) + w1*(-kappa_w_v*t_35 - t_26) + w2*(-kappa_w_w*t_37 - t_27);
+    }
+    (void)tau; (void)P; (void)Q;
+}
+"""
+
 
 def rhs(tau, x, p):
     """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); result (n,) or (n, N)."""

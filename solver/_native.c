@@ -467,3 +467,47 @@ void gs_eval_batch(double tau, int n, const double *X, const double *P, double *
     gs_rhs_batch(tau, n, X, P, Q, DX);
     free(Q);
 }
+
+#ifdef GS_VARIATIONAL
+/* Benettin's largest Lyapunov exponent: the state x (first half) and a tangent vector w
+ * (second half) integrated together period by period; w renormalised after each period and
+ * log |w| accumulated.  running[k] = estimate after k + 1 periods.  Returns a GS_ status. */
+int gs_benettin(const double *p, const double *z0, double t0, double period, int periods,
+                double rtol, double atol, double bound, long long max_steps, double *running,
+                long long *NFEV)
+{
+    const int n = GS_NX / 2;
+    double q[GS_NQ], z[GS_NX], f[GS_NX];
+    long long nfev = 0, nsteps = 0;
+    gs_prep(p, q);
+    memcpy(z, z0, sizeof(double) * GS_NX);
+    double t = t0, total = 0.0;
+    gs_rhs(t, z, p, q, f);
+    nfev += 1;
+    double h_abs = gs_initial_step(t, z, f, period, 7, rtol, atol, p, q, &nfev);
+    static const gs_tableau DOP853 = {12, GS_DOP853_A, GS_DOP853_B, GS_DOP853_C, 0,
+                                      GS_DOP853_E3, GS_DOP853_E5, 7};
+    for (int k = 0; k < periods; ++k) {
+        const int status = gs_adaptive_to(&DOP853, &t, z, f, &h_abs, t0 + (k + 1) * period,
+                                          rtol, atol, p, q, bound, max_steps, &nfev, &nsteps);
+        if (status != GS_OK) {
+            *NFEV = nfev;
+            return status;
+        }
+        double g = 0.0;
+        for (int i = n; i < GS_NX; ++i) g += z[i] * z[i];
+        g = sqrt(g);
+        if (!(g > 0.0) || !isfinite(g)) {
+            *NFEV = nfev;
+            return GS_NOT_FINITE;
+        }
+        total += log(g);
+        for (int i = n; i < GS_NX; ++i) z[i] /= g;
+        gs_rhs(t, z, p, q, f); /* the tangent part of f changed with the rescaling */
+        nfev += 1;
+        running[k] = total / ((k + 1) * period);
+    }
+    *NFEV = nfev;
+    return GS_OK;
+}
+#endif

@@ -283,6 +283,26 @@ def _cmd_stiffness(args) -> int:
     return 0
 
 
+def _cmd_bench(args) -> int:
+    import importlib.util
+
+    from gearsym.derive.build import project_root
+
+    path = project_root() / "benchmarks" / "performance.py"
+    if not path.exists():
+        raise _Fail(
+            "bench needs the checkout's benchmarks/ folder; install gearsym from a clone "
+            "with `pip install -e .`"
+        )
+    spec = importlib.util.spec_from_file_location("gearsym_benchmarks_performance", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    argv = (["--quick"] if args.quick else []) + (["--json"] if args.json else [])
+    if args.out:
+        argv += ["--out", args.out]
+    return bench.main(argv)
+
+
 def _cmd_simulate(args) -> int:
     from gearsym.solver._json import dumps
     from gearsym.solver.point import analyse_point
@@ -359,6 +379,7 @@ def _cmd_sweep(args) -> int:
     try:
         result = sweep(system, args.param, values, continuation=not args.independent,
                        backward=args.backward, executor=args.executor, progress=bar,
+                       scheduler=args.scheduler,
                        store=out / "store", **_analysis_settings(args))  # fmt: skip
     except (SimulationError, ValueError) as err:
         raise _Fail(f"sweep: {err}") from None
@@ -643,6 +664,16 @@ def _parser() -> argparse.ArgumentParser:
     )
     st.set_defaults(func=_cmd_stiffness)
 
+    be = sub.add_parser("bench", help="measure speed against accuracy; write docs/performance.md",
+                        description="Benchmarks of every integration back end (benchmarks/"
+                        "performance.py): the headline sweep against the plain SciPy baseline "
+                        "and a hand-written C reference, throughput, the speed/accuracy Pareto "
+                        "table, feature costs and scaling.")  # fmt: skip
+    be.add_argument("--quick", action="store_true", help="fewer points and repeats (~1 min)")
+    be.add_argument("--json", action="store_true", help="also print every figure as JSON")
+    be.add_argument("--out", metavar="FILE", help="write FILE instead of docs/performance.md")
+    be.set_defaults(func=_cmd_bench)
+
     si = sub.add_parser("simulate", help="simulate one operating point and classify it",
                         description="Simulate a scene, discard the transient, and report the "
                         "Poincaré points, motion type with its evidence, ranges, spectral "
@@ -668,11 +699,15 @@ def _parser() -> argparse.ArgumentParser:
         action="store_true",
         help="no continuation: every point from the same initial state",
     )
-    sw.add_argument("--executor", choices=("serial", "processes"), default="processes")
+    sw.add_argument("--executor", choices=("serial", "processes", "dask"), default="processes",
+                    help="serial, local processes (default, all cores) or dask.distributed "
+                    "(needs gearsym[dask]; a LocalCluster unless --scheduler)")  # fmt: skip
+    sw.add_argument("--scheduler", metavar="ADDRESS",
+                    help="dask scheduler address, e.g. tcp://head:8786")  # fmt: skip
     sw.add_argument("--out", metavar="DIR")
     sw.add_argument("--quiet", action="store_true", help="no progress bar")
     _analysis_options(sw)
-    sw.set_defaults(func=_cmd_sweep, method_default="cvodes")
+    sw.set_defaults(func=_cmd_sweep, method_default="fastest")
 
     sh = sub.add_parser("shoot", help="find a periodic orbit by shooting; Floquet multipliers",
                         description="Find the period-n orbit (period n T) by Newton shooting "
@@ -731,6 +766,10 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if getattr(args, "method", "absent") is None:
         args.method = args.method_default
+        if args.method == "fastest":
+            from gearsym.solver.simulate import fastest_method
+
+            args.method = fastest_method(args.rtol)
     if args.debug:
         return args.func(args)
     from gearsym.derive import InputError

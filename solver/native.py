@@ -33,6 +33,7 @@ import numpy as np
 
 __all__ = [
     "NATIVE_METHODS",
+    "benettin",
     "BatchResult",
     "NativeUnavailable",
     "compiler",
@@ -107,14 +108,17 @@ def _tables() -> str:
     )
 
 
-def source(module) -> str:
-    """Full C text of the library for a generated module."""
-    if not hasattr(module, "C_SOURCE"):
+def source(module, variational: bool = False) -> str:
+    """Full C text of the library for a generated module (``variational``: the state
+    extended by a tangent vector, with ``gs_benettin``)."""
+    attr = "C_SOURCE_VARIATIONAL" if variational else "C_SOURCE"
+    if not hasattr(module, attr):
         raise NativeUnavailable(
-            f"generated module '{module.NAME}' has no C_SOURCE; regenerate it with `gearsym derive`"
+            f"generated module '{module.NAME}' has no {attr}; regenerate it with `gearsym derive`"
         )
     body = (Path(__file__).with_name("_native.c")).read_text(encoding="utf-8")
-    return "\n".join(["#include <math.h>", module.C_SOURCE, _tables(), body])
+    head = ["#define GS_VARIATIONAL 1"] if variational else []
+    return "\n".join([*head, "#include <math.h>", getattr(module, attr), _tables(), body])
 
 
 def _compiler_id(cc: str) -> str:
@@ -125,7 +129,7 @@ def _compiler_id(cc: str) -> str:
         return cc
 
 
-def library(module) -> tuple[ctypes.CDLL, dict]:
+def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
     """Compile (or load from the cache) the native library of ``module``.
 
     Returns the library and facts: ``path``, ``compiled`` (bool: built now), ``seconds``.
@@ -134,11 +138,11 @@ def library(module) -> tuple[ctypes.CDLL, dict]:
     cc = compiler()
     if cc is None:
         raise NativeUnavailable("no C compiler found (install gcc or clang, or set GEARSYM_CC)")
-    text = source(module)
+    text = source(module, variational)
     key = hashlib.sha256(
         "\n".join([text, _compiler_id(cc), " ".join(_FLAGS)]).encode()
     ).hexdigest()[:20]
-    path = cache_dir() / f"{module.NAME}-{key}.so"
+    path = cache_dir() / f"{module.NAME}{'-var' if variational else ''}-{key}.so"
     facts = {"path": str(path), "compiled": False, "seconds": 0.0, "compiler": cc}
     if str(path) in _loaded:
         return _loaded[str(path)], facts
@@ -190,6 +194,12 @@ def library(module) -> tuple[ctypes.CDLL, dict]:
                                   ptr(np.float64, flags="C")]  # fmt: skip
     lib.gs_rhs_loop.restype = d
     lib.gs_rhs_loop.argtypes = [ptr(np.float64, flags="C"), ptr(np.float64, flags="C"), ll, d]
+    if variational:
+        lib.gs_benettin.restype = i
+        lib.gs_benettin.argtypes = [
+            ptr(np.float64, flags="C"), ptr(np.float64, flags="C"), d, d, i, d, d, d, ll,
+            ptr(np.float64, flags="C"), ptr(np.int64, flags="C"),
+        ]  # fmt: skip
     _loaded[str(path)] = lib
     return lib, facts
 
@@ -226,6 +236,7 @@ def run_batch(
     max_steps: int = 50_000_000,
     lockstep: bool = True,
     group: int = 64,
+    workers: int = 1,
     fallback: bool = True,
 ) -> BatchResult:
     """Integrate every column set ``P[i]`` (parameters) from ``X0[i]`` of ``module``.
@@ -263,6 +274,11 @@ def run_batch(
     k = periods * spp + 1
     t = t0 + (transient + np.arange(k) / spp) * period
     started = time.perf_counter()
+    if workers > 1 and P.shape[0] > 1:
+        return _parallel(module, P, X0, workers, started, dict(
+            method=method, rtol=rtol, atol=atol, t0=t0, transient=transient, periods=periods,
+            samples_per_period=spp, steps_per_period=steps_per_period, bound=bound,
+            max_steps=max_steps, lockstep=lockstep, group=group, fallback=fallback))  # fmt: skip
     try:
         lib, facts = library(module)
     except NativeUnavailable as err:
@@ -300,6 +316,34 @@ def run_batch(
         backend="native",
         wall_time=time.perf_counter() - started,
         compile_seconds=facts["seconds"],
+    )
+
+
+def _chunk(args):
+    source, P, X0, kwargs = args
+    from ._models import load_generated
+
+    return run_batch(load_generated(source), P, X0, **kwargs)
+
+
+def _parallel(module, P, X0, workers, started, kwargs) -> BatchResult:
+    """Split the points into ``workers`` contiguous chunks run by as many processes."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    source = module.__file__
+    library(module)  # compile once here, not in every worker
+    chunks = [c for c in np.array_split(np.arange(P.shape[0]), workers) if c.size]
+    with ProcessPoolExecutor(max_workers=len(chunks)) as pool:
+        parts = list(pool.map(_chunk, [(source, P[c], X0[c], kwargs) for c in chunks]))
+    return BatchResult(
+        t=parts[0].t,
+        x=np.concatenate([r.x for r in parts]),
+        nfev=np.concatenate([r.nfev for r in parts]),
+        nsteps=np.concatenate([r.nsteps for r in parts]),
+        status=tuple(s for r in parts for s in r.status),
+        t_fail=np.concatenate([r.t_fail for r in parts]),
+        backend=parts[0].backend,
+        wall_time=time.perf_counter() - started,
     )
 
 
@@ -359,3 +403,21 @@ def _numpy_batch(module, P, X0, method, rtol, atol, t0, transient, periods, spp,
         backend="numpy",
         wall_time=time.perf_counter() - started,
     )
+
+
+def benettin(module, p, z0, *, t0: float, periods: int, rtol: float, atol: float):
+    """Running estimate of the largest Lyapunov exponent (``solver/lyapunov.py``) in native
+    code: DOP853 on the variational equations, renormalised every period.  Returns
+    ``(running, nfev)``; raises :class:`NativeUnavailable` without a compiler and
+    ``FloatingPointError`` when the run fails."""
+    lib, _ = library(module, variational=True)
+    p = np.ascontiguousarray(p, dtype=float)
+    z0 = np.ascontiguousarray(z0, dtype=float)
+    running = np.empty(periods)
+    nfev = np.zeros(1, dtype=np.int64)
+    period = 2.0 * np.pi / float(p[0])
+    status = lib.gs_benettin(p, z0, float(t0), period, int(periods), float(rtol), float(atol),
+                             1e12, 50_000_000, running, nfev)  # fmt: skip
+    if status != 0:
+        raise FloatingPointError(f"variational integration stopped: {STATUS[status]}")
+    return running, int(nfev[0])

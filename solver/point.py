@@ -41,7 +41,7 @@ class PointResult:
 
 def classification_tolerance(method: str, rtol: float) -> float:
     """How close Poincare points must come to count as the same, relative to the cloud."""
-    if method in ("rk", "collocation"):
+    if method in ("rk", "rk4", "collocation"):
         return 1e-3
     return max(1e-6, 1e3 * rtol)
 

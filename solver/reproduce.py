@@ -19,6 +19,7 @@ import numpy as np
 
 from ._json import dumps
 from .point import analyse_point
+from .simulate import fastest_method
 from .sweep import Progress, sweep_many
 from .system import System
 
@@ -41,7 +42,7 @@ RESOLUTIONS = {
 }
 
 CASES = (("light", "reference_light", 0.1), ("heavy", "reference_heavy", 0.5))
-METHOD = {"method": "cvodes", "rtol": 1e-8, "atol": 1e-10}
+TOLERANCES = {"rtol": 1e-8, "atol": 1e-10}
 
 
 def reproduce(out: Path, *, quick: bool = False, executor: str = "processes",
@@ -52,7 +53,8 @@ def reproduce(out: Path, *, quick: bool = False, executor: str = "processes",
     out = Path(out)
     (out / "data").mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
-    settings = dict(METHOD, transient=res.transient, periods=res.periods,
+    method = fastest_method(TOLERANCES["rtol"])
+    settings = dict(TOLERANCES, method=method, transient=res.transient, periods=res.periods,
                     lyapunov_periods=res.lyapunov_periods)  # fmt: skip
     lam = np.round(np.linspace(0.0, 1.0, res.points), 10)
     systems = {case: System.load(module) for case, module, _ in CASES}
@@ -395,7 +397,8 @@ def _report(res, lam, by_case, points, maps, map_lam, elapsed, quick, systems,
         f"Made by `gearsym reproduce{' --quick' if quick else ''}` in {elapsed:.0f} s "
         f"({'quick' if quick else 'full'} resolution: {res.points} values of λ in [0, 1], "
         f"{res.transient} transient + {res.periods} sampled forcing periods per point, "
-        f"largest Lyapunov exponent over {res.lyapunov_periods} periods; CVODES, rtol 1e-8). "
+        f"largest Lyapunov exponent over {res.lyapunov_periods} periods (CVODES on the "
+        f"variational equations); integrator {fastest_method(TOLERANCES['rtol'])}, rtol 1e-8). "
         f"Model hashes: light `{light.model_hash[:12]}`, heavy "
         f"`{systems['heavy'].model_hash[:12]}`.",
         "",

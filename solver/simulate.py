@@ -34,12 +34,23 @@ from scipy.integrate import solve_ivp
 
 from .system import System
 
-__all__ = ["METHODS", "SimulationError", "Trajectory", "simulate"]
+__all__ = ["METHODS", "SimulationError", "Trajectory", "fastest_method", "simulate"]
 
 SCIPY_METHODS = ("RK45", "DOP853", "LSODA", "Radau")
 CASADI_METHODS = ("cvodes", "rk", "collocation")
 NATIVE_METHODS = ("dop853", "dopri5", "rk4")
 METHODS = SCIPY_METHODS + CASADI_METHODS + NATIVE_METHODS
+
+
+def fastest_method(rtol: float) -> str:
+    """The fastest back end that meets ``rtol`` on this model class, from the measured
+    speed/accuracy trade (``docs/performance.md``): compiled ``dopri5`` down to rtol 1e-6,
+    compiled ``dop853`` below; ``cvodes`` (the fastest uncompiled one) without a C compiler."""
+    from .native import compiler
+
+    if compiler() is None:
+        return "cvodes"
+    return "dopri5" if rtol >= 1e-6 else "dop853"
 
 
 class SimulationError(RuntimeError):

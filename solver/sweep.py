@@ -31,7 +31,7 @@ from .system import System
 
 __all__ = ["Progress", "SweepResult", "SweepStoreError", "sweep", "sweep_many"]
 
-EXECUTORS = ("serial", "processes")
+EXECUTORS = ("serial", "processes", "dask")
 
 
 @dataclass(frozen=True)
@@ -276,7 +276,8 @@ def _plan(system: System, parameter: str, values, *, continuation: bool, backwar
 
 
 def _execute(chains: list[_Chain], executor: str, workers: int | None,
-             progress: Progress | None) -> list[list[dict]]:  # fmt: skip
+             progress: Progress | None,
+             scheduler: str | None = None) -> list[list[dict]]:  # fmt: skip
     if executor not in EXECUTORS:
         raise ValueError(f"unknown executor '{executor}'; executors: {', '.join(EXECUTORS)}")
 
@@ -284,6 +285,8 @@ def _execute(chains: list[_Chain], executor: str, workers: int | None,
         if progress:
             progress.step(f"{chains[0].parameter}={point['value']:.4g}")
 
+    if executor == "dask":
+        return _dask(chains, workers, tick, scheduler)
     if executor == "serial" or len(chains) <= 1:
         return [_run_chain(c, on_point=tick) for c in chains]
     results = []
@@ -293,6 +296,38 @@ def _execute(chains: list[_Chain], executor: str, workers: int | None,
             for point in chunk:
                 tick(point)
     return results
+
+
+def _dask(chains, workers, tick, scheduler) -> list[list[dict]]:
+    """Run the chains on a dask.distributed cluster: the scheduler at ``scheduler``
+    (``tcp://host:port``), or a LocalCluster of ``workers`` single-threaded processes."""
+    try:
+        from dask.distributed import Client, LocalCluster, as_completed
+    except ImportError:
+        raise ValueError(
+            "the dask executor needs dask.distributed: pip install 'gearsym[dask]'"
+        ) from None
+    cluster = None
+    if scheduler:
+        client = Client(scheduler)
+    else:
+        cluster = LocalCluster(n_workers=workers or os.cpu_count(), threads_per_worker=1,
+                               processes=True, dashboard_address=None)  # fmt: skip
+        client = Client(cluster)
+    try:
+        futures = client.map(_run_chain, chains, pure=False)
+        index = {f.key: k for k, f in enumerate(futures)}
+        results: list = [None] * len(chains)
+        for future in as_completed(futures):
+            chunk = future.result()
+            results[index[future.key]] = chunk
+            for point in chunk:
+                tick(point)
+        return results
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
 
 
 def _result(system, parameter, values, direction, settings, points) -> SweepResult:
@@ -321,6 +356,7 @@ def sweep(
     workers: int | None = None,
     progress: Progress | None = None,
     store: Path | None = None,
+    scheduler: str | None = None,
     **settings,
 ) -> SweepResult:
     """Sweep ``parameter`` over ``values`` (see module docstring); ``settings`` go to
@@ -354,7 +390,9 @@ def sweep(
         for _ in done:
             progress.step("(stored)")
     found = dict(done)
-    for chain, points in zip(chains, _execute(chains, executor, workers, progress), strict=True):
+    for chain, points in zip(
+        chains, _execute(chains, executor, workers, progress, scheduler), strict=True
+    ):
         found.update(zip(chain.indices, points, strict=True))
     points = [found[i] for i in range(values.size)]
     if backward:
@@ -363,7 +401,8 @@ def sweep(
 
 
 def sweep_many(jobs: list[dict], *, executor: str = "processes", workers: int | None = None,
-               progress: Progress | None = None) -> list[SweepResult]:  # fmt: skip
+               progress: Progress | None = None,
+               scheduler: str | None = None) -> list[SweepResult]:  # fmt: skip
     """Several continuation sweeps (each a dict of :func:`sweep` arguments, ``system``
     included) run side by side, one chain per worker process."""
     plans = []
@@ -380,7 +419,9 @@ def sweep_many(jobs: list[dict], *, executor: str = "processes", workers: int | 
         )  # fmt: skip
         plans.append(chain)
     results = []
-    for job, points in zip(jobs, _execute(plans, executor, workers, progress), strict=True):
+    for job, points in zip(
+        jobs, _execute(plans, executor, workers, progress, scheduler), strict=True
+    ):
         backward = job.get("backward", False)
         results.append(_result(job["system"], job["parameter"], job["values"],
                                "backward" if backward else "forward", _job_settings(job),

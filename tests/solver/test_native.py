@@ -125,3 +125,17 @@ def test_without_a_compiler_numpy_takes_over_with_a_warning(monkeypatch):
         np.testing.assert_allclose(res.x, compiled.x, atol=1e-6)
     finally:
         importlib.reload(native)
+
+
+def test_native_lyapunov_exponent_matches_cvodes():
+    # Two independent integrators of the same variational equations (compiled DOP853 and
+    # CasADi's CVODES) give the same Benettin estimate.
+    from gearsym.solver.lyapunov import largest_lyapunov
+
+    system = System.load("reference_light", **{"lambda": 0.1})
+    tr = simulate(system, method="dop853", transient=200, periods=2, samples_per_period=1)
+    a = largest_lyapunov(system, tr.x_final, t0=tr.t_final, periods=60, backend="native")
+    b = largest_lyapunov(system, tr.x_final, t0=tr.t_final, periods=60, backend="cvodes")
+    assert a.exponent < 0
+    assert a.exponent == pytest.approx(b.exponent, rel=1e-5)
+    assert a.describe()["method"].endswith("compiled DOP853")

@@ -32,6 +32,22 @@ def test_serial_and_parallel_sweeps_are_bit_identical():
     assert [_strip(p) for p in a.points] == [_strip(p) for p in b.points]
 
 
+def test_a_dask_local_cluster_sweep_equals_the_serial_one():
+    # dask.distributed: two worker processes on a LocalCluster, independent points and one
+    # continuation chain; the points are bit-identical to a serial run (the lyapunov
+    # exponent included: same integrator, same operations).
+    pytest.importorskip("dask.distributed")
+    system = System.load("reference_light")
+    lam = np.linspace(0.0, 1.0, 4)
+    settings = dict(SETTINGS, method="dop853")
+    for continuation in (False, True):
+        a = sweep(system, "lambda", lam, continuation=continuation, executor="serial",
+                  **settings)  # fmt: skip
+        b = sweep(system, "lambda", lam, continuation=continuation, executor="dask",
+                  workers=2, **settings)  # fmt: skip
+        assert [_strip(p) for p in a.points] == [_strip(p) for p in b.points]
+
+
 def test_a_store_of_another_model_is_refused(tmp_path):
     lam = [0.0, 0.5]
     sweep(System.load("reference_light"), "lambda", lam, store=tmp_path, **SETTINGS)
