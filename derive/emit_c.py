@@ -29,7 +29,7 @@ class _Printer(C99CodePrinter):
             b = self._print(base)
             return "(" + "*".join([f"({b})"] * int(exp)) + ")"
         if exp.is_Integer and -8 <= int(exp) <= -1:
-            return f"(1.0/{self._print(sp.Pow(base, -exp))})"
+            return f"(1.0/({self._print(sp.Pow(base, -exp))}))"
         return super()._print_Pow(expr)
 
     def _print_Float(self, expr):
@@ -48,8 +48,14 @@ class _Printer(C99CodePrinter):
         return f"({float(expr.p)!r}/{float(expr.q)!r})"
 
 
-def _reduce_trig(exprs, tau):
-    """Replace trig atoms by recurrence symbols; return (exprs, bases, q_defs)."""
+def _reduce_trig(exprs, tau, params, omega):
+    """Replace trig atoms by recurrence symbols; return (exprs, bases, q_defs).
+
+    Only what is safe is rewritten: an argument ``n w tau + B`` whose frequency ``w``
+    depends on ``omega`` alone (so that points sharing omega share the excitation) and whose
+    phase ``B`` on parameters alone (hoisted into ``q``); anything else (a state inside a
+    sine, a frequency set by another parameter) is printed as it is."""
+    params = set(params)
     atoms = set().union(*(e.atoms(sp.sin, sp.cos) for e in exprs))
     bases: dict = {}  # w -> (index, max harmonic)
     q_defs: dict = {}  # parameter-only expression -> symbol
@@ -67,6 +73,8 @@ def _reduce_trig(exprs, tau):
 
     for atom in sorted(atoms, key=sp.default_sort_key):
         arg = sp.expand(atom.args[0])
+        if not arg.free_symbols <= params | {tau}:
+            continue  # depends on a state: computed where it stands
         if tau not in arg.free_symbols:
             replace[atom] = q(atom)
             continue
@@ -78,6 +86,8 @@ def _reduce_trig(exprs, tau):
         n, w = coeff.as_coeff_Mul()
         if not (n.is_Integer and n != 0):
             n, w = sp.Integer(1), coeff
+        if not w.free_symbols <= {omega}:
+            continue  # a frequency set by another parameter: not shared by a group
         k, sign = abs(int(n)), (1 if n > 0 else -1)
         c_a, s_a = harmonic(w, k)
         s_a = sign * s_a
@@ -109,7 +119,8 @@ def c_source(model: Model, variational: bool = False) -> str:
         jac = list(model.jacobian)
         exprs += [sp.Add(*[jac[i * n0 + j] * w[j] for j in range(n0)]) for i in range(n0)]
         states += w
-    exprs, bases, q_defs = _reduce_trig(exprs, tau)
+    omega = next((s for s in model.parameter_symbols if s.name == "omega"), None)
+    exprs, bases, q_defs = _reduce_trig(exprs, tau, model.parameter_symbols, omega)
     n, m = len(states), len(model.parameters)
     params = {s: k for k, s in enumerate(model.parameter_symbols)}
 

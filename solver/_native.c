@@ -135,10 +135,11 @@ static int gs_adaptive_to(const gs_tableau *T, double *t, double *y, double *f, 
     const double exponent = -1.0 / (T->error_order + 1);
     while (*t < target) {
         const double min_step = 10.0 * fabs(nextafter(*t, INFINITY) - *t);
+        if (!isfinite(*h_abs)) return GS_NOT_FINITE;
         double h = *h_abs < min_step ? min_step : *h_abs;
         int rejected = 0;
         for (;;) {
-            if (h < min_step) return GS_STEP_TOO_SMALL;
+            if (!(h >= min_step)) return GS_STEP_TOO_SMALL;
             double t_new = *t + h;
             int clipped = 0;
             if (t_new >= target) {
@@ -173,7 +174,7 @@ static int gs_adaptive_to(const gs_tableau *T, double *t, double *y, double *f, 
         *nsteps += 1;
         const int c = gs_check(y, bound);
         if (c != GS_OK) return c;
-        if (*nsteps > max_steps) return GS_TOO_MANY_STEPS;
+        if (*nsteps >= max_steps) return GS_TOO_MANY_STEPS;
     }
     return GS_OK;
 }
@@ -215,15 +216,18 @@ int gs_run(int method, int npts, const double *P, const double *X0, double t0, d
         memcpy(y, X0 + (long)i * GS_NX, sizeof(double) * GS_NX);
         double h_abs = 0.0;
         const double t_end = t0 + (double)(n_transient + n_sample) * period;
-        if (method != 2) {
+        status = gs_check(y, bound);
+        if (status == GS_OK && method != 2) {
             gs_rhs(t, y, p, q, f);
             nfev += 1;
+            status = gs_check(f, INFINITY);
             h_abs = gs_initial_step(t, y, f, t_end - t0, T->error_order, rtol, atol, p, q,
                                     &nfev);
         }
         int k = 0;
         long long done = 0; /* RK4 steps taken */
-        for (; k < n_out; ++k) {
+        const int bad_start = status != GS_OK;
+        for (; k < n_out && !bad_start; ++k) {
             const double target =
                 t0 + ((double)n_transient * spp + k) * period / (double)spp;
             if (method == 2) {
@@ -313,13 +317,23 @@ int gs_run_lockstep(int method, int npts, int group, const double *P, const doub
             for (int k = 0; k < GS_NQ; ++k) Qg[k * n + j] = q[k];
             for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = X0[(long)(g0 + j) * GS_NX + i];
             gs_rhs(t0, X0 + (long)(g0 + j) * GS_NX, p, q, f);
-            const double h0 = gs_initial_step(t0, X0 + (long)(g0 + j) * GS_NX, f, t_end - t0,
-                                              T->error_order, rtol, atol, p, q, &nfev);
-            if (h0 < h_abs) h_abs = h0;
             alive[j] = 1;
             STATUS[g0 + j] = GS_OK;
             TFAIL[g0 + j] = NAN;
+            int c = gs_check(X0 + (long)(g0 + j) * GS_NX, bound);
+            if (c == GS_OK) c = gs_check(f, INFINITY);
+            if (c != GS_OK) {
+                alive[j] = 0;
+                STATUS[g0 + j] = c;
+                TFAIL[g0 + j] = t0;
+                for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = 0.0;
+                continue;
+            }
+            const double h0 = gs_initial_step(t0, X0 + (long)(g0 + j) * GS_NX, f, t_end - t0,
+                                              T->error_order, rtol, atol, p, q, &nfev);
+            if (h0 < h_abs) h_abs = h0;
         }
+        if (!isfinite(h_abs)) h_abs = 1e-6 * period;
         nfev = nfev / (n > 0 ? n : 1) + 1;
         gs_rhs_batch(t0, n, Y, Pg, Qg, K); /* K[0] = f(t0, y0) */
         int group_status = GS_OK;
@@ -392,7 +406,15 @@ int gs_run_lockstep(int method, int npts, int group, const double *P, const doub
                                      ? 0.0
                                      : fabs(hh) * E5s[j] / sqrt((E5s[j] + 0.01 * E3s[j]) * GS_NX);
                         }
-                        if (!(ej <= err)) err = ej; /* NaN propagates as a rejection */
+                        if (!isfinite(ej)) {
+                            /* a non-finite point leaves the group instead of stalling it */
+                            alive[j] = 0;
+                            STATUS[g0 + j] = GS_NOT_FINITE;
+                            TFAIL[g0 + j] = t;
+                            for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = 0.0;
+                            continue;
+                        }
+                        if (ej > err) err = ej;
                     }
                     if (err < 1.0) {
                         double factor = err == 0.0 ? 10.0 : 0.9 * pow(err, exponent);
@@ -411,7 +433,7 @@ int gs_run_lockstep(int method, int npts, int group, const double *P, const doub
                     rejected = 1;
                 }
                 nsteps += 1;
-                if (nsteps > max_steps && group_status == GS_OK) group_status = GS_TOO_MANY_STEPS;
+                if (nsteps >= max_steps && group_status == GS_OK) group_status = GS_TOO_MANY_STEPS;
                 for (int j = 0; j < n; ++j) {
                     if (!alive[j]) continue;
                     double yj[GS_NX];
@@ -484,6 +506,10 @@ int gs_benettin(const double *p, const double *z0, double t0, double period, int
     double t = t0, total = 0.0;
     gs_rhs(t, z, p, q, f);
     nfev += 1;
+    if (gs_check(z, bound) != GS_OK || gs_check(f, INFINITY) != GS_OK) {
+        *NFEV = nfev;
+        return GS_NOT_FINITE;
+    }
     double h_abs = gs_initial_step(t, z, f, period, 7, rtol, atol, p, q, &nfev);
     static const gs_tableau DOP853 = {12, GS_DOP853_A, GS_DOP853_B, GS_DOP853_C, 0,
                                       GS_DOP853_E3, GS_DOP853_E5, 7};

@@ -19,8 +19,10 @@ warning.
 from __future__ import annotations
 
 import ctypes
+import functools
 import hashlib
 import os
+import platform
 import shutil
 import subprocess
 import tempfile
@@ -54,6 +56,8 @@ _FLAGS = (
 )
 _loaded: dict[str, ctypes.CDLL] = {}
 _warned: set[str] = set()
+_paths: dict[tuple, Path] = {}  # (module file, inputs hash, variational, compiler) -> library
+_failed: dict[str, str] = {}  # cache key -> why it could not be built (once per session)
 
 
 class NativeUnavailable(RuntimeError):
@@ -121,12 +125,24 @@ def source(module, variational: bool = False) -> str:
     return "\n".join([*head, "#include <math.h>", getattr(module, attr), _tables(), body])
 
 
+@functools.lru_cache(maxsize=8)
 def _compiler_id(cc: str) -> str:
+    """The compiler's version line and this CPU's identity: the libraries are built with
+    -march=native, so a cache shared between machines (a cluster's home) keeps one per CPU."""
     try:
         out = subprocess.run([cc, "--version"], capture_output=True, text=True, timeout=30)
-        return out.stdout.splitlines()[0] if out.stdout else cc
+        version = out.stdout.splitlines()[0] if out.stdout else cc
     except (OSError, subprocess.SubprocessError):
-        return cc
+        version = cc
+    cpu = platform.machine()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as fh:
+            for line in fh:
+                if line.startswith(("flags", "Features", "model name")):
+                    cpu += "|" + line.strip()
+    except OSError:
+        cpu += "|" + platform.processor()
+    return version + "|" + cpu
 
 
 def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
@@ -138,13 +154,23 @@ def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
     cc = compiler()
     if cc is None:
         raise NativeUnavailable("no C compiler found (install gcc or clang, or set GEARSYM_CC)")
+    memo = (getattr(module, "__file__", module.NAME), getattr(module, "INPUTS_SHA256", ""),
+            variational, cc, str(cache_dir()))  # fmt: skip
+    facts = {"compiled": False, "seconds": 0.0, "compiler": cc}
+    path = _paths.get(memo)
+    if path is not None and str(path) in _loaded:
+        facts["path"] = str(path)
+        return _loaded[str(path)], facts
     text = source(module, variational)
     key = hashlib.sha256(
         "\n".join([text, _compiler_id(cc), " ".join(_FLAGS)]).encode()
     ).hexdigest()[:20]
+    if key in _failed:
+        raise NativeUnavailable(_failed[key])
     path = cache_dir() / f"{module.NAME}{'-var' if variational else ''}-{key}.so"
-    facts = {"path": str(path), "compiled": False, "seconds": 0.0, "compiler": cc}
+    facts["path"] = str(path)
     if str(path) in _loaded:
+        _paths[memo] = path
         return _loaded[str(path)], facts
     if not path.exists():
         started = time.perf_counter()
@@ -161,12 +187,15 @@ def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
                     timeout=300,
                 )
             except (OSError, subprocess.SubprocessError) as err:
-                raise NativeUnavailable(f"the C compiler {cc} could not be run: {err}") from None
+                _failed[key] = f"the C compiler {cc} could not be run: {err}"
+                raise NativeUnavailable(_failed[key]) from None
             if done.returncode != 0:
                 first = (done.stderr or done.stdout).strip().splitlines()[:3]
-                raise NativeUnavailable(f"compiling {module.NAME} failed: {' / '.join(first)}")
+                _failed[key] = f"compiling {module.NAME} failed: {' / '.join(first)}"
+                raise NativeUnavailable(_failed[key])
             os.replace(so, path)  # atomic: parallel workers never see half a library
         facts.update(compiled=True, seconds=time.perf_counter() - started)
+    _paths[memo] = path
     lib = ctypes.CDLL(str(path))
     d, i, ll = ctypes.c_double, ctypes.c_int, ctypes.c_longlong
     ptr = np.ctypeslib.ndpointer
@@ -259,6 +288,10 @@ def run_batch(
         raise ValueError(
             f"P must be (N, {len(module.PARAMETERS)}) and X0 (N, {n}); got {P.shape} and {X0.shape}"
         )
+    if not (np.all(np.isfinite(P)) and np.all(np.isfinite(X0))):
+        bad = "P" if not np.all(np.isfinite(P)) else "X0"
+        raise ValueError(f"{bad} holds a NaN or infinite value; every parameter and initial "
+                         "state must be a finite number")  # fmt: skip
     omega = P[:, 0]
     if not (np.all(np.isfinite(omega)) and np.all(omega > 0)) or np.ptp(omega) != 0.0:
         raise ValueError("omega (P[:, 0]) must be positive and the same for every point")
@@ -274,6 +307,10 @@ def run_batch(
     k = periods * spp + 1
     t = t0 + (transient + np.arange(k) / spp) * period
     started = time.perf_counter()
+    if "?" in getattr(module, "C_SOURCE", ""):
+        # A piecewise force law (the dead zone): each point's kinks would shrink the step
+        # of the whole group, so such models run point by point.
+        lockstep = False
     if workers > 1 and P.shape[0] > 1:
         return _parallel(module, P, X0, workers, started, dict(
             method=method, rtol=rtol, atol=atol, t0=t0, transient=transient, periods=periods,
@@ -331,7 +368,12 @@ def _parallel(module, P, X0, workers, started, kwargs) -> BatchResult:
     from concurrent.futures import ProcessPoolExecutor
 
     source = module.__file__
-    library(module)  # compile once here, not in every worker
+    try:
+        library(module)  # compile once here, not in every worker
+    except NativeUnavailable:
+        if not kwargs.get("fallback", True):
+            raise
+        return run_batch(module, P, X0, **kwargs)  # the NumPy path, in this process
     chunks = [c for c in np.array_split(np.arange(P.shape[0]), workers) if c.size]
     with ProcessPoolExecutor(max_workers=len(chunks)) as pool:
         parts = list(pool.map(_chunk, [(source, P[c], X0[c], kwargs) for c in chunks]))
@@ -349,13 +391,13 @@ def _parallel(module, P, X0, workers, started, kwargs) -> BatchResult:
 
 def _numpy_batch(module, P, X0, method, rtol, atol, t0, transient, periods, spp,
                  steps_per_period, bound, t, started) -> BatchResult:  # fmt: skip
-    """The same integration without a compiler: one vectorised system (all points at once)
-    under SciPy's RK45/DOP853, or NumPy RK4 on the same grid as the C code."""
+    """The same integration without a compiler: SciPy's RK45/DOP853 point by point on the
+    generated NumPy right-hand side (each with an escape event at ``bound``), or NumPy RK4
+    on all points at once, on the same grid as the C code."""
     from scipy.integrate import solve_ivp
 
     N, n = X0.shape
     Pt = P.T.copy()
-    period = t[1] - t[0] if len(t) > 1 else 2 * np.pi / P[0, 0]
     period = 2.0 * np.pi / float(P[0, 0])
     if method == "rk4":
         h = period / steps_per_period
@@ -377,29 +419,46 @@ def _numpy_batch(module, P, X0, method, rtol, atol, t0, transient, periods, spp,
             y = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
         nfev = np.full(N, 4 * steps_total)
         nsteps = np.full(N, steps_total)
+        finite = np.all(np.isfinite(out), axis=(1, 2))
+        big = np.any(np.abs(np.nan_to_num(out)) > bound, axis=(1, 2))
+        status = tuple("ok" if f and not b else ("divergent" if b else "not finite")
+                       for f, b in zip(finite, big, strict=True))  # fmt: skip
+        t_fail = np.full(N, np.nan)
     else:
-
-        def f(tt, yy):
-            return module.rhs(tt, yy.reshape(n, N), Pt).reshape(-1)
-
-        sol = solve_ivp(f, (t0, t[-1]), X0.T.reshape(-1), method="RK45" if method == "dopri5"
-                        else "DOP853", t_eval=t, rtol=rtol, atol=atol)  # fmt: skip
+        # point by point, each stopped by its own escape event (a diverging point must not
+        # hold up the others, as one stacked system would)
         out = np.full((N, len(t), n), np.nan)
-        m = sol.y.shape[1]
-        out[:, :m, :] = sol.y.reshape(n, N, m).transpose(1, 2, 0)
-        nfev = np.full(N, sol.nfev)
-        nsteps = np.full(N, len(sol.t))
-    finite = np.all(np.isfinite(out), axis=(1, 2))
-    big = np.any(np.abs(np.nan_to_num(out)) > bound, axis=(1, 2))
-    status = tuple("ok" if f and not b else ("divergent" if b else "not finite")
-                   for f, b in zip(finite, big, strict=True))  # fmt: skip
+        nfev = np.zeros(N, dtype=np.int64)
+        nsteps = np.zeros(N, dtype=np.int64)
+        status, t_fail = [], np.full(N, np.nan)
+
+        def escape(tt, yy):
+            return bound - np.max(np.abs(yy))
+
+        escape.terminal = True
+        for i in range(N):
+            sol = solve_ivp(lambda tt, yy, pp=P[i]: module.rhs(tt, yy, pp), (t0, t[-1]), X0[i],
+                            method="RK45" if method == "dopri5" else "DOP853", t_eval=t,
+                            rtol=rtol, atol=atol, events=escape)  # fmt: skip
+            ys = np.asarray(sol.y, dtype=float).reshape(n, -1)  # [] when no sample was reached
+            out[i, : ys.shape[1], :] = ys.T
+            nfev[i], nsteps[i] = sol.nfev, len(sol.t)
+            if sol.status == 1:
+                status.append("divergent")
+                t_fail[i] = float(sol.t_events[0][0])
+            elif sol.status != 0 or not np.all(np.isfinite(ys)):
+                status.append("not finite")
+                t_fail[i] = float(sol.t[-1]) if sol.t.size else t0
+            else:
+                status.append("ok")
+        status = tuple(status)
     return BatchResult(
         t=t,
         x=out,
         nfev=nfev,
         nsteps=nsteps,
         status=status,
-        t_fail=np.full(N, np.nan),
+        t_fail=t_fail,
         backend="numpy",
         wall_time=time.perf_counter() - started,
     )

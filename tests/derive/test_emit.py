@@ -145,3 +145,23 @@ def test_parameters_function_maps_scene_parameters():
     assert mod.parameters(kappa_u_v=0.0)[idx["kappa_u_v"]] == 0.0
     with pytest.raises(KeyError, match="unknown parameter"):
         mod.parameters(lamda=0.3)
+
+
+def test_c_printer_keeps_reciprocals_of_sums_and_leaves_state_trig_alone():
+    # 1/(a + b u) must not print as 1.0/a + b*u; sin of a state is not a parameter-only
+    # term to hoist; a frequency set by another parameter is not reduced.
+    import sympy as sp
+    from gearsym.derive.emit_c import _Printer, _reduce_trig
+
+    a, b, u, omega, r, tau = sp.symbols("a b u omega r tau")
+    text = _Printer().doprint(1 / (a + b * u))
+    assert eval(text.replace("1.0/", "1.0/"), {"a": 2.0, "b": 3.0, "u": 0.5}) == pytest.approx(
+        1 / 3.5
+    )
+    exprs, bases, q = _reduce_trig(
+        [sp.sin(u), sp.cos(omega * tau + u), sp.cos(r * tau), sp.cos(2 * omega * tau - a)],
+        tau, [a, b, omega, r], omega,
+    )  # fmt: skip
+    assert exprs[0] == sp.sin(u) and exprs[1] == sp.cos(omega * tau + u)
+    assert exprs[2] == sp.cos(r * tau)
+    assert list(bases) == [omega] and sp.cos(a) in q and sp.sin(a) in q

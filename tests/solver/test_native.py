@@ -139,3 +139,36 @@ def test_native_lyapunov_exponent_matches_cvodes():
     assert a.exponent < 0
     assert a.exponent == pytest.approx(b.exponent, rel=1e-5)
     assert a.describe()["method"].endswith("compiled DOP853")
+
+
+def test_bad_starts_end_at_once_with_a_status():
+    # A start beyond the bound (or one whose right-hand side is not finite) ends the point
+    # at once instead of stepping forever; NaN parameters are refused with a message.
+    module = System.load("reference_light").module
+    p = module.parameters()
+    start = np.array([[1.0, 0.0, 0.0, 0.0], [1e50, -1e50, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]])
+    for lockstep in (False, True):
+        res = native.run_batch(module, np.repeat(p[None, :], 3, axis=0), start, transient=2,
+                               periods=1, lockstep=lockstep, group=3)  # fmt: skip
+        assert res.status == ("ok", "divergent", "ok")
+    bad = p.copy()
+    bad[3] = np.nan
+    with pytest.raises(ValueError, match="P holds a NaN"):
+        native.run_batch(module, bad[None, :], start[:1])
+
+
+def test_fallback_with_workers_and_a_diverging_point(monkeypatch):
+    # Without a compiler, several workers and a diverging point still give every point its
+    # own status, as the compiled path does.
+    monkeypatch.setenv("GEARSYM_CC", "none")
+    module = System.load("reference_light").module
+    P = np.array([module.parameters(**{"lambda": 0.8}),
+                  module.parameters(**{"lambda": 0.8, "damping_ratio": -0.5})])  # fmt: skip
+    x0 = default_initial_state(System.load("reference_light"))
+    X0 = np.repeat(x0[None, :], 2, axis=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = native.run_batch(module, P, X0, method="dop853", transient=40, periods=2,
+                               workers=2)  # fmt: skip
+    assert res.backend == "numpy"
+    assert res.status == ("ok", "divergent")
