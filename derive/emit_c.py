@@ -102,6 +102,24 @@ def _reduce_trig(exprs, tau, params, omega):
     return [e.xreplace(replace) for e in exprs], bases, q_defs
 
 
+def _harmonic_lines(bases, printer, substitute=None) -> list[str]:
+    """``cos``/``sin`` of ``k w tau`` for each base frequency ``w``: one pair by the library,
+    the higher harmonics by the angle-addition recurrence."""
+    lines = []
+    for w, (idx, top) in sorted(bases.items(), key=lambda kv: kv[1][0]):
+        freq = w.xreplace(substitute) if substitute else w
+        lines.append(f"    const double th{idx} = ({printer.doprint(freq)})*tau;")
+        lines.append(f"    const double C{idx}_1 = cos(th{idx}), S{idx}_1 = sin(th{idx});")
+        for k in range(2, top + 1):
+            lines.append(
+                f"    const double C{idx}_{k} = C{idx}_{k - 1}*C{idx}_1 - S{idx}_{k - 1}*S{idx}_1;"
+            )
+            lines.append(
+                f"    const double S{idx}_{k} = S{idx}_{k - 1}*C{idx}_1 + C{idx}_{k - 1}*S{idx}_1;"
+            )
+    return lines
+
+
 def c_source(model: Model, variational: bool = False) -> str:
     """C text of ``gs_prep`` and ``gs_rhs`` for ``model``; with ``variational`` for the
     state extended by a tangent vector ``w``: ``(x, w)' = (F(tau, x), J(tau, x) w)``."""
@@ -157,16 +175,7 @@ def c_source(model: Model, variational: bool = False) -> str:
     for w in bases:
         base_used |= w.free_symbols
     lines += unpack(model.parameter_symbols, used | base_used)
-    for w, (idx, top) in sorted(bases.items(), key=lambda kv: kv[1][0]):
-        lines.append(f"    const double th{idx} = ({printer.doprint(w)})*tau;")
-        lines.append(f"    const double C{idx}_1 = cos(th{idx}), S{idx}_1 = sin(th{idx});")
-        for k in range(2, top + 1):
-            lines.append(
-                f"    const double C{idx}_{k} = C{idx}_{k - 1}*C{idx}_1 - S{idx}_{k - 1}*S{idx}_1;"
-            )
-            lines.append(
-                f"    const double S{idx}_{k} = S{idx}_{k - 1}*C{idx}_1 + C{idx}_{k - 1}*S{idx}_1;"
-            )
+    lines += _harmonic_lines(bases, printer)
     for sym, e in replacements:
         lines.append(f"    const double {sym.name} = {printer.doprint(e)};")
     for k, e in enumerate(reduced):
@@ -181,16 +190,7 @@ def c_source(model: Model, variational: bool = False) -> str:
         "{",
     ]
     first = {s: sp.Symbol(f"P[{params[s]}*n]") for s in model.parameter_symbols}
-    for w, (idx, top) in sorted(bases.items(), key=lambda kv: kv[1][0]):
-        lines.append(f"    const double th{idx} = ({printer.doprint(w.xreplace(first))})*tau;")
-        lines.append(f"    const double C{idx}_1 = cos(th{idx}), S{idx}_1 = sin(th{idx});")
-        for k in range(2, top + 1):
-            lines.append(
-                f"    const double C{idx}_{k} = C{idx}_{k - 1}*C{idx}_1 - S{idx}_{k - 1}*S{idx}_1;"
-            )
-            lines.append(
-                f"    const double S{idx}_{k} = S{idx}_{k - 1}*C{idx}_1 + C{idx}_{k - 1}*S{idx}_1;"
-            )
+    lines += _harmonic_lines(bases, printer, first)
     lines += ["#pragma GCC ivdep", "    for (int j = 0; j < n; ++j) {"]
     if q_defs:
         lines.append("        double q[GS_NQ];")

@@ -229,6 +229,21 @@ def pair_compliance(pair: PairGeometry, materials, bores, s) -> dict[str, np.nda
     return out
 
 
+def _slices(pair: PairGeometry, slices: int):
+    """Face width, base pitch, tan(beta_b) (either hand: same stiffness), start and length of
+    the path of contact, slice width and the slices' mid positions."""
+    dz = pair.face_width / slices
+    return (
+        pair.face_width,
+        pair.transverse_base_pitch,
+        math.tan(abs(pair.driver.base_helix_angle)),
+        pair.start_of_contact,
+        pair.path_of_contact,
+        dz,
+        (np.arange(slices) + 0.5) * dz,
+    )
+
+
 def sliced_stiffness(
     pair: PairGeometry, unit_stiffness, slices: int, samples: int
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -239,11 +254,7 @@ def sliced_stiffness(
     """
     if slices < 1 or samples < 8:
         raise ValueError("need at least 1 slice and 8 samples per mesh period")
-    b, pbt = pair.face_width, pair.transverse_base_pitch
-    tan_bb = math.tan(abs(pair.driver.base_helix_angle))  # either hand: same stiffness
-    s_a, g = pair.start_of_contact, pair.path_of_contact
-    dz = b / slices
-    z = (np.arange(slices) + 0.5) * dz
+    b, pbt, tan_bb, s_a, g, dz, z = _slices(pair, slices)
     tau = np.arange(samples) / samples
     span = g + b * tan_bb  # a tooth pair is in contact somewhere for this long
     pairs = np.arange(-math.ceil(span / pbt) - 1, 2)
@@ -263,11 +274,7 @@ def tooth_pair_history(
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(tau, k_t)`` of one tooth pair alone, from its entry on the front face
     (``tau = 0``) to its exit from the back face (``tau = eps_alpha + eps_beta``)."""
-    b, pbt = pair.face_width, pair.transverse_base_pitch
-    tan_bb = math.tan(abs(pair.driver.base_helix_angle))
-    s_a, g = pair.start_of_contact, pair.path_of_contact
-    dz = b / slices
-    z = (np.arange(slices) + 0.5) * dz
+    b, pbt, tan_bb, s_a, g, dz, z = _slices(pair, slices)
     tau = np.linspace(0.0, (g + b * tan_bb) / pbt, samples)
     s = s_a + tau[:, None] * pbt - z[None, :] * tan_bb
     inside = (s >= s_a) & (s < s_a + g)

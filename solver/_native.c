@@ -33,6 +33,10 @@ typedef struct {
 
 #define GS_MAXS 13
 
+static const gs_tableau GS_RK45 = {6, GS_RK45_A, GS_RK45_B, GS_RK45_C, GS_RK45_E, 0, 0, 4};
+static const gs_tableau GS_DOP853 = {12, GS_DOP853_A, GS_DOP853_B, GS_DOP853_C, 0,
+                                     GS_DOP853_E3, GS_DOP853_E5, 7};
+
 static double gs_rms(const double *v, const double *scale)
 {
     double s = 0.0;
@@ -200,10 +204,7 @@ int gs_run(int method, int npts, const double *P, const double *X0, double t0, d
            double bound, long long max_steps, double *OUT, long long *NFEV, long long *NSTEP,
            int *STATUS, double *TFAIL)
 {
-    static const gs_tableau RK45 = {6, GS_RK45_A, GS_RK45_B, GS_RK45_C, GS_RK45_E, 0, 0, 4};
-    static const gs_tableau DOP853 = {12, GS_DOP853_A, GS_DOP853_B, GS_DOP853_C, 0,
-                                      GS_DOP853_E3, GS_DOP853_E5, 7};
-    const gs_tableau *T = method == 0 ? &RK45 : &DOP853;
+    const gs_tableau *T = method == 0 ? &GS_RK45 : &GS_DOP853;
     const int n_out = n_sample * spp + 1;
     for (int i = 0; i < npts; ++i) {
         const double *p = P + (long)i * GS_NP;
@@ -289,10 +290,7 @@ int gs_run_lockstep(int method, int npts, int group, const double *P, const doub
                     double rtol, double atol, double bound, long long max_steps, double *OUT,
                     long long *NFEV, long long *NSTEP, int *STATUS, double *TFAIL)
 {
-    static const gs_tableau RK45 = {6, GS_RK45_A, GS_RK45_B, GS_RK45_C, GS_RK45_E, 0, 0, 4};
-    static const gs_tableau DOP853 = {12, GS_DOP853_A, GS_DOP853_B, GS_DOP853_C, 0,
-                                      GS_DOP853_E3, GS_DOP853_E5, 7};
-    const gs_tableau *T = method == 0 ? &RK45 : &DOP853;
+    const gs_tableau *T = method == 0 ? &GS_RK45 : &GS_DOP853;
     const int ns = T->ns, n_out = n_sample * spp + 1;
     const double exponent = -1.0 / (T->error_order + 1);
     if (group < 1) group = 1;
@@ -511,10 +509,8 @@ int gs_benettin(const double *p, const double *z0, double t0, double period, int
         return GS_NOT_FINITE;
     }
     double h_abs = gs_initial_step(t, z, f, period, 7, rtol, atol, p, q, &nfev);
-    static const gs_tableau DOP853 = {12, GS_DOP853_A, GS_DOP853_B, GS_DOP853_C, 0,
-                                      GS_DOP853_E3, GS_DOP853_E5, 7};
     for (int k = 0; k < periods; ++k) {
-        const int status = gs_adaptive_to(&DOP853, &t, z, f, &h_abs, t0 + (k + 1) * period,
+        const int status = gs_adaptive_to(&GS_DOP853, &t, z, f, &h_abs, t0 + (k + 1) * period,
                                           rtol, atol, p, q, bound, max_steps, &nfev, &nsteps);
         if (status != GS_OK) {
             *NFEV = nfev;
