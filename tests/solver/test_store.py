@@ -83,6 +83,10 @@ def test_a_sweep_killed_with_sigkill_resumes_and_matches(tmp_path):
         "0:1:8",
         "--executor",
         "serial",
+        # CVODES, not the compiled default: the points must take long enough (a tenth of a
+        # second each) for the kill below to land in the middle of the sweep.
+        "--method",
+        "cvodes",
         "--transient",
         "60",
         "--periods",
