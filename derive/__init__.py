@@ -5,9 +5,8 @@ and :func:`fit_dead_zone`; ``gearsym.derive.build`` writes the generated code an
 audit pages.
 """
 
-__version__ = "0.1.0"
-
 from ._input import InputError
+from ._version import __version__
 from .backlash import (
     DeadZone,
     LinearContact,
@@ -21,6 +20,7 @@ from .scene import Features, Scene, load_scene, load_target, resolve_target
 from .topology import Topology, load_topology
 
 __all__ = [
+    "__version__",
     "DeadZone",
     "Features",
     "InputError",

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ._input import InputError
+from ._paths import display_path, project_root  # re-exported: callers import them here
 from .audit import audit_page, index_page
 from .emit import emit_module, write_atomic
 from .model import Model, derive_model
@@ -34,24 +35,10 @@ __all__ = [
 ]
 
 
-def project_root() -> Path:
-    """The folder holding ``derive/``, ``generated/`` and ``docs/`` (the checkout)."""
-    return Path(__file__).resolve().parent.parent
-
-
 def shipped_targets() -> list[Path]:
     """Built-in scenes, then built-in topologies, in name order."""
     root = builtin_root()
     return sorted(root.glob("*.toml")) + sorted((root / "topologies").glob("*.toml"))
-
-
-def display_path(path: Path | str) -> str:
-    """``path`` relative to the project root when inside it, else as given."""
-    p = Path(path).resolve()
-    try:
-        return p.relative_to(project_root()).as_posix()
-    except ValueError:
-        return str(path)
 
 
 @dataclass(frozen=True)

@@ -20,7 +20,7 @@ import sympy as sp
 from sympy.printing.str import StrPrinter
 
 from .emit_c import c_source
-from .model import Model
+from .model import Model, operation_count  # operation_count re-exported
 
 __all__ = ["CodePrinter", "emit_module", "operation_count", "write_atomic"]
 
@@ -72,14 +72,6 @@ class CodePrinter(StrPrinter):
         for value, cond in reversed(pairs):
             out = f"{where}({self._print(cond)}, {self._print(value)}, {out})"
         return out
-
-
-def operation_count(expressions) -> int:
-    """Arithmetic operations (SymPy's count_ops) after common-subexpression elimination."""
-    replacements, reduced = sp.cse(list(expressions), symbols=sp.numbered_symbols("_t"))
-    return int(
-        sum(sp.count_ops(e) for _, e in replacements) + sum(sp.count_ops(e) for e in reduced)
-    )
 
 
 def _body(model: Model, outputs, printer: CodePrinter, indent: str = "    ") -> tuple[list, list]:

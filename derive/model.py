@@ -28,13 +28,21 @@ from functools import cached_property
 
 import sympy as sp
 
-from . import __version__
 from ._input import InputError, expression_source
+from ._version import __version__
 from .equations import derive_equations
 from .nondim import NonDim, nondimensionalise
 from .scene import Features, Scene
 
-__all__ = ["Model", "Parameter", "derive_model"]
+__all__ = ["Model", "Parameter", "derive_model", "operation_count"]
+
+
+def operation_count(expressions) -> int:
+    """Arithmetic operations (SymPy's count_ops) after common-subexpression elimination."""
+    replacements, reduced = sp.cse(list(expressions), symbols=sp.numbered_symbols("_t"))
+    return int(
+        sum(sp.count_ops(e) for _, e in replacements) + sum(sp.count_ops(e) for e in reduced)
+    )
 
 
 @dataclass(frozen=True)
@@ -88,8 +96,6 @@ class Model:
     @cached_property
     def operations(self) -> dict[str, int]:
         """Operation counts of the emitted code after common-subexpression elimination."""
-        from .emit import operation_count
-
         return {
             "rhs": operation_count(self.rhs),
             "rhs_and_jacobian": operation_count(list(self.rhs) + list(self.jacobian)),

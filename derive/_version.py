@@ -1,0 +1,3 @@
+"""The generator's version (written into every input hash); imports nothing."""
+
+__version__ = "0.1.0"
