@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from fractions import Fraction
 
 import numpy as np
 import sympy as sp
@@ -199,9 +200,13 @@ def fit_dead_zone(
     """Least-squares odd polynomial fit of the unit dead zone on ``[-A, A]``.
 
     Minimises ``sum_i (p(x_i) - dz(x_i))^2`` over ``x_i = -A, -A + h, ..., A`` (``step=h``),
-    or, with ``step=None``, the continuous ``int_{-A}^{A} (p - dz)^2 dx``.  Both are solved in
-    the scaled variable ``t = x / A`` (QR for the samples; the Gram matrix of exact
-    moments for the continuous case) so that high orders stay well conditioned.
+    or, with ``step=None``, the continuous ``int_{-A}^{A} (p - dz)^2 dx``.  Both normal
+    equations, in the scaled variable ``t = x / A``, are formed and solved exactly in rational
+    arithmetic (the sample sums in closed form, Faulhaber's formula), so each coefficient is
+    the correctly rounded least-squares solution at any order and the same on every
+    machine.  A floating-point solve is not: LAPACK's answer moves in the last bits with the
+    BLAS kernel, and the generated files, which carry these coefficients, are compared byte
+    for byte.
 
     The defaults are the reference study's set-up: order 7, ``A = 3`` and ``h = 0.01``
     (601 samples) give ``0.0017 x^7 - 0.0366 x^5 + 0.2833 x^3 - 0.1555 x`` to its
@@ -211,16 +216,14 @@ def fit_dead_zone(
         raise ValueError(f"order must be an odd whole number >= 1, got {order!r}")
     if not (math.isfinite(fit_range) and fit_range > 1.0):
         raise ValueError(f"range must be > 1 (it must contain the backlash), got {fit_range}")
-    powers = np.arange(1, order + 1, 2)
+    powers = range(1, order + 1, 2)
+    a = Fraction(fit_range)  # exact: the float the caller gave
     if step is None:
         # Gram matrix of t^i t^j on [0, 1] (the problem is odd, so half the interval),
         # right side int_{1/A}^{1} t^i (A t - 1) dt.
-        s = 1.0 / fit_range
-        gram = 1.0 / (powers[:, None] + powers[None, :] + 1.0)
-        rhs = fit_range * (1.0 - s ** (powers + 2)) / (powers + 2) - (1.0 - s ** (powers + 1)) / (
-            powers + 1
-        )
-        scaled = np.linalg.solve(gram, rhs)
+        s = 1 / a
+        gram = [[Fraction(1, p + q + 1) for q in powers] for p in powers]
+        rhs = [a * (1 - s ** (p + 2)) / (p + 2) - (1 - s ** (p + 1)) / (p + 1) for p in powers]
         samples = None
     else:
         if not (math.isfinite(step) and step > 0):
@@ -236,13 +239,65 @@ def fit_dead_zone(
                 f"step {step} leaves {samples} samples for {len(powers)} "
                 "coefficients; use a smaller step"
             )
-        x = np.linspace(-fit_range, fit_range, samples)
-        basis = (x[:, None] / fit_range) ** powers[None, :]
-        scaled = np.linalg.lstsq(basis, dead_zone(x), rcond=None)[0]
-    coefficients = scaled / fit_range**powers
+        # Samples t_i = j / M, j = 2i - M (i = 0..M, M = samples - 1).  Both sides are odd
+        # in t, so the sums run over t > 0 (j > 0) and the factor 2 cancels; the dead zone
+        # is A t - 1 where A t > 1, i.e. A j > M (a sample at A t = 1 adds 0).
+        m = samples - 1
+        moments = _odd_grid_sums(m, m // 2 + 1, 2 * order)
+        outer = _odd_grid_sums(m, int((m + m / a) // 2) + 1, order + 1)
+        gram = [[Fraction(moments[p + q], m ** (p + q)) for q in powers] for p in powers]
+        rhs = [a * Fraction(outer[p + 1], m ** (p + 1)) - Fraction(outer[p], m**p) for p in powers]
+    scaled = _solve_exact(gram, rhs)
     return PolynomialFit(
         order=order,
         fit_range=float(fit_range),
         samples=samples,
-        coefficients=tuple(float(c) for c in coefficients),
+        coefficients=tuple(float(c / a**p) for c, p in zip(scaled, powers, strict=True)),
     )
+
+
+def _bernoulli(n: int) -> list[Fraction]:
+    """Bernoulli numbers B_0..B_n with B_1 = -1/2 (``sum_j C(m+1, j) B_j = 0``)."""
+    b = [Fraction(1)]
+    for m in range(1, n + 1):
+        b.append(-sum(math.comb(m + 1, j) * b[j] for j in range(m)) / (m + 1))
+    return b
+
+
+def _power_sums(n: int, kmax: int, bernoulli: list[Fraction]) -> list[int]:
+    """``sum_{i=0}^{n-1} i^k`` for k = 0..kmax, by Faulhaber's formula."""
+    sums = []
+    for k in range(kmax + 1):
+        s = sum(math.comb(k + 1, j) * bernoulli[j] * n ** (k + 1 - j) for j in range(k + 1))
+        sums.append(int(s / (k + 1)))  # an integer: the division is exact
+    return sums
+
+
+def _odd_grid_sums(m: int, start: int, kmax: int) -> list[int]:
+    """``sum_{i=start}^{m} (2i - m)^k`` for k = 0..kmax, exactly, without a loop over i."""
+    bernoulli = _bernoulli(kmax)
+    d = [
+        x - y
+        for x, y in zip(
+            _power_sums(m + 1, kmax, bernoulli), _power_sums(start, kmax, bernoulli), strict=True
+        )
+    ]
+    return [
+        sum(math.comb(k, j) * 2**j * (-m) ** (k - j) * d[j] for j in range(k + 1))
+        for k in range(kmax + 1)
+    ]
+
+
+def _solve_exact(a: list[list[Fraction]], b: list[Fraction]) -> list[Fraction]:
+    """Solve ``a x = b`` exactly (Gauss-Jordan in rationals; ``a`` is a Gram matrix, so
+    nonsingular)."""
+    n = len(b)
+    rows = [[*row, rhs] for row, rhs in zip(a, b, strict=True)]
+    for c in range(n):
+        pivot = next(r for r in range(c, n) if rows[r][c] != 0)
+        rows[c], rows[pivot] = rows[pivot], rows[c]
+        for r in range(n):
+            if r != c and rows[r][c] != 0:
+                f = rows[r][c] / rows[c][c]
+                rows[r] = [x - f * y for x, y in zip(rows[r], rows[c], strict=True)]
+    return [rows[i][n] / rows[i][i] for i in range(n)]

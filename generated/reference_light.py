@@ -43,9 +43,9 @@ Parameters (in order; default = the scene's value):
     25  psi_u_1       0  transmission-error phase 1 of mesh pg, rad
     26  E_v_1         0.1  transmission-error harmonic 1 of mesh qg over its half backlash
     27  psi_v_1       0  transmission-error phase 1 of mesh qg, rad
-    28  g1           -0.155490456219278  coefficient of x^1 in the backlash polynomial
-    29  g3            0.283300573889451  coefficient of x^3 in the backlash polynomial
-    30  g5           -0.0366360349448123  coefficient of x^5 in the backlash polynomial
+    28  g1           -0.15549045621928  coefficient of x^1 in the backlash polynomial
+    29  g3            0.283300573889452  coefficient of x^3 in the backlash polynomial
+    30  g5           -0.0366360349448122  coefficient of x^5 in the backlash polynomial
     31  g7            0.00171168067934036  coefficient of x^7 in the backlash polynomial
 
 Features: stiffness harmonics 3; backlash polynomial (valid for |u| <= 3); transmission error on; mesh phase on; damping coupling on.
@@ -89,9 +89,9 @@ DEFAULTS = (
     0.0,
     0.1,
     0.0,
-    -0.155490456219278,
-    0.283300573889451,
-    -0.0366360349448123,
+    -0.15549045621928,
+    0.283300573889452,
+    -0.0366360349448122,
     0.00171168067934036,
 )
 VALID_RANGE = 3.0  # |coordinate| bound of the backlash model, None if global

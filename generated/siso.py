@@ -25,9 +25,9 @@ Parameters (in order; default = the scene's value):
      9  ks_u_3        0.00231910918699717  sine stiffness harmonic 3 of mesh pg over its mean
     10  E_u_1         0.1  transmission-error harmonic 1 of mesh pg over its half backlash
     11  psi_u_1       0  transmission-error phase 1 of mesh pg, rad
-    12  g1           -0.155490456219278  coefficient of x^1 in the backlash polynomial
-    13  g3            0.283300573889451  coefficient of x^3 in the backlash polynomial
-    14  g5           -0.0366360349448123  coefficient of x^5 in the backlash polynomial
+    12  g1           -0.15549045621928  coefficient of x^1 in the backlash polynomial
+    13  g3            0.283300573889452  coefficient of x^3 in the backlash polynomial
+    14  g5           -0.0366360349448122  coefficient of x^5 in the backlash polynomial
     15  g7            0.00171168067934036  coefficient of x^7 in the backlash polynomial
 
 Features: stiffness harmonics 3; backlash polynomial (valid for |u| <= 3); transmission error on; mesh phase on; damping coupling on.
@@ -55,9 +55,9 @@ DEFAULTS = (
     0.00231910918699717,
     0.1,
     0.0,
-    -0.155490456219278,
-    0.283300573889451,
-    -0.0366360349448123,
+    -0.15549045621928,
+    0.283300573889452,
+    -0.0366360349448122,
     0.00171168067934036,
 )
 VALID_RANGE = 3.0  # |coordinate| bound of the backlash model, None if global

@@ -64,3 +64,35 @@ def test_smooth_dead_zone_error_is_half_its_width():
         xs = sp.Symbol("x", real=True)
         expr = model.expression(xs).subs(sp.Symbol("eps_g", real=True), e)
         assert sp.simplify(expr.subs(xs, -xs) + expr) == 0  # odd
+
+
+def _brute_force_fit(order, fit_range, step):
+    # Reference: the definition of the discrete fit, summed sample by sample in rationals.
+    from fractions import Fraction
+
+    from gearsym.derive.backlash import _solve_exact
+
+    n = int(round(2.0 * fit_range / step)) + 1
+    a, m = Fraction(fit_range), n - 1
+    powers = range(1, order + 1, 2)
+    ts = [Fraction(2 * i - m, m) for i in range(n)]
+    dz = [a * t - 1 if a * t > 1 else a * t + 1 if a * t < -1 else 0 for t in ts]
+    gram = [[sum(t ** (p + q) for t in ts) for q in powers] for p in powers]
+    rhs = [sum(t**p * d for t, d in zip(ts, dz, strict=True)) for p in powers]
+    return tuple(float(c / a**p) for c, p in zip(_solve_exact(gram, rhs), powers, strict=True))
+
+
+@pytest.mark.parametrize("args", [(7, 3.0, 0.01), (5, 2.7, 0.013), (9, 4.0, 0.5), (1, 1.01, 0.1)])
+def test_fit_is_the_exact_least_squares_solution(args):
+    # The closed-form sample sums give bit for bit the correctly rounded exact solution, so
+    # the generated files do not depend on the machine's BLAS kernel.
+    assert fit_dead_zone(*args).coefficients == _brute_force_fit(*args)
+
+
+def test_fit_agrees_with_a_floating_point_least_squares_solve():
+    # Reference: numpy.linalg.lstsq on the scaled Vandermonde matrix (the former method).
+    fit = fit_dead_zone(7, 3.0, 0.01)
+    x = np.linspace(-3.0, 3.0, fit.samples)
+    powers = np.array(fit.powers)
+    scaled = np.linalg.lstsq((x[:, None] / 3.0) ** powers, dead_zone(x), rcond=None)[0]
+    assert np.allclose(fit.coefficients, scaled / 3.0**powers, rtol=1e-12, atol=0)
