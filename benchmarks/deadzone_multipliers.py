@@ -11,28 +11,31 @@ boundaries every period) for
 
 against a located DOP853 reference at rtol 1e-12.  Writes docs/deadzone-multipliers.md.
 
-Run: python benchmarks/deadzone_multipliers.py
+Run from a checkout (it writes the checkout's ``docs/``):
+``python -m gearsym.benchmarks.deadzone_multipliers`` or
+``python benchmarks/deadzone_multipliers.py``.
 """
 
 from __future__ import annotations
 
 import time
-from pathlib import Path
 
 import numpy as np
-from gearsym.solver.flow import FlowMap
-from gearsym.solver.shooting import shoot
-from gearsym.solver.simulate import simulate
+from gearsym.benchmarks._output import checkout_docs, output_folder, run_script
+from gearsym.solver.integrate import simulate
+from gearsym.solver.periodic import FlowMap, shoot
 from gearsym.solver.system import System
 
-ROOT = Path(__file__).resolve().parent.parent
+REPORT = "deadzone-multipliers.md"
 
 
 def main() -> None:
+    out = output_folder(checkout_docs(), (REPORT,)) / REPORT
     system = System.load("reference_dead_zone", f1=0.05, **{"lambda": 1.0})
     guess = simulate(system, method="RK45", transient=200, periods=1).poincare[:, 0]
-    ref = shoot(system, guess, 1, flow=FlowMap(system, rtol=1e-12, atol=1e-14),
-                monodromy="variational")  # fmt: skip
+    ref = shoot(
+        system, guess, 1, flow=FlowMap(system, rtol=1e-12, atol=1e-14), monodromy="variational"
+    )
     exact = np.sort_complex(ref.floquet.multipliers)
     rows = []
     for rtol in (1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11):
@@ -67,10 +70,9 @@ def main() -> None:
         "located route by default (`FlowMap(locate=True)`).",
         "",
     ]
-    out = ROOT / "docs" / "deadzone-multipliers.md"
     out.write_text("\n".join(lines), encoding="utf-8")
     print(out.read_text(encoding="utf-8"))
 
 
 if __name__ == "__main__":
-    main()
+    run_script(main)

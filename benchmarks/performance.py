@@ -1,6 +1,11 @@
-"""Speed and accuracy of every integration back end: writes docs/performance.md.
+"""Speed and accuracy of every integration back end: writes performance.md and its figure.
 
-Run: ``gearsym bench [--quick] [--json]`` (or ``python benchmarks/performance.py``).
+Run: ``gearsym bench [--quick] [--json] [--out DIR | --docs]``, or the same options to
+``python -m gearsym.benchmarks.performance`` (from a checkout also
+``python benchmarks/performance.py``). The report ``performance.md`` and the figure
+``performance-pareto.png`` go to ``--out DIR`` (default ``bench-out``, created if missing)
+or, with ``--docs``, to the checkout's ``docs/`` (the tracked report). The folder is
+checked for writing before the benchmark starts.
 
 Sections (every timing a median of repeated runs on this machine, ratios measured in the
 same run):
@@ -34,9 +39,12 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-DOC = ROOT / "docs" / "performance.md"
-FIGURE = ROOT / "docs" / "performance-pareto.png"
+# absolute, so that ``python benchmarks/performance.py`` runs too
+from gearsym.benchmarks._output import OutputError, checkout_docs, output_folder, run_script
+
+REPORT = "performance.md"
+FIGURE = "performance-pareto.png"
+DEFAULT_OUT = "bench-out"
 
 
 def _median_time(fn, repeats: int, long: float = 2.0):
@@ -53,7 +61,7 @@ def _median_time(fn, repeats: int, long: float = 2.0):
 
 # ---------------------------------------------------------------- the reference model
 def _reference(lam=None):
-    from gearsym.solver.simulate import default_initial_state
+    from gearsym.solver.integrate import default_initial_state
     from gearsym.solver.system import System
 
     system = System.load("reference_light")
@@ -90,10 +98,20 @@ def plain_rhs(q: dict):
         eu = -q["E_u_1"] * w**2 * cos(w * t + q["psi_u_1"])
         ev = -q["E_v_1"] * w**2 * cos(w * t - phi + q["psi_v_1"])
         gu, gv = ku * g(u), kv * g(v)
-        ddu = (q["f_u"] + eu - 2 * (q["xi_u_u"] * du + q["xi_u_v"] * dv)
-               - q["kappa_u_u"] * gu - q["kappa_u_v"] * gv)  # fmt: skip
-        ddv = (q["f_v"] + ev - 2 * (q["xi_v_u"] * du + q["xi_v_v"] * dv)
-               - q["kappa_v_u"] * gu - q["kappa_v_v"] * gv)  # fmt: skip
+        ddu = (
+            q["f_u"]
+            + eu
+            - 2 * (q["xi_u_u"] * du + q["xi_u_v"] * dv)
+            - q["kappa_u_u"] * gu
+            - q["kappa_u_v"] * gv
+        )
+        ddv = (
+            q["f_v"]
+            + ev
+            - 2 * (q["xi_v_u"] * du + q["xi_v_v"] * dv)
+            - q["kappa_v_u"] * gu
+            - q["kappa_v_v"] * gv
+        )
         return [du, dv, ddu, ddv]
 
     return f
@@ -104,30 +122,37 @@ def baseline_point(module, p, x0, transient, periods, rtol=1e-8, atol=1e-10, met
 
     T = 2 * math.pi / p[0]
     t_eval = (transient + np.arange(periods + 1)) * T
-    sol = solve_ivp(plain_rhs(_named(module, p)), (0.0, t_eval[-1]), x0, method=method,
-                    t_eval=t_eval, rtol=rtol, atol=atol)  # fmt: skip
+    sol = solve_ivp(
+        plain_rhs(_named(module, p)),
+        (0.0, t_eval[-1]),
+        x0,
+        method=method,
+        t_eval=t_eval,
+        rtol=rtol,
+        atol=atol,
+    )
     return sol.y.T, sol.nfev
 
 
 def _reference_library():
-    """Compile benchmarks/lockstep_reference.c (cached like the models)."""
-    from gearsym.solver import native
+    """Compile lockstep_reference.c, shipped beside this module (cached like the models)."""
+    from gearsym.solver.integrate import native
 
     cc = native.compiler()
     if cc is None:
         return None
-    src = ROOT / "benchmarks" / "lockstep_reference.c"
+    src = Path(__file__).resolve().parent / "lockstep_reference.c"
     out = native.cache_dir() / "lockstep_reference.so"
     if not out.exists() or out.stat().st_mtime < src.stat().st_mtime:
         out.parent.mkdir(parents=True, exist_ok=True)
-        subprocess.run([cc, "-O3", "-march=native", "-fno-math-errno", "-fPIC", "-shared", "-o",
-                        str(out), str(src), "-lm"], check=True)  # fmt: skip
+        flags = "-O3 -march=native -fno-math-errno -fPIC -shared".split()
+        subprocess.run([cc, *flags, "-o", str(out), str(src), "-lm"], check=True)
     lib = ctypes.CDLL(str(out))
     ptr = np.ctypeslib.ndpointer(np.float64, flags="C")
     lib.ref_run.restype = ctypes.c_longlong
-    lib.ref_run.argtypes = [ctypes.c_int, ptr, ptr, ptr, ptr, ptr, ptr, ptr, ptr, ptr,
-                            ctypes.c_int, ctypes.c_int, ctypes.c_double, ctypes.c_double,
-                            ptr]  # fmt: skip
+    # ref_run(n, fu, fv, consts, A, B, C, E3, E5, x0, transient, periods, rtol, atol, out)
+    c_int, c_double = ctypes.c_int, ctypes.c_double
+    lib.ref_run.argtypes = [c_int, *[ptr] * 9, c_int, c_int, c_double, c_double, ptr]
     return lib
 
 
@@ -135,53 +160,80 @@ def reference_run(lib, module, P, X0, transient, periods, rtol=1e-8, atol=1e-10)
     from scipy.integrate._ivp import dop853_coefficients as d
 
     q = _named(module, P[0])
-    names = ["omega", "xi_u_u", "xi_u_v", "xi_v_u", "xi_v_v", "kappa_u_u", "kappa_u_v",
-             "kappa_v_u", "kappa_v_v", "kc_u_1", "kc_u_2", "kc_u_3", "ks_u_1", "ks_u_2",
-             "ks_u_3", "kc_v_1", "kc_v_2", "kc_v_3", "ks_v_1", "ks_v_2", "ks_v_3", "phi_v",
-             "E_u_1", "psi_u_1", "E_v_1", "psi_v_1", "g1", "g3", "g5", "g7"]  # fmt: skip
+    # the order of the constants array in lockstep_reference.c
+    names = (
+        "omega xi_u_u xi_u_v xi_v_u xi_v_v kappa_u_u kappa_u_v kappa_v_u kappa_v_v "
+        "kc_u_1 kc_u_2 kc_u_3 ks_u_1 ks_u_2 ks_u_3 kc_v_1 kc_v_2 kc_v_3 ks_v_1 ks_v_2 ks_v_3 "
+        "phi_v E_u_1 psi_u_1 E_v_1 psi_v_1 g1 g3 g5 g7"
+    ).split()
     consts = np.array([q[k] for k in names])
     n = len(P)
     fu = np.ascontiguousarray(P[:, module.PARAMETERS.index("f_u")])
     fv = np.ascontiguousarray(P[:, module.PARAMETERS.index("f_v")])
     out = np.empty((n, periods + 1, 4))
     c = np.ascontiguousarray
-    nfev = lib.ref_run(n, fu, fv, consts, c(d.A[:12, :12]), c(d.B), c(d.C[:12]), c(d.E3),
-                       c(d.E5), c(X0), transient, periods, rtol, atol, out)  # fmt: skip
+    nfev = lib.ref_run(
+        n,
+        fu,
+        fv,
+        consts,
+        c(d.A[:12, :12]),
+        c(d.B),
+        c(d.C[:12]),
+        c(d.E3),
+        c(d.E5),
+        c(X0),
+        transient,
+        periods,
+        rtol,
+        atol,
+        out,
+    )
     return out, nfev
 
 
 # ---------------------------------------------------------------- 1. headline
 def headline(quick: bool) -> dict:
-    from gearsym.solver.native import run_batch
+    from gearsym.solver.integrate.native import run_batch
 
     module, lam, P, X0 = _reference()
     tr, per = 300, 100
     reps = 3
     # independent reference for the accuracy comparison: CVODES (BDF) at rtol 1e-13
     subset = np.linspace(0, len(lam) - 1, 2 if quick else 6).round().astype(int)
-    from gearsym.solver.simulate import simulate
+    from gearsym.solver.integrate import simulate
     from gearsym.solver.system import System
 
     tight = []
     for i in subset:
         s = System(module, P[i])
-        tight.append(simulate(s, X0[i], method="cvodes", rtol=1e-13, atol=1e-15, transient=tr,
-                              periods=per, samples_per_period=1).x.T)  # fmt: skip
+        tight.append(
+            simulate(
+                s,
+                X0[i],
+                method="cvodes",
+                rtol=1e-13,
+                atol=1e-15,
+                transient=tr,
+                periods=per,
+                samples_per_period=1,
+            ).x.T
+        )
     tight = np.array(tight)
     baselines = {}
     for method in ("RK45", "DOP853"):
         times, errs, nfevs = [], [], []
         for k, i in enumerate(subset):
             t_i, (y, nfev) = _median_time(
-                lambda i=i, method=method: baseline_point(module, P[i], X0[i], tr, per,
-                                                          method=method),
+                lambda i=i, method=method: baseline_point(
+                    module, P[i], X0[i], tr, per, method=method
+                ),
                 1 if quick else 2,
-            )  # fmt: skip
+            )
             times.append(t_i)
             nfevs.append(nfev)
             errs.append(float(np.max(np.abs(y[:-1] - tight[k]))))
-        baselines[method] = (statistics.median(times), max(errs),
-                             float(statistics.median(nfevs)))  # fmt: skip
+        baselines[method] = (statistics.median(times), max(errs), float(statistics.median(nfevs)))
     run_batch(module, P[:2], X0[:2], transient=1, periods=1)  # compile outside the timing
     t_one, res_one = _median_time(
         lambda: run_batch(module, P, X0, method="dop853", transient=tr, periods=per), reps
@@ -232,15 +284,18 @@ def headline(quick: bool) -> dict:
 
 # ---------------------------------------------------------------- 2. throughput
 def throughput(quick: bool) -> dict:
-    from gearsym.solver.native import library, run_batch
+    from gearsym.solver.integrate.native import library, run_batch
 
     module, lam, P, X0 = _reference(np.linspace(0.6, 1.0, 20))
     lib, _ = library(module)
     n = 20_000_000 if not quick else 5_000_000
     t_loop, _ = _median_time(lambda: lib.gs_rhs_loop(P[0], X0[0], n, 1e-3), 3)
     t_int, res = _median_time(
-        lambda: run_batch(module, P, X0, method="dop853", transient=300, periods=100,
-                          lockstep=False), 3)  # fmt: skip
+        lambda: run_batch(
+            module, P, X0, method="dop853", transient=300, periods=100, lockstep=False
+        ),
+        3,
+    )
     return {
         "rhs_only_evals_per_s": n / t_loop,
         "one_point_dop853_evals_per_s": float(res.nfev.sum()) / t_int,
@@ -254,7 +309,7 @@ FIXED = ["rk", "collocation", "rk4"]
 
 
 def pareto(quick: bool) -> list[dict]:
-    from gearsym.solver.simulate import simulate
+    from gearsym.solver.integrate import simulate
     from gearsym.solver.system import System
 
     module, lam, P, X0 = _reference(np.linspace(0.1, 0.9, 2 if quick else 4))
@@ -263,18 +318,31 @@ def pareto(quick: bool) -> list[dict]:
     steps = [32, 128] if quick else [16, 32, 64, 128, 256, 512, 1024]
     # reference: Radau IIA (implicit, an independent method) at rtol 1e-12; over this window
     # it agrees with SciPy's DOP853 at rtol 1e-13 to about 1e-13
-    refs = [simulate(System(module, p), x0, method="Radau", rtol=1e-12, atol=1e-14,
-                     transient=tr, periods=per, samples_per_period=1).x
-            for p, x0 in zip(P, X0, strict=True)]  # fmt: skip
+    refs = [
+        simulate(
+            System(module, p),
+            x0,
+            method="Radau",
+            rtol=1e-12,
+            atol=1e-14,
+            transient=tr,
+            periods=per,
+            samples_per_period=1,
+        ).x
+        for p, x0 in zip(P, X0, strict=True)
+    ]
     rows = []
 
     def measure(method, **kw):
         errs, times, nfev = [], [], []
         for p, x0, ref in zip(P, X0, refs, strict=True):
             s = System(module, p)
-            t, r = _median_time(lambda s=s, x0=x0: simulate(
-                s, x0, method=method, transient=tr, periods=per, samples_per_period=1, **kw),
-                1 if quick else 3)  # fmt: skip
+            t, r = _median_time(
+                lambda s=s, x0=x0: simulate(
+                    s, x0, method=method, transient=tr, periods=per, samples_per_period=1, **kw
+                ),
+                1 if quick else 3,
+            )
             errs.append(float(np.max(np.abs(r.x - ref))) if r.status == "ok" else float("inf"))
             times.append(t)
             nfev.append(r.nfev)
@@ -284,8 +352,15 @@ def pareto(quick: bool) -> list[dict]:
     for method in ADAPTIVE:
         for tol in tols:
             err, t, nfev = measure(method, rtol=tol, atol=tol * 1e-2)
-            rows.append({"method": method, "setting": f"rtol {tol:.0e}", "error": err,
-                         "s_per_point": t, "nfev": nfev})  # fmt: skip
+            rows.append(
+                {
+                    "method": method,
+                    "setting": f"rtol {tol:.0e}",
+                    "error": err,
+                    "s_per_point": t,
+                    "nfev": nfev,
+                }
+            )
             if t > slow:
                 break
     for method in FIXED:
@@ -293,8 +368,15 @@ def pareto(quick: bool) -> list[dict]:
             if method == "collocation" and n < 16:
                 continue
             err, t, nfev = measure(method, steps_per_period=n)
-            rows.append({"method": method, "setting": f"{n} steps/period", "error": err,
-                         "s_per_point": t, "nfev": nfev})  # fmt: skip
+            rows.append(
+                {
+                    "method": method,
+                    "setting": f"{n} steps/period",
+                    "error": err,
+                    "s_per_point": t,
+                    "nfev": nfev,
+                }
+            )
     for r in rows:
         r["window_periods"] = tr + per
     return rows
@@ -325,13 +407,15 @@ FEATURES = [
 def _variant(tmp: Path, name: str, changes: dict) -> Path:
     """A copy of the light-load scene with some [features] changed, derived into tmp."""
     from gearsym.derive.build import build_files, write_files
+    from gearsym.derive.scene import builtin_root
 
-    text = (ROOT / "scenes" / "reference-light.toml").read_text(encoding="utf-8")
+    scenes = builtin_root()
+    text = (scenes / "reference-light.toml").read_text(encoding="utf-8")
     text = text.replace('name = "reference-light"', f'name = "{name.replace("_", "-")}"')
     text = text.replace(
         'topology = "topologies/diso.toml"',
-        f'topology = "{(ROOT / "scenes" / "topologies" / "diso.toml").as_posix()}"',
-    )  # noqa: E501
+        f'topology = "{(scenes / "topologies" / "diso.toml").as_posix()}"',
+    )
     lines = []
     for line in text.splitlines():
         key = line.split("=")[0].strip()
@@ -339,8 +423,11 @@ def _variant(tmp: Path, name: str, changes: dict) -> Path:
             line = f"{key} = {changes[key]}"
         lines.append(line)
     if changes.get("backlash") in ('"linear"', '"dead-zone"', '"smooth"'):
-        lines = [ln for ln in lines if not ln.strip().startswith(("backlash_order",
-                 "backlash_range", "backlash_step"))]  # fmt: skip
+        lines = [
+            ln
+            for ln in lines
+            if not ln.strip().startswith(("backlash_order", "backlash_range", "backlash_step"))
+        ]
     scene = tmp / f"{name}.toml"
     scene.write_text("\n".join(lines) + "\n", encoding="utf-8")
     built = build_files([scene])
@@ -349,8 +436,8 @@ def _variant(tmp: Path, name: str, changes: dict) -> Path:
 
 
 def features(quick: bool) -> list[dict]:
-    from gearsym.solver.native import run_batch
-    from gearsym.solver.simulate import default_initial_state
+    from gearsym.solver.integrate import default_initial_state
+    from gearsym.solver.integrate.native import run_batch
     from gearsym.solver.system import System
 
     lam = np.linspace(0.0, 1.0, 20 if quick else 100)
@@ -365,27 +452,32 @@ def features(quick: bool) -> list[dict]:
             P = np.array([module.parameters(**{"lambda": v}) for v in lam])
             X0 = np.repeat(default_initial_state(system)[None, :], len(lam), axis=0)
             run_batch(module, P[:1], X0[:1], transient=1, periods=1)
-            t, res = _median_time(lambda m=module, P=P, X0=X0: run_batch(
-                m, P, X0, method="dop853", transient=tr, periods=per), 3)  # fmt: skip
+            t, res = _median_time(
+                lambda m=module, P=P, X0=X0: run_batch(
+                    m, P, X0, method="dop853", transient=tr, periods=per
+                ),
+                3,
+            )
             x = res.x[:, :-1, :2]
             if base_x is None:
                 base_x = x
-            rows.append({
-                "feature": label,
-                "operations_rhs": module.OPERATIONS["rhs"],
-                "ms_per_point": 1e3 * t / len(lam),
-                "nfev_per_point": float(np.median(res.nfev)),
-                "max_change_poincare_u_v": float(np.nanmax(np.abs(x - base_x))),
-                "median_change_poincare_u_v": float(np.nanmedian(np.abs(x - base_x))),
-            })  # fmt: skip
+            rows.append(
+                {
+                    "feature": label,
+                    "operations_rhs": module.OPERATIONS["rhs"],
+                    "ms_per_point": 1e3 * t / len(lam),
+                    "nfev_per_point": float(np.median(res.nfev)),
+                    "max_change_poincare_u_v": float(np.nanmax(np.abs(x - base_x))),
+                    "median_change_poincare_u_v": float(np.nanmedian(np.abs(x - base_x))),
+                }
+            )
     return rows
 
 
 # ---------------------------------------------------------------- 5. scaling
 def scaling(quick: bool) -> dict:
-    from gearsym.solver import native
-    from gearsym.solver.native import run_batch
-    from gearsym.solver.simulate import default_initial_state
+    from gearsym.solver.integrate import default_initial_state, native
+    from gearsym.solver.integrate.native import run_batch
     from gearsym.solver.system import System
 
     sizes = [1, 10, 100] if quick else [1, 10, 100, 1000]
@@ -402,7 +494,7 @@ def scaling(quick: bool) -> dict:
         out["sweep_size"].append({"points": n, "s": t, "ms_per_point": 1e3 * t / n})
     with tempfile.TemporaryDirectory() as tmp:
         os.environ["GEARSYM_CACHE"] = tmp
-        native._loaded.clear()
+        native.reset()
         try:
             for name in ("siso", "diso", "tiso"):
                 system = System.load(name)
@@ -412,15 +504,25 @@ def scaling(quick: bool) -> dict:
                 m = system.module
                 P = np.repeat(system.p[None, :], 100, axis=0)
                 X0 = np.repeat(default_initial_state(system)[None, :], 100, axis=0)
-                t, res = _median_time(lambda m=m, P=P, X0=X0: run_batch(
-                    m, P, X0, method="dop853", transient=300, periods=100), 3)  # fmt: skip
-                out["meshes"].append({"model": name, "meshes": len(m.COORDINATES),
-                                      "operations_rhs": m.OPERATIONS["rhs"],
-                                      "compile_s": compile_s, "ms_per_point": 1e3 * t / 100,
-                                      "nfev_per_point": float(np.median(res.nfev))})  # fmt: skip
+                t, res = _median_time(
+                    lambda m=m, P=P, X0=X0: run_batch(
+                        m, P, X0, method="dop853", transient=300, periods=100
+                    ),
+                    3,
+                )
+                out["meshes"].append(
+                    {
+                        "model": name,
+                        "meshes": len(m.COORDINATES),
+                        "operations_rhs": m.OPERATIONS["rhs"],
+                        "compile_s": compile_s,
+                        "ms_per_point": 1e3 * t / 100,
+                        "nfev_per_point": float(np.median(res.nfev)),
+                    }
+                )
         finally:
             os.environ.pop("GEARSYM_CACHE", None)
-            native._loaded.clear()
+            native.reset()
     return out
 
 
@@ -431,13 +533,20 @@ def _fmt(x, digits=3):
     return f"{x:.{digits}g}"
 
 
-def write_doc(res: dict, path: Path = DOC, figure: Path | None = FIGURE) -> None:
+def write_doc(
+    res: dict, path: Path, figure: Path | None = None, command: str | None = None
+) -> None:
+    """Write the report of ``run``'s result to ``path`` and, unless None, the Pareto
+    figure to ``figure`` (the report links it by name, so keep both in one folder).
+    ``command`` is the command the report says wrote it."""
+    if command is None:
+        command = f"gearsym bench{' --quick' if res['quick'] else ''}"
     h, th = res["headline"], res["throughput"]
     cpu = os.cpu_count()
     lines = [
         "# Performance: speed against accuracy",
         "",
-        f"Written by `gearsym bench{' --quick' if res['quick'] else ''}` on "
+        f"Written by `{command}` on "
         f"{res['date']} ({cpu} cores; the machine is shared, so every time is the median of "
         "repeated runs and every ratio is measured within the same run). "
         "Code: `benchmarks/performance.py`, `benchmarks/lockstep_reference.c`.",
@@ -457,7 +566,7 @@ def write_doc(res: dict, path: Path = DOC, figure: Path | None = FIGURE) -> None
         f"| the same with SciPy's DOP853 (the compiled method's algorithm) | "
         f"{_fmt(h['baseline_dop853_s_400'])} | {h['baseline_dop853_nfev_per_point']:.0f} | "
         f"{_fmt(h['baseline_dop853_max_poincare_error'])} |",
-        f"| compiled batched DOP853 (`gearsym.solver.native`), 1 core | "
+        f"| compiled batched DOP853 (`gearsym.solver.integrate.native`), 1 core | "
         f"{_fmt(h['compiled_1_core_s'])} | {h['compiled_nfev_per_point']:.0f} | "
         f"{_fmt(h['compiled_max_poincare_error'])} |",
         f"| compiled batched DOP853, 2 processes | {_fmt(h['compiled_2_cores_s'])} | | |",
@@ -499,8 +608,10 @@ def write_doc(res: dict, path: Path = DOC, figure: Path | None = FIGURE) -> None
     front = {(r["method"], r["setting"]) for r in pareto_front(res["pareto"])}
     for r in res["pareto"]:
         mark = " **(Pareto)**" if (r["method"], r["setting"]) in front else ""
-        lines.append(f"| {r['method']} | {r['setting']}{mark} | {_fmt(r['error'])} | "
-                     f"{_fmt(r['s_per_point'])} | {r['nfev']} |")  # fmt: skip
+        lines.append(
+            f"| {r['method']} | {r['setting']}{mark} | {_fmt(r['error'])} | "
+            f"{_fmt(r['s_per_point'])} | {r['nfev']} |"
+        )
     lines += [
         "",
         "## What each model feature costs",
@@ -514,9 +625,11 @@ def write_doc(res: dict, path: Path = DOC, figure: Path | None = FIGURE) -> None
         "|---|---|---|---|---|---|",
     ]
     for r in res["features"]:
-        lines.append(f"| {r['feature']} | {r['operations_rhs']} | {r['ms_per_point']:.2f} | "
-                     f"{r['nfev_per_point']:.0f} | {_fmt(r['max_change_poincare_u_v'])} | "
-                     f"{_fmt(r['median_change_poincare_u_v'])} |")  # fmt: skip
+        lines.append(
+            f"| {r['feature']} | {r['operations_rhs']} | {r['ms_per_point']:.2f} | "
+            f"{r['nfev_per_point']:.0f} | {_fmt(r['max_change_poincare_u_v'])} | "
+            f"{_fmt(r['median_change_poincare_u_v'])} |"
+        )
     sc = res["scaling"]
     lines += [
         "",
@@ -529,10 +642,13 @@ def write_doc(res: dict, path: Path = DOC, figure: Path | None = FIGURE) -> None
         "| model | meshes | rhs operations | compile (s, once per model) | ms per point | "
         "evaluations per point |",
         "|---|---|---|---|---|---|",
-        *(f"| {r['model']} | {r['meshes']} | {r['operations_rhs']} | {r['compile_s']:.2f} | "
-          f"{r['ms_per_point']:.2f} | {r['nfev_per_point']:.0f} |" for r in sc["meshes"]),
+        *(
+            f"| {r['model']} | {r['meshes']} | {r['operations_rhs']} | {r['compile_s']:.2f} | "
+            f"{r['ms_per_point']:.2f} | {r['nfev_per_point']:.0f} |"
+            for r in sc["meshes"]
+        ),
         "",
-    ]  # fmt: skip
+    ]
     path.write_text("\n".join(lines), encoding="utf-8")
     if figure is not None:
         _plot(res["pareto"], figure)
@@ -565,8 +681,13 @@ def _plot(rows, path):
 
 def run(quick: bool) -> dict:
     res = {"quick": quick, "date": time.strftime("%Y-%m-%d")}
-    for name, fn in (("headline", headline), ("throughput", throughput), ("pareto", pareto),
-                     ("features", features), ("scaling", scaling)):  # fmt: skip
+    for name, fn in (
+        ("headline", headline),
+        ("throughput", throughput),
+        ("pareto", pareto),
+        ("features", features),
+        ("scaling", scaling),
+    ):
         started = time.perf_counter()
         print(f"bench: {name} ...", file=sys.stderr, flush=True)
         res[name] = fn(quick)
@@ -574,21 +695,44 @@ def run(quick: bool) -> dict:
     return res
 
 
-def main(argv=None) -> int:
+def output_files(out: Path | str | None = None, *, docs: bool = False) -> tuple[Path, Path]:
+    """The report and figure paths: in ``out`` (default ``bench-out``) or, with ``docs``,
+    in the checkout's ``docs/``; the folder is created if missing and checked for writing.
+
+    Raises :class:`OutputError` (one line) when both are given, outside a checkout with
+    ``docs``, or when the folder cannot be written.
+    """
+    if docs and out is not None:
+        raise OutputError(
+            "--docs and --out both given: --docs writes the checkout's docs/, --out DIR "
+            "another folder; give one"
+        )
+    folder = checkout_docs() if docs else Path(DEFAULT_OUT if out is None else out)
+    folder = output_folder(folder, (REPORT, FIGURE))
+    return folder / REPORT, folder / FIGURE
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``gearsym bench``: check the output folder, run, write the report and figure.
+
+    Raises :class:`OutputError` before any benchmark runs when the output is unusable.
+    """
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true")
-    parser.add_argument("--json", action="store_true")
-    parser.add_argument("--out", type=Path, default=DOC)
+    parser.add_argument("--quick", action="store_true", help="fewer points and repeats")
+    parser.add_argument("--json", action="store_true", help="also print every figure as JSON")
+    parser.add_argument("--out", type=Path, metavar="DIR", help=f"default {DEFAULT_OUT}")
+    parser.add_argument("--docs", action="store_true", help="write the checkout's docs/")
     args = parser.parse_args(argv)
+    report, figure = output_files(args.out, docs=args.docs)
     res = run(args.quick)
-    figure = args.out.with_name(FIGURE.name)
-    write_doc(res, args.out, figure)
+    command = "gearsym bench" + " --quick" * args.quick + " --docs" * args.docs
+    write_doc(res, report, figure, command)
     if args.json:
         print(json.dumps(res, indent=2))
     else:
-        print(f"wrote {args.out} and {figure}")
+        print(f"wrote {report} and {figure}")
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    run_script(main)

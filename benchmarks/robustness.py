@@ -1,6 +1,8 @@
 """Write docs/robustness.md: the extremes matrix (every case with every back end).
 
-Run: python benchmarks/robustness.py
+Run from a checkout (it writes the checkout's ``docs/`` and lists the bad-input cases of
+its ``tests/``): ``python -m gearsym.benchmarks.robustness`` or
+``python benchmarks/robustness.py``.
 """
 
 from __future__ import annotations
@@ -8,17 +10,20 @@ from __future__ import annotations
 import tempfile
 from pathlib import Path
 
-from gearsym.solver.robustness import CASES, describe, harmonics_models, matrix
-from gearsym.solver.simulate import METHODS
+from gearsym.benchmarks._output import checkout_docs, output_folder, run_script
+from gearsym.derive.build import project_root
+from gearsym.solver.integrate import METHODS
+from gearsym.studies.robustness import CASES, describe, harmonics_models, matrix
 
-ROOT = Path(__file__).resolve().parent.parent
+REPORT = "robustness.md"
 
 
 def _bad_input_cases() -> list[tuple[str, str]]:
-    """The bad-input cases of the test suite, by label and expected message."""
+    """The bad-input cases of the test suite (the checkout's tests/), by label and
+    expected message."""
     import sys
 
-    sys.path.insert(0, str(ROOT))
+    sys.path.insert(0, str(project_root()))
     from tests.derive import test_input_errors as t
     from tests.solver import test_cli_solver as c
 
@@ -29,6 +34,7 @@ def _bad_input_cases() -> list[tuple[str, str]]:
 
 
 def main() -> None:
+    out = output_folder(checkout_docs(), (REPORT,)) / REPORT
     with tempfile.TemporaryDirectory() as tmp:
         rows = matrix(harmonics_models(Path(tmp)))
     by = {(r["case"], r["method"]): r for r in rows}
@@ -69,10 +75,9 @@ def main() -> None:
         *(f"| {what} | `{fragment}` |" for what, fragment in _bad_input_cases()),
         "",
     ]
-    out = ROOT / "docs" / "robustness.md"
     out.write_text("\n".join(lines), encoding="utf-8")
     print(out.read_text(encoding="utf-8"))
 
 
 if __name__ == "__main__":
-    main()
+    run_script(main)

@@ -1,0 +1,19 @@
+"""gearsym.benchmarks -- speed and accuracy measurements, each writing a Markdown table.
+
+* ``performance`` -- speed against accuracy of every integration back end (``gearsym bench``
+  or ``python -m gearsym.benchmarks.performance``); writes ``performance.md`` and
+  ``performance-pareto.png`` to an output folder, or to the checkout's ``docs/`` with
+  ``--docs``;
+* ``robustness`` -- the extremes matrix, every case with every back end
+  (``python -m gearsym.benchmarks.robustness``; writes ``docs/robustness.md``, needs the
+  checkout, whose tests list the bad-input cases);
+* ``deadzone_multipliers`` -- Floquet multipliers of a dead-zone orbit against the
+  tolerance (``python -m gearsym.benchmarks.deadzone_multipliers``; writes
+  ``docs/deadzone-multipliers.md``);
+* ``lockstep_reference.c`` -- the hand-written vectorised lockstep DOP853 in C that
+  ``performance`` times the compiled back end against (shipped as package data);
+* ``_output`` -- output folders: the checkout's ``docs/``, the writability check made
+  before a long run, and the one-line failure of the scripts.
+
+Each module also runs as a script from a checkout: ``python benchmarks/<name>.py``.
+"""
