@@ -288,7 +288,38 @@ def audit_page(model: Model, command: str) -> str:
         )
         + ".\n"
     )
+    w(_contract_paragraph(model))
     return "\n".join(out)
+
+
+def _contract_paragraph(model: Model) -> str:
+    """Section 9's account of the module's ``CONTRACT``, from the same data."""
+    c = model.contract
+    states = c["states"]
+    surfaces = ", ".join(f"${states[i]} = {v:g}$" for i, v in c["switching_surfaces"])
+    valid = c["valid_range"]
+    return (
+        "The module states as data (`CONTRACT`) what a solver needs to know: velocities "
+        + ", ".join(f"`{q}` → `{states[i]}` (index {i})" for q, i in c["velocities"].items())
+        + f"; forcing frequency `{c['forcing_frequency']}` (period $2\\pi/\\bar\\omega$); "
+        + "loads "
+        + (", ".join(f"`{q}` → `{f}`" for q, f in c["loads"].items()) or "none")
+        + "; contact edges "
+        + ", ".join(f"`{q}` ∈ [{lo:g}, {hi:g}]" for q, (lo, hi) in c["contact"].items())
+        + " (separated inside, in contact outside); "
+        + (
+            f"piecewise, with switching surfaces {surfaces}"
+            if c["piecewise"]
+            else "smooth, no switching surfaces"
+        )
+        + "; "
+        + (
+            "valid everywhere"
+            if valid is None
+            else "valid for " + ", ".join(f"$|{q}| \\le {a:g}$" for q, a in valid.items())
+        )
+        + ".\n"
+    )
 
 
 def index_page(models: list[Model], command: str) -> str:
@@ -336,6 +367,17 @@ def index_page(models: list[Model], command: str) -> str:
         "way and the ratios $\\kappa_{12}/\\kappa_{11}$ are unchanged for equal helix angles; "
         "only the dimensional $\\omega_n$ differs, by the factor "
         "$\\sqrt{\\cos\\beta_b}$ (0.7 % for $\\beta = 10°$).\n",
+        "## Generated modules\n",
+        "Each `generated/<name>.py` documents its state and parameter order in its "
+        "docstring and holds: `STATES`, `COORDINATES`, `PARAMETERS` (the order of `p`), "
+        "`DEFAULTS`, `VALID_RANGE`, `OMEGA_N`, `HALF_BACKLASH`, `FEATURES`, "
+        "`SCENE_PARAMETERS`, `OPERATIONS`; `CONTRACT`, what a solver needs to know as plain "
+        "data (the velocity index of each coordinate, the forcing-frequency parameter, the "
+        "load parameters, the contact edges, piecewise or smooth with its switching surfaces "
+        "$x_i = c$, the valid range); `rhs(tau, x, p)`, `jacobian(tau, x, p)`, "
+        "`parameters(**values)`, `casadi_functions()`, and the C right-hand side `C_SOURCE` "
+        "(with its variational form `C_SOURCE_VARIATIONAL`). A solver reads `CONTRACT`, "
+        "never the source or a naming pattern.\n",
         "## Targets\n",
         "| target | source | states | parameters | operations (rhs / rhs + Jacobian) | page |",
         "|---|---|---|---|---|---|",

@@ -14,6 +14,10 @@ Each model is plain data plus the symbolic expression it contributes; the fit's
 coefficients are computed here, never typed in.  :func:`fit_dead_zone` with its
 defaults (order 7, range 3, uniform samples of step 0.01) reproduces the printed
 coefficients of the reference study, ``0.0017 x^7 - 0.0366 x^5 + 0.2833 x^3 - 0.1555 x``.
+
+Each model also lists the kinks of ``g`` (where its slope jumps) in ``kinks``: the dead
+zone's edges ``+1, -1``; the smooth, linear and polynomial models have none.  The model's
+contract (``derive/model.py``) turns them into switching surfaces for the solver.
 """
 
 from __future__ import annotations
@@ -21,12 +25,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from fractions import Fraction
+from typing import ClassVar
 
 import numpy as np
 import sympy as sp
 
 __all__ = [
     "BACKLASH_MODELS",
+    "DEAD_ZONE_EDGES",
     "Backlash",
     "DeadZone",
     "LinearContact",
@@ -35,6 +41,11 @@ __all__ = [
     "dead_zone",
     "fit_dead_zone",
 ]
+
+
+# (lower, upper) edges of the dead zone in the unit half backlash: teeth in contact forward
+# for x > upper, separated for lower <= x <= upper, in contact backward for x < lower.
+DEAD_ZONE_EDGES = (-1.0, 1.0)
 
 
 def dead_zone(x: np.ndarray) -> np.ndarray:
@@ -53,9 +64,13 @@ class Backlash:
         Registry name (``linear``, ``dead-zone``, ``smooth``, ``polynomial``).
     valid_range : float or None
         ``A`` such that the model is valid for ``|x| <= A``; None if valid everywhere.
+    kinks : tuple of float
+        The ``x`` where ``g`` has a kink (its slope jumps), upper before lower; ``()``
+        for a smooth ``g``.  An integrator locates these as switching surfaces.
     """
 
     kind = "base"
+    kinks: ClassVar[tuple[float, ...]] = ()
     valid_range: float | None = field(default=None, init=False)
 
     def parameters(self) -> tuple[tuple[str, float, str], ...]:
@@ -106,6 +121,7 @@ class DeadZone(Backlash):
     """Piecewise-linear dead zone ``g(x) = x - 1 (x > 1), 0 (|x| <= 1), x + 1 (x < -1)``."""
 
     kind = "dead-zone"
+    kinks = (DEAD_ZONE_EDGES[1], DEAD_ZONE_EDGES[0])
 
     def expression(self, x):
         return sp.Piecewise((x - 1, x > 1), (x + 1, x < -1), (0, True))

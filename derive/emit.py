@@ -2,7 +2,8 @@
 
 The module written to ``generated/<name>.py`` needs only NumPy (CasADi is imported by
 :func:`casadi_functions` when called).  It announces the command that made it and the
-sha256 of its inputs, documents the state and parameter order, and is written to a
+sha256 of its inputs, documents the state and parameter order, states what a solver needs
+to know as the literal ``CONTRACT`` (:attr:`Model.contract`), and is written to a
 temporary name and renamed so that a reader never sees half a file.
 
 Both back ends print the same common-subexpression-eliminated SymPy expressions through
@@ -133,6 +134,9 @@ def _docstring(model: Model, command: str) -> str:
         f"; mesh phase {'on' if feats.mesh_phase else 'off'}"
         f"; damping coupling {'on' if feats.damping_coupling else 'off'}.",
         f"Time: tau = omega_n t, omega_n = {model.scales['omega_n_rad_per_s']:.10g} rad/s.",
+        "",
+        "CONTRACT states as data what a solver needs: velocity indices, forcing frequency,",
+        "loads, contact edges, piecewise or smooth, switching surfaces, valid range.",
     ]
     return "\n".join(lines)
 
@@ -181,6 +185,12 @@ def emit_module(model: Model, command: str) -> str:
         + ", ".join(f"{k!r}: {fmt(v)}" for k, v in model.scene_parameters.items())
         + "}",
         f"OPERATIONS = {model.operations!r}",
+        "",
+        "# What a solver needs to know about this model, as plain data (Model.contract in",
+        "# derive/model.py); solvers read this, never the source or the names.",
+        "CONTRACT = {",
+        *(f"    {k!r}: {v!r}," for k, v in model.contract.items()),
+        "}",
         "",
         "# The right-hand side in C for the compiled integrators (solver/native.py).",
         'C_SOURCE = r"""',

@@ -16,6 +16,10 @@ State order: the mesh coordinates ``u_1..u_m`` in mesh order, then their derivat
 6. ``phi_<j>`` -- stiffness/TE phase lag of mesh j (mesh phase on, non-reference meshes);
 7. ``E_<j>_<h>``, ``psi_<j>_<h>`` -- transmission-error harmonics over ``b_j``, and phases;
 8. backlash parameters (``g1, g3, ...`` or ``eps_g``).
+
+:attr:`Model.contract` states, as plain Python literals, what a solver needs to know about
+the model (format :data:`CONTRACT_FORMAT`); every generated module carries it as
+``CONTRACT``.
 """
 
 from __future__ import annotations
@@ -30,11 +34,15 @@ import sympy as sp
 
 from ._input import InputError, expression_source
 from ._version import __version__
+from .backlash import DEAD_ZONE_EDGES
 from .equations import derive_equations
 from .nondim import NonDim, nondimensionalise
 from .scene import Features, Scene
 
-__all__ = ["Model", "Parameter", "derive_model", "operation_count"]
+__all__ = ["CONTRACT_FORMAT", "Model", "Parameter", "derive_model", "operation_count"]
+
+# Version of the layout of Model.contract; a solver refuses a format it does not read.
+CONTRACT_FORMAT = 1
 
 
 def operation_count(expressions) -> int:
@@ -62,6 +70,8 @@ class Model:
     coordinates: tuple[str, ...]
     states: tuple[str, ...]
     parameters: tuple[Parameter, ...]
+    forcing_frequency: str  # the parameter omega: excitation period 2 pi / omega
+    load_parameters: dict[str, str]  # coordinate -> its static-load parameter
     tau: sp.Symbol
     state_symbols: tuple[sp.Symbol, ...]
     parameter_symbols: tuple[sp.Symbol, ...]
@@ -92,6 +102,73 @@ class Model:
     @property
     def valid_range(self) -> float | None:
         return self.features.backlash.valid_range
+
+    @property
+    def contract(self) -> dict:
+        """What a solver needs to know about this model, as plain Python literals (a new
+        dict on each call, so a caller's edits cannot leak into the model).
+
+        ``format``
+            :data:`CONTRACT_FORMAT`.
+        ``states``, ``coordinates``, ``parameters``
+            State order, the mesh coordinates (in half backlashes), parameter order of ``p``.
+        ``velocities``
+            coordinate -> index in the state vector of its time derivative, read off the
+            first-order equations (the right-hand side of a coordinate is a state).
+        ``forcing_frequency``
+            The parameter ``omega``; the excitation period is ``2 pi / omega``.
+        ``loads``
+            coordinate -> its static-load parameter (coordinates that have one).
+        ``contact``
+            coordinate -> ``(lower, upper)`` edges of the backlash, ``(-1.0, 1.0)`` in half
+            backlashes: forward contact for ``u > upper``, separated for
+            ``lower <= u <= upper``, backward contact for ``u < lower``.
+        ``piecewise``
+            True when the right-hand side contains a ``Piecewise`` (it has kinks).
+        ``switching_surfaces``
+            ``(state index i, value c)`` for each kink ``x[i] = c`` of the right-hand side:
+            per coordinate in coordinate order, its backlash model's kinks (upper edge,
+            then lower); ``()`` when smooth.
+        ``valid_range``
+            coordinate -> bound ``a``, the force law holding for ``|u| <= a`` only (a
+            polynomial fit of the dead zone); None when valid everywhere.
+        """
+        index = {s: k for k, s in enumerate(self.state_symbols)}
+        velocities = {}
+        for c in self.coordinates:
+            rate = self.rhs[self.states.index(c)]
+            if rate not in index:
+                raise AssertionError(f"the right-hand side of {c} is not a state: {rate}")
+            velocities[c] = index[rate]
+        pieces = {p for e in self.rhs for p in e.atoms(sp.Piecewise)}
+        kinked = {s for p in pieces for s in p.free_symbols}
+        backlash = self.features.backlash
+        surfaces = tuple(
+            (self.states.index(c), float(edge))
+            for c in self.coordinates
+            if self.state_symbols[self.states.index(c)] in kinked
+            for edge in backlash.kinks
+        )
+        if bool(pieces) != bool(surfaces):
+            raise AssertionError(
+                f"backlash '{backlash.kind}' lists kinks {backlash.kinks} but the right-hand "
+                f"side {'has' if pieces else 'has no'} Piecewise"
+            )
+        names = self.parameter_names
+        valid = backlash.valid_range
+        return {
+            "format": CONTRACT_FORMAT,
+            "states": tuple(self.states),
+            "coordinates": tuple(self.coordinates),
+            "velocities": velocities,
+            "parameters": tuple(names),
+            "forcing_frequency": self.forcing_frequency,
+            "loads": {c: f for c, f in self.load_parameters.items() if f in names},
+            "contact": {c: tuple(float(e) for e in DEAD_ZONE_EDGES) for c in self.coordinates},
+            "piecewise": bool(pieces),
+            "switching_surfaces": surfaces,
+            "valid_range": None if valid is None else {c: float(valid) for c in self.coordinates},
+        }
 
     @cached_property
     def operations(self) -> dict[str, int]:
@@ -320,6 +397,8 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
         coordinates=coords,
         states=states,
         parameters=tuple(params),
+        forcing_frequency=omega.name,
+        load_parameters={c: s.name for c, s in zip(coords, f, strict=True)},
         tau=tau,
         state_symbols=state_symbols,
         parameter_symbols=tuple(sp.Symbol(n, real=True) for n in names),

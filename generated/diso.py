@@ -50,6 +50,9 @@ Parameters (in order; default = the scene's value):
 
 Features: stiffness harmonics 3; backlash polynomial (valid for |u| <= 3); transmission error on; mesh phase on; damping coupling on.
 Time: tau = omega_n t, omega_n = 11068.62872 rad/s.
+
+CONTRACT states as data what a solver needs: velocity indices, forcing frequency,
+loads, contact edges, piecewise or smooth, switching surfaces, valid range.
 """
 
 import numpy as np
@@ -100,6 +103,22 @@ HALF_BACKLASH = {'u': 5e-05, 'v': 5e-05}  # m
 FEATURES = {'stiffness_harmonics': 3, 'backlash': 'polynomial', 'transmission_error': True, 'mesh_phase': True, 'damping_coupling': True}
 SCENE_PARAMETERS = {'damping_ratio': 0.03, 'omega': 0.709571332557897}
 OPERATIONS = {'rhs': 91, 'rhs_and_jacobian': 132}
+
+# What a solver needs to know about this model, as plain data (Model.contract in
+# derive/model.py); solvers read this, never the source or the names.
+CONTRACT = {
+    'format': 1,
+    'states': ('u', 'v', 'du', 'dv'),
+    'coordinates': ('u', 'v'),
+    'velocities': {'u': 2, 'v': 3},
+    'parameters': ('omega', 'f_u', 'f_v', 'xi_u_u', 'xi_u_v', 'xi_v_u', 'xi_v_v', 'kappa_u_u', 'kappa_u_v', 'kappa_v_u', 'kappa_v_v', 'kc_u_1', 'ks_u_1', 'kc_u_2', 'ks_u_2', 'kc_u_3', 'ks_u_3', 'kc_v_1', 'ks_v_1', 'kc_v_2', 'ks_v_2', 'kc_v_3', 'ks_v_3', 'phi_v', 'E_u_1', 'psi_u_1', 'E_v_1', 'psi_v_1', 'g1', 'g3', 'g5', 'g7'),
+    'forcing_frequency': 'omega',
+    'loads': {'u': 'f_u', 'v': 'f_v'},
+    'contact': {'u': (-1.0, 1.0), 'v': (-1.0, 1.0)},
+    'piecewise': False,
+    'switching_surfaces': (),
+    'valid_range': {'u': 3.0, 'v': 3.0},
+}
 
 # The right-hand side in C for the compiled integrators (solver/native.py).
 C_SOURCE = r"""

@@ -27,6 +27,9 @@ Parameters (in order; default = the scene's value):
 
 Features: stiffness harmonics 0; backlash linear; transmission error off; mesh phase off; damping coupling off.
 Time: tau = omega_n t, omega_n = 11068.62872 rad/s.
+
+CONTRACT states as data what a solver needs: velocity indices, forcing frequency,
+loads, contact edges, piecewise or smooth, switching surfaces, valid range.
 """
 
 import numpy as np
@@ -54,6 +57,22 @@ HALF_BACKLASH = {'u': 5e-05, 'v': 5e-05}  # m
 FEATURES = {'stiffness_harmonics': 0, 'backlash': 'linear', 'transmission_error': False, 'mesh_phase': False, 'damping_coupling': False}
 SCENE_PARAMETERS = {'omega': 0.5, 'damping_ratio': 0.03, 'f1': 0.1, 'lambda': 0.1}
 OPERATIONS = {'rhs': 14, 'rhs_and_jacobian': 20}
+
+# What a solver needs to know about this model, as plain data (Model.contract in
+# derive/model.py); solvers read this, never the source or the names.
+CONTRACT = {
+    'format': 1,
+    'states': ('u', 'v', 'du', 'dv'),
+    'coordinates': ('u', 'v'),
+    'velocities': {'u': 2, 'v': 3},
+    'parameters': ('omega', 'f_u', 'f_v', 'xi_u_u', 'xi_v_v', 'kappa_u_u', 'kappa_u_v', 'kappa_v_u', 'kappa_v_v'),
+    'forcing_frequency': 'omega',
+    'loads': {'u': 'f_u', 'v': 'f_v'},
+    'contact': {'u': (-1.0, 1.0), 'v': (-1.0, 1.0)},
+    'piecewise': False,
+    'switching_surfaces': (),
+    'valid_range': None,
+}
 
 # The right-hand side in C for the compiled integrators (solver/native.py).
 C_SOURCE = r"""
