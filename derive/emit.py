@@ -192,7 +192,7 @@ def emit_module(model: Model, command: str) -> str:
         *(f"    {k!r}: {v!r}," for k, v in model.contract.items()),
         "}",
         "",
-        "# The right-hand side in C for the compiled integrators (solver/native.py).",
+        "# The right-hand side in C for the compiled integrators (solver/integrate/native/).",
         'C_SOURCE = r"""',
         c_source(model).rstrip("\n"),
         '"""',

@@ -1,4 +1,4 @@
-"""Emit a Model's right-hand side as C for the compiled integrators (``solver/native.py``).
+"""Emit a Model's right-hand side as C for the compiled integrators (``solver/integrate/native/``).
 
 The same SymPy expressions as the NumPy and CasADi code, rewritten for speed:
 

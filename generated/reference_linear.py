@@ -74,7 +74,7 @@ CONTRACT = {
     'valid_range': None,
 }
 
-# The right-hand side in C for the compiled integrators (solver/native.py).
+# The right-hand side in C for the compiled integrators (solver/integrate/native/).
 C_SOURCE = r"""
 /* reference_linear: right-hand side for the compiled integrators (gearsym derive). */
 #define GS_NX 4

@@ -86,7 +86,7 @@ CONTRACT = {
     'valid_range': {'u': 3.0},
 }
 
-# The right-hand side in C for the compiled integrators (solver/native.py).
+# The right-hand side in C for the compiled integrators (solver/integrate/native/).
 C_SOURCE = r"""
 /* siso: right-hand side for the compiled integrators (gearsym derive). */
 #define GS_NX 2

@@ -15,7 +15,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from .analysis import spectrum  # noqa: E402
-from .simulate import Trajectory  # noqa: E402
+from .integrate import Trajectory  # noqa: E402
 from .sweep import SweepResult  # noqa: E402
 
 __all__ = ["bifurcation_diagram", "map_figure", "point_figure"]
@@ -31,20 +31,29 @@ def _save(fig, path: Path) -> Path:
     return path
 
 
-def bifurcation_diagram(sweeps: list[SweepResult], states: list[str], path: Path,
-                        title: str = "") -> Path:  # fmt: skip
+def bifurcation_diagram(
+    sweeps: list[SweepResult], states: list[str], path: Path, title: str = ""
+) -> Path:
     """Poincare points of each state against the swept parameter, one panel per state;
     forward and backward continuation overlaid (hysteresis shows as two colours apart)."""
-    fig, axes = plt.subplots(len(states), 1, figsize=(7, 2.8 * len(states)), sharex=True,
-                             squeeze=False)  # fmt: skip
+    fig, axes = plt.subplots(
+        len(states), 1, figsize=(7, 2.8 * len(states)), sharex=True, squeeze=False
+    )
     for ax, state in zip(axes[:, 0], states, strict=True):
         for sw in sweeps:
             xs, ys = [], []
             for value, pts in zip(sw.values, sw.poincare(state), strict=True):
                 xs.append(np.full(pts.size, value))
                 ys.append(pts)
-            ax.plot(np.concatenate(xs), np.concatenate(ys), ".", markersize=1.5, alpha=0.8,
-                    color=_COLOURS[sw.direction], label=f"{sw.direction} sweep")  # fmt: skip
+            ax.plot(
+                np.concatenate(xs),
+                np.concatenate(ys),
+                ".",
+                markersize=1.5,
+                alpha=0.8,
+                color=_COLOURS[sw.direction],
+                label=f"{sw.direction} sweep",
+            )
         ax.set_ylabel(f"{state} (Poincaré), 1/half backlash")
         ax.grid(alpha=0.3)
     axes[0, 0].legend(loc="best", markerscale=6, fontsize=8)
@@ -62,18 +71,24 @@ def point_figure(tr: Trajectory, path: Path, title: str = "", periods_shown: int
     spp = tr.samples_per_period
     shown = slice(max(0, tr.t.size - periods_shown * spp), None)
     for row, c in enumerate(coords):
-        u, du = tr.coordinate(c), tr.coordinate(f"d{c}")
+        u, du = tr.coordinate(c), tr.velocity(c)
         ax = axes[row, 0]
         ax.plot(tr.t[shown], u[shown], lw=0.8)
-        for edge in (-1, 1):
+        for edge in tr.system.contract.contact.get(c, ()):
             ax.axhline(edge, color="grey", lw=0.6, ls="--")
         ax.set_xlabel("τ (non-dimensional time)")
         ax.set_ylabel(f"{c} (1/half backlash)")
         ax.set_title(f"{c}: time series (last {periods_shown} periods)", fontsize=9)
         ax = axes[row, 1]
         ax.plot(u, du, lw=0.3, color="tab:blue", alpha=0.6)
-        ax.plot(tr.poincare[tr.system.index(c)], tr.poincare[tr.system.index(f"d{c}")], "o",
-                ms=2.5, color="tab:red", label="Poincaré")  # fmt: skip
+        ax.plot(
+            tr.poincare[tr.system.index(c)],
+            tr.poincare[tr.system.velocity_index(c)],
+            "o",
+            ms=2.5,
+            color="tab:red",
+            label="Poincaré",
+        )
         ax.set_xlabel(c)
         ax.set_ylabel(f"d{c}/dτ")
         ax.set_title(f"{c}: phase portrait", fontsize=9)
@@ -92,8 +107,14 @@ def point_figure(tr: Trajectory, path: Path, title: str = "", periods_shown: int
     return _save(fig, path)
 
 
-_MOTION_CODES = {"period-1": 1, "period-n": 2, "quasi-periodic": 3, "chaotic": 4,
-                 "undetermined": 5, "divergent": 6}  # fmt: skip
+_MOTION_CODES = {
+    "period-1": 1,
+    "period-n": 2,
+    "quasi-periodic": 3,
+    "chaotic": 4,
+    "undetermined": 5,
+    "divergent": 6,
+}
 
 
 def motion_code(motion: str) -> int:
@@ -102,8 +123,16 @@ def motion_code(motion: str) -> int:
     return _MOTION_CODES.get(motion, 5)
 
 
-def map_figure(f_values, lam_values, max_u, min_v, motion_v, path: Path, title: str = "",
-               names=("f1", "lambda", "u", "v")) -> Path:  # fmt: skip
+def map_figure(
+    f_values,
+    lam_values,
+    max_u,
+    min_v,
+    motion_v,
+    path: Path,
+    title: str = "",
+    names=("f1", "lambda", "u", "v"),
+) -> Path:
     """Maps over (f1, lambda): Max(u), Min(v) and the motion type of v."""
     fig, axes = plt.subplots(1, 3, figsize=(15, 4))
 
@@ -114,8 +143,10 @@ def map_figure(f_values, lam_values, max_u, min_v, motion_v, path: Path, title: 
         return v[0] - half, v[-1] + half
 
     extent = [*edges(lam_values), *edges(f_values)]
-    for ax, data, label in ((axes[0], max_u, f"Max({names[2]})"),
-                            (axes[1], min_v, f"Min({names[3]})")):  # fmt: skip
+    for ax, data, label in (
+        (axes[0], max_u, f"Max({names[2]})"),
+        (axes[1], min_v, f"Min({names[3]})"),
+    ):
         im = ax.imshow(np.asarray(data), origin="lower", aspect="auto", extent=extent)
         fig.colorbar(im, ax=ax, label=label)
         ax.set_xlabel(names[1])
@@ -125,11 +156,13 @@ def map_figure(f_values, lam_values, max_u, min_v, motion_v, path: Path, title: 
     cmap = matplotlib.colors.ListedColormap(
         ["tab:green", "tab:olive", "tab:blue", "tab:red", "lightgrey", "black"]
     )
-    im = axes[2].imshow(codes, origin="lower", aspect="auto", extent=extent, cmap=cmap,
-                        vmin=0.5, vmax=6.5)  # fmt: skip
+    im = axes[2].imshow(
+        codes, origin="lower", aspect="auto", extent=extent, cmap=cmap, vmin=0.5, vmax=6.5
+    )
     cbar = fig.colorbar(im, ax=axes[2], ticks=range(1, 7))
-    cbar.ax.set_yticklabels(["period-1", "period-n", "quasi-periodic", "chaotic",
-                             "undetermined", "divergent"])  # fmt: skip
+    cbar.ax.set_yticklabels(
+        ["period-1", "period-n", "quasi-periodic", "chaotic", "undetermined", "divergent"]
+    )
     axes[2].set_xlabel(names[1])
     axes[2].set_ylabel(names[0])
     axes[2].set_title(f"motion of {names[3]}")
@@ -139,8 +172,9 @@ def map_figure(f_values, lam_values, max_u, min_v, motion_v, path: Path, title: 
     return _save(fig, path)
 
 
-def branch_figure(branches, path: Path, state_index: int = 0, state: str = "u",
-                  sweeps=None, title: str = "") -> Path:  # fmt: skip
+def branch_figure(
+    branches, path: Path, state_index: int = 0, state: str = "u", sweeps=None, title: str = ""
+) -> Path:
     """Continuation branches over the brute-force diagram: stable solid, unstable dashed,
     bifurcations marked; Poincare points of brute-force sweeps in the background."""
     fig, ax = plt.subplots(figsize=(8, 4.5))
@@ -150,10 +184,19 @@ def branch_figure(branches, path: Path, state_index: int = 0, state: str = "u",
             xs.append(np.full(np.size(pts), value))
             ys.append(np.asarray(pts))
         if xs:
-            ax.plot(np.concatenate(xs), np.concatenate(ys), ".", markersize=2, color="0.6",
-                    label=f"brute force ({sw.direction})" if sw is sweeps[0] else None)  # fmt: skip
-    markers = {"fold": ("s", "tab:red"), "period-doubling": ("D", "tab:purple"),
-               "neimark-sacker": ("o", "tab:green")}  # fmt: skip
+            ax.plot(
+                np.concatenate(xs),
+                np.concatenate(ys),
+                ".",
+                markersize=2,
+                color="0.6",
+                label=f"brute force ({sw.direction})" if sw is sweeps[0] else None,
+            )
+    markers = {
+        "fold": ("s", "tab:red"),
+        "period-doubling": ("D", "tab:purple"),
+        "neimark-sacker": ("o", "tab:green"),
+    }
     for k, br in enumerate(branches):
         lam = np.asarray(br.values)
         y = np.array([s[state_index] for s in br.states])
@@ -161,8 +204,14 @@ def branch_figure(branches, path: Path, state_index: int = 0, state: str = "u",
         colour = f"C{k}"
         for flag, style in ((True, "-"), (False, "--")):
             yy = np.where(stable == flag, y, np.nan)
-            ax.plot(lam, yy, style, color=colour, lw=1.4,
-                    label=f"period-{br.n} {'stable' if flag else 'unstable'}")  # fmt: skip
+            ax.plot(
+                lam,
+                yy,
+                style,
+                color=colour,
+                lw=1.4,
+                label=f"period-{br.n} {'stable' if flag else 'unstable'}",
+            )
         for b in br.bifurcations:
             m, c = markers[b.kind]
             ax.plot(b.value, b.x0[state_index], m, color=c, ms=7, label=b.kind)

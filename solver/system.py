@@ -1,9 +1,10 @@
 """A generated model, ready to integrate: names, parameter vector, period, CasADi graphs.
 
 :class:`System` is the solver's only view of a model.  It reads the generated module's
-interface (``STATES``, ``PARAMETERS``, ``parameters()``, ``rhs``, ``jacobian``,
-``casadi_functions``) and never anything about gears.  It is immutable; ``with_values``
-returns a new system with other parameter values, sharing the compiled CasADi graphs.
+contract (:class:`~gearsym.solver.contract.Contract`) and its functions (``parameters()``,
+``rhs``, ``jacobian``, ``casadi_functions``), never anything about gears.  It is
+immutable; ``with_values`` returns a new system with other parameter values, sharing the
+compiled CasADi graphs.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from types import ModuleType
 
 import numpy as np
 
-from ._models import load_generated
+from .contract import Contract, load_generated
 
 __all__ = ["System"]
 
@@ -32,21 +33,30 @@ class System:
         Parameter vector in the module's order.
     values : dict
         The named values (scene or model parameters) that produced ``p``.
+    contract : Contract
+        What the model states about itself (read once per model, shared by ``with_values``).
     """
 
     module: ModuleType
     p: np.ndarray
     values: dict = field(default_factory=dict)
+    contract: Contract = None  # type: ignore[assignment]
 
     def __post_init__(self):
-        bad = [n for n, v in zip(self.module.PARAMETERS, self.p, strict=True) if not np.isfinite(v)]
+        if self.contract is None:
+            object.__setattr__(self, "contract", Contract.of(self.module))
+        names = self.contract.parameters
+        bad = [n for n, v in zip(names, self.p, strict=True) if not np.isfinite(v)]
         if bad:
             raise ValueError(f"parameter(s) {', '.join(bad)} are not finite numbers")
-        if not self.p[list(self.module.PARAMETERS).index("omega")] > 0:
-            raise ValueError("omega (the excitation frequency) must be > 0")
+        omega = self.contract.forcing_frequency
+        if not self.p[names.index(omega)] > 0:
+            raise ValueError(f"{omega} (the excitation frequency) must be > 0")
 
     @classmethod
     def load(cls, name_or_module, **values) -> System:
+        """The model of a generated module (a module, its name or its file) with ``values``
+        (scene or model parameters by name; the rest keep the scene's values)."""
         module = (
             name_or_module
             if isinstance(name_or_module, ModuleType)
@@ -57,12 +67,15 @@ class System:
     def with_values(self, **values) -> System:
         """The same model with some named values changed (the rest kept)."""
         merged = self.values | values
-        new = System(self.module, self.module.parameters(**merged), merged)
+        new = System(self.module, self.module.parameters(**merged), merged, self.contract)
         # Share the CasADi graphs: they depend on the model, not on the values.
-        for key in ("casadi",):
-            if key in self.__dict__:
-                new.__dict__[key] = self.__dict__[key]
+        if "casadi" in self.__dict__:
+            new.__dict__["casadi"] = self.__dict__["casadi"]
         return new
+
+    def parameters_with(self, **values) -> np.ndarray:
+        """The parameter vector with some named values changed (no new System)."""
+        return self.module.parameters(**(self.values | values))
 
     # -- names -------------------------------------------------------------------------
     @property
@@ -71,30 +84,31 @@ class System:
 
     @property
     def states(self) -> tuple[str, ...]:
-        return tuple(self.module.STATES)
+        return self.contract.states
 
     @property
     def coordinates(self) -> tuple[str, ...]:
-        return tuple(self.module.COORDINATES)
+        return self.contract.coordinates
 
     @property
     def n(self) -> int:
-        return len(self.module.STATES)
+        return len(self.contract.states)
 
     def index(self, state: str) -> int:
-        try:
-            return self.states.index(state)
-        except ValueError:
-            raise KeyError(f"no state '{state}'; states: {', '.join(self.states)}") from None
+        return self.contract.index(state)
+
+    def velocity_index(self, coordinate: str) -> int:
+        """Index of the time derivative of mesh coordinate ``coordinate``."""
+        return self.contract.velocity(coordinate)
 
     def parameter(self, name: str) -> float:
-        return float(self.p[list(self.module.PARAMETERS).index(name)])
+        return float(self.p[self.contract.parameters.index(name)])
 
     # -- forcing -----------------------------------------------------------------------
     @property
     def omega(self) -> float:
         """Excitation frequency (non-dimensional) of the reference mesh."""
-        return self.parameter("omega")
+        return self.parameter(self.contract.forcing_frequency)
 
     @property
     def period(self) -> float:
@@ -102,8 +116,8 @@ class System:
         return 2.0 * math.pi / self.omega
 
     @property
-    def valid_range(self) -> float | None:
-        return self.module.VALID_RANGE
+    def piecewise(self) -> bool:
+        return self.contract.piecewise
 
     @property
     def backlash(self) -> str:
@@ -125,13 +139,23 @@ class System:
         """(rhs, jacobian) as CasADi Functions of (tau, x, p); built once per model."""
         return self.module.casadi_functions()
 
+    def scales(self) -> dict:
+        """How to go back to SI: omega_n and the half backlash of each coordinate."""
+        return {
+            "omega_n_rad_per_s": float(self.module.OMEGA_N),
+            "half_backlash_m": dict(self.module.HALF_BACKLASH),
+            "time": "tau = omega_n t; coordinates in half backlashes",
+        }
+
     def describe(self) -> dict:
         return {
             "model": self.name,
             "model_hash": self.model_hash,
             "values": {k: float(v) for k, v in self.values.items()},
-            "parameters": dict(zip(self.module.PARAMETERS, map(float, self.p), strict=True)),
+            "parameters": dict(zip(self.contract.parameters, map(float, self.p), strict=True)),
             "omega_n_rad_per_s": self.module.OMEGA_N,
             "half_backlash_m": dict(self.module.HALF_BACKLASH),
             "features": dict(self.module.FEATURES),
         }
+
+    to_dict = describe

@@ -5,6 +5,7 @@ import subprocess
 import sys
 
 import pytest
+from gearsym.cli import main
 from gearsym.derive.build import (
     build_files,
     check,
@@ -12,7 +13,6 @@ from gearsym.derive.build import (
     write_files,
     write_stiffness_figure,
 )
-from gearsym.solver.cli import main
 
 
 def run(capsys, *argv):
@@ -117,7 +117,7 @@ def test_console_script_runs_without_traceback_on_bad_input(tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text("[scene]\nname = 'x'\n")
     proc = subprocess.run(
-        [sys.executable, "-m", "gearsym.solver.cli", "derive", str(bad)],
+        [sys.executable, "-m", "gearsym.cli", "derive", str(bad)],
         capture_output=True,
         text=True,
     )

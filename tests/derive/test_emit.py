@@ -160,8 +160,10 @@ def test_c_printer_keeps_reciprocals_of_sums_and_leaves_state_trig_alone():
     )
     exprs, bases, q = _reduce_trig(
         [sp.sin(u), sp.cos(omega * tau + u), sp.cos(r * tau), sp.cos(2 * omega * tau - a)],
-        tau, [a, b, omega, r], omega,
-    )  # fmt: skip
+        tau,
+        [a, b, omega, r],
+        omega,
+    )
     assert exprs[0] == sp.sin(u) and exprs[1] == sp.cos(omega * tau + u)
     assert exprs[2] == sp.cos(r * tau)
     assert list(bases) == [omega] and sp.cos(a) in q and sp.sin(a) in q

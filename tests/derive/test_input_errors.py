@@ -1,7 +1,7 @@
 """Every kind of bad topology or scene input stops with one line naming file and key."""
 
 import pytest
-from gearsym.solver.cli import main
+from gearsym.cli import main
 
 
 @pytest.fixture()

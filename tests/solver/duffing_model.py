@@ -32,6 +32,21 @@ FEATURES = {
 SCENE_PARAMETERS = {"omega": 1.0}
 OPERATIONS = {"rhs": 8, "rhs_and_jacobian": 12}
 
+# What the solver needs to know, as data (the generated modules' contract, format 1).
+CONTRACT = {
+    "format": 1,
+    "states": STATES,
+    "coordinates": COORDINATES,
+    "velocities": {"x": 1},
+    "parameters": PARAMETERS,
+    "forcing_frequency": "omega",
+    "loads": {},
+    "contact": {},
+    "piecewise": False,
+    "switching_surfaces": (),
+    "valid_range": None,
+}
+
 
 def parameters(**values):
     p = dict(zip(PARAMETERS, DEFAULTS, strict=True))

@@ -1,8 +1,7 @@
 """Motion classification against systems whose motion is known."""
 
 import numpy as np
-from gearsym.solver.classify import classify_points, correlation_dimension
-from gearsym.solver.point import analyse_point
+from gearsym.solver.analysis import analyse_point, classify_points, correlation_dimension
 from gearsym.solver.system import System
 
 

@@ -3,7 +3,7 @@
 import json
 
 import pytest
-from gearsym.solver.cli import main
+from gearsym.cli import main
 
 
 def test_simulate_json_has_the_verdicts_and_their_evidence(capsys):

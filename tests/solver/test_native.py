@@ -1,12 +1,10 @@
 """The compiled batched integrators against the NumPy code and SciPy's integrators."""
 
-import importlib
 import warnings
 
 import numpy as np
 import pytest
-from gearsym.solver import native
-from gearsym.solver.simulate import default_initial_state, simulate
+from gearsym.solver.integrate import default_initial_state, native, simulate
 from gearsym.solver.system import System
 
 pytestmark = pytest.mark.skipif(native.compiler() is None, reason="no C compiler")
@@ -98,9 +96,9 @@ def test_a_diverging_point_does_not_spoil_its_group():
 def test_library_is_cached_on_disk(tmp_path, monkeypatch):
     monkeypatch.setenv("GEARSYM_CACHE", str(tmp_path))
     module = System.load("siso").module
-    native._loaded.clear()
+    native.reset()
     _, first = native.library(module)
-    native._loaded.clear()
+    native.reset()
     _, second = native.library(module)
     assert first["compiled"] and not second["compiled"]
     assert first["path"] == second["path"] and first["path"].startswith(str(tmp_path))
@@ -108,7 +106,7 @@ def test_library_is_cached_on_disk(tmp_path, monkeypatch):
 
 def test_without_a_compiler_numpy_takes_over_with_a_warning(monkeypatch):
     monkeypatch.setenv("GEARSYM_CC", "none")
-    importlib.reload(native)
+    native.reset()
     try:
         module = System.load("reference_light").module
         P = np.array([module.parameters(**{"lambda": v}) for v in (0.7, 0.9)])
@@ -124,13 +122,13 @@ def test_without_a_compiler_numpy_takes_over_with_a_warning(monkeypatch):
         assert compiled.backend == "native"
         np.testing.assert_allclose(res.x, compiled.x, atol=1e-6)
     finally:
-        importlib.reload(native)
+        native.reset()
 
 
 def test_native_lyapunov_exponent_matches_cvodes():
     # Two independent integrators of the same variational equations (compiled DOP853 and
     # CasADi's CVODES) give the same Benettin estimate.
-    from gearsym.solver.lyapunov import largest_lyapunov
+    from gearsym.solver.analysis import largest_lyapunov
 
     system = System.load("reference_light", **{"lambda": 0.1})
     tr = simulate(system, method="dop853", transient=200, periods=2, samples_per_period=1)
@@ -148,8 +146,15 @@ def test_bad_starts_end_at_once_with_a_status():
     p = module.parameters()
     start = np.array([[1.0, 0.0, 0.0, 0.0], [1e50, -1e50, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]])
     for lockstep in (False, True):
-        res = native.run_batch(module, np.repeat(p[None, :], 3, axis=0), start, transient=2,
-                               periods=1, lockstep=lockstep, group=3)  # fmt: skip
+        res = native.run_batch(
+            module,
+            np.repeat(p[None, :], 3, axis=0),
+            start,
+            transient=2,
+            periods=1,
+            lockstep=lockstep,
+            group=3,
+        )
         assert res.status == ("ok", "divergent", "ok")
     bad = p.copy()
     bad[3] = np.nan
@@ -162,13 +167,16 @@ def test_fallback_with_workers_and_a_diverging_point(monkeypatch):
     # own status, as the compiled path does.
     monkeypatch.setenv("GEARSYM_CC", "none")
     module = System.load("reference_light").module
-    P = np.array([module.parameters(**{"lambda": 0.8}),
-                  module.parameters(**{"lambda": 0.8, "damping_ratio": -0.5})])  # fmt: skip
+    P = np.array(
+        [
+            module.parameters(**{"lambda": 0.8}),
+            module.parameters(**{"lambda": 0.8, "damping_ratio": -0.5}),
+        ]
+    )
     x0 = default_initial_state(System.load("reference_light"))
     X0 = np.repeat(x0[None, :], 2, axis=0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res = native.run_batch(module, P, X0, method="dop853", transient=40, periods=2,
-                               workers=2)  # fmt: skip
+        res = native.run_batch(module, P, X0, method="dop853", transient=40, periods=2, workers=2)
     assert res.backend == "numpy"
     assert res.status == ("ok", "divergent")

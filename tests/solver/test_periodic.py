@@ -2,10 +2,8 @@
 
 import numpy as np
 import pytest
-from gearsym.solver.continuation import continue_orbit, switch_period_doubling
-from gearsym.solver.flow import FlowMap
-from gearsym.solver.shooting import shoot
-from gearsym.solver.simulate import simulate
+from gearsym.solver.integrate import simulate
+from gearsym.solver.periodic import FlowMap, continue_orbit, shoot, switch_period_doubling
 from gearsym.solver.system import System
 from scipy.linalg import expm
 
@@ -143,15 +141,15 @@ def test_branch_switching_follows_the_period_two_orbit():
 @pytest.mark.slow
 @pytest.mark.parametrize("module", ["reference_light", "reference_heavy"])
 def test_continuation_over_lambda_matches_the_brute_force_windows(module):
-    from gearsym.solver.reproduce import stable_coverage
     from gearsym.solver.sweep import sweep
+    from gearsym.studies.report import stable_coverage
 
     system = System.load(module)
     lam = np.linspace(0.0, 1.0, 11)
     settings = dict(method="cvodes", transient=150, periods=8, lyapunov_periods=0)
     sweeps = [sweep(system, "lambda", lam, backward=b, **settings) for b in (False, True)]
     start = sweeps[0].points[0]
-    x0 = np.array([start["poincare"][s][0] for s in system.states])
+    x0 = start.poincare_state(system.states)
     branch = continue_orbit(system, "lambda", 0.0, 1.0, x0, ds=0.03, ds_max=0.12)
     covered, total, missed = stable_coverage([branch], sweeps)
     assert total > 0 and covered == total, missed

@@ -2,9 +2,9 @@
 
 import numpy as np
 import pytest
-from gearsym.solver.robustness import CASES, harmonics_models, run_case
-from gearsym.solver.simulate import METHODS, simulate
+from gearsym.solver.integrate import METHODS, simulate
 from gearsym.solver.system import System
+from gearsym.studies.robustness import CASES, harmonics_models, run_case
 
 
 @pytest.fixture(scope="module")

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from gearsym.solver.simulate import METHODS, simulate
+from gearsym.solver.integrate import METHODS, simulate
 from gearsym.solver.system import System
 
 

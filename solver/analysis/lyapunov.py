@@ -4,8 +4,9 @@ The state and one tangent vector are integrated together,
 
     ``x' = F(tau, x, p)``,   ``w' = J(tau, x, p) w``,
 
-over one forcing period at a time -- with the compiled DOP853 (``solver/native.py``) when a
-C compiler is available, else with CasADi's CVODES; after each period the tangent
+over one forcing period at a time -- with the compiled DOP853 (``integrate/native``) when a
+C compiler is available, else with CasADi's CVODES on the variational system of
+``integrate/variational.py``; after each period the tangent
 vector is renormalised and ``log |w|`` accumulated (Benettin, Galgani, Giorgilli and
 Strelcyn 1980, "Lyapunov characteristic exponents for smooth dynamical systems",
 Meccanica 15).  The exponent is per unit of non-dimensional time tau; the running
@@ -18,7 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .system import System
+from ..integrate import native
+from ..integrate.variational import casadi_dae
+from ..system import System
 
 __all__ = ["LyapunovEstimate", "largest_lyapunov"]
 
@@ -44,6 +47,8 @@ class LyapunovEstimate:
             "atol": self.atol,
         }
 
+    to_dict = describe
+
 
 def largest_lyapunov(
     system: System,
@@ -66,33 +71,44 @@ def largest_lyapunov(
     v = rng.standard_normal(n)
     v /= np.linalg.norm(v)
     if backend != "cvodes":
-        from . import native
-
         try:
             running, _ = native.benettin(
-                system.module, system.p, np.concatenate([np.asarray(x0, float), v]), t0=t0,
-                periods=periods, rtol=rtol, atol=atol)  # fmt: skip
+                system.module,
+                system.p,
+                np.concatenate([np.asarray(x0, float), v]),
+                t0=t0,
+                period=system.period,
+                periods=periods,
+                rtol=rtol,
+                atol=atol,
+            )
         except native.NativeUnavailable:
             if backend == "native":
                 raise
         else:
             half = running[periods // 2 :]
-            return LyapunovEstimate(float(running[-1]), running, periods,
-                                    float(half.max() - half.min()), rtol, atol,
-                                    "compiled DOP853")  # fmt: skip
+            return LyapunovEstimate(
+                float(running[-1]),
+                running,
+                periods,
+                float(half.max() - half.min()),
+                rtol,
+                atol,
+                "compiled DOP853",
+            )
     import casadi as ca
 
-    f, jac = system.casadi
-    tau = ca.SX.sym("tau")
-    x = ca.SX.sym("x", n)
-    w = ca.SX.sym("w", n)
-    p = ca.SX.sym("p", system.p.size)
-    shift = ca.SX.sym("shift")  # integrate each period from 0 with the forcing shifted
-    ode = ca.vertcat(f(tau + shift, x, p), ca.mtimes(jac(tau + shift, x, p), w))
-    dae = {"x": ca.vertcat(x, w), "p": ca.vertcat(p, shift), "t": tau, "ode": ode}
+    # Each period is integrated from 0 with the forcing shifted to start at t0 + k T.
+    dae = casadi_dae(system, tangents=1)
     T = system.period
-    F = ca.integrator("period", "cvodes", dae, 0.0, T,
-                      {"reltol": rtol, "abstol": atol, "max_num_steps": 1_000_000})  # fmt: skip
+    F = ca.integrator(
+        "period",
+        "cvodes",
+        dae,
+        0.0,
+        T,
+        {"reltol": rtol, "abstol": atol, "max_num_steps": 1_000_000},
+    )
     z = np.concatenate([np.asarray(x0, dtype=float), v])
     total = 0.0
     running = np.empty(periods)
@@ -105,5 +121,6 @@ def largest_lyapunov(
         z[n:] /= growth
         running[k] = total / ((k + 1) * T)
     half = running[periods // 2 :]
-    return LyapunovEstimate(float(running[-1]), running, periods,
-                            float(half.max() - half.min()), rtol, atol)  # fmt: skip
+    return LyapunovEstimate(
+        float(running[-1]), running, periods, float(half.max() - half.min()), rtol, atol
+    )

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .simulate import Trajectory
+from ..integrate import Trajectory
 
 __all__ = ["Spectrum", "extremes", "meshing_states", "spectrum"]
 
@@ -64,6 +64,8 @@ class Spectrum:
             "peaks": self.peaks(),
         }
 
+    to_dict = describe
+
 
 def spectrum(tr: Trajectory, state: str) -> Spectrum:
     """Hann-windowed FFT of ``state`` over the sampled window (mean removed); non-finite
@@ -85,24 +87,32 @@ def extremes(tr: Trajectory) -> dict:
     out = {}
     for k, s in enumerate(tr.system.states):
         finite = tr.x[k][np.isfinite(tr.x[k])]
-        out[s] = {"max": float(finite.max()) if finite.size else None,
-                  "min": float(finite.min()) if finite.size else None}  # fmt: skip
+        out[s] = {
+            "max": float(finite.max()) if finite.size else None,
+            "min": float(finite.min()) if finite.size else None,
+        }
     return out
 
 
 def meshing_states(tr: Trajectory) -> dict:
-    """Share of the sampled time each mesh spends in forward contact (u > 1), separated
-    (|u| <= 1) and in backward contact (u < -1): the state switching of the study."""
+    """Share of the sampled time each mesh spends in forward contact (past the upper
+    contact edge, u > 1), separated (between the edges) and in backward contact (u < -1):
+    the state switching of the study.  Coordinates without contact edges in the model's
+    contract are left out."""
     out = {}
+    contact = tr.system.contract.contact
     for c in tr.system.coordinates:
+        if c not in contact:
+            continue
+        lower, upper = contact[c]
         u = tr.coordinate(c)
         u = u[np.isfinite(u)]
         if not u.size:
             out[c] = {"forward": None, "separated": None, "backward": None}
             continue
         out[c] = {
-            "forward": float(np.mean(u > 1.0)),
-            "separated": float(np.mean(np.abs(u) <= 1.0)),
-            "backward": float(np.mean(u < -1.0)),
+            "forward": float(np.mean(u > upper)),
+            "separated": float(np.mean((u >= lower) & (u <= upper))),
+            "backward": float(np.mean(u < lower)),
         }
     return out

@@ -15,10 +15,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-
-from .point import analyse_point
-from .simulate import METHODS, SimulationError
-from .system import System
+from gearsym.solver.analysis import analyse_point
+from gearsym.solver.integrate import METHODS, SimulationError
+from gearsym.solver.system import System
 
 __all__ = ["CASES", "Case", "harmonics_models", "run_case"]
 
@@ -49,8 +48,7 @@ CASES = (
     Case("damping ratio -0.5 (energy grows)", {"damping_ratio": -0.5}),
 )
 
-BASE = dict(transient=6, periods=2, samples_per_period=16, lyapunov_periods=0,
-            steps_per_period=256)  # fmt: skip
+BASE = dict(transient=6, periods=2, samples_per_period=16, lyapunov_periods=0, steps_per_period=256)
 
 
 def harmonics_models(folder: Path) -> dict[str, Path]:
@@ -88,9 +86,14 @@ def run_case(case: Case, method: str, models: dict[str, Path] | None = None) -> 
         tr = result.trajectory
         u = tr.coordinate(system.coordinates[0])
         finite = bool(np.all(np.isfinite(tr.x)))
-        outcome.update(status=tr.status, message=tr.message, finite=finite,
-                       u_range=(float(u.min()), float(u.max())) if finite else None,
-                       nfev=tr.nfev, left_valid_range=tr.left_valid_range)  # fmt: skip
+        outcome.update(
+            status=tr.status,
+            message=tr.message,
+            finite=finite,
+            u_range=(float(u.min()), float(u.max())) if finite else None,
+            nfev=tr.nfev,
+            left_valid_range=tr.left_valid_range,
+        )
     outcome["seconds"] = time.perf_counter() - started
     return outcome
 

@@ -8,11 +8,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .analysis import extremes, meshing_states, spectrum
+from ..integrate import Trajectory, get_method, simulate
+from ..system import System
 from .classify import Classification, classify_points
 from .lyapunov import LyapunovEstimate, largest_lyapunov
-from .simulate import Trajectory, simulate
-from .system import System
+from .spectra import extremes, meshing_states, spectrum
 
 __all__ = ["PointResult", "analyse_point", "classification_tolerance"]
 
@@ -38,10 +38,27 @@ class PointResult:
             out["poincare"] = {s: tr.poincare[k].tolist() for k, s in enumerate(tr.system.states)}
         return out
 
+    def to_dict(self, samples: bool = True) -> dict:
+        """Everything of :meth:`describe`, with the time series when ``samples``."""
+        out = self.describe()
+        if samples:
+            out["samples"] = {k: v for k, v in self.trajectory.to_dict().items() if k in ("t", "x")}
+        return out
+
+    def to_table(self) -> tuple[list, list]:
+        """The sampled response, one row per sample (see ``Trajectory.to_table``)."""
+        return self.trajectory.to_table()
+
+    def save(self, path):
+        """Write to ``path``: ``.json``, ``.csv`` or ``.mat`` (see ``solver/export.py``)."""
+        from ..export import save
+
+        return save(self, path)
+
 
 def classification_tolerance(method: str, rtol: float) -> float:
     """How close Poincare points must come to count as the same, relative to the cloud."""
-    if method in ("rk", "rk4", "collocation"):
+    if not get_method(method).adaptive:
         return 1e-3
     return max(1e-6, 1e3 * rtol)
 
@@ -50,7 +67,7 @@ def analyse_point(
     system: System,
     x0=None,
     *,
-    method: str = "RK45",
+    method: str | None = None,
     rtol: float = 1e-8,
     atol: float = 1e-10,
     transient: int = 300,
@@ -60,33 +77,53 @@ def analyse_point(
     steps_per_period: int = 512,
     on_invalid: str = "warn",
 ) -> PointResult:
-    """Simulate, estimate the largest exponent from the end state, classify each mesh."""
+    """Simulate, estimate the largest exponent from the end state, classify each mesh.
+
+    ``method`` defaults to the fastest that meets ``rtol`` (see :func:`simulate`).
+    """
     tr = simulate(
-        system, x0, method=method, rtol=rtol, atol=atol, transient=transient, periods=periods,
-        samples_per_period=samples_per_period, steps_per_period=steps_per_period,
+        system,
+        x0,
+        method=method,
+        rtol=rtol,
+        atol=atol,
+        transient=transient,
+        periods=periods,
+        samples_per_period=samples_per_period,
+        steps_per_period=steps_per_period,
         on_invalid=on_invalid,
-    )  # fmt: skip
+    )
     lyap = None
     if tr.status == "ok" and lyapunov_periods > 0:
-        # The variational equations always go through CVODES (the only back end that
-        # integrates them here), at the run's own tolerances.
+        # The variational equations at the run's own tolerances (compiled DOP853, or
+        # CVODES without a compiler: see lyapunov.py).
         try:
-            lyap = largest_lyapunov(system, tr.x_final, t0=tr.t_final, periods=lyapunov_periods,
-                                    rtol=max(rtol, 1e-13), atol=max(atol, 1e-15))  # fmt: skip
+            lyap = largest_lyapunov(
+                system,
+                tr.x_final,
+                t0=tr.t_final,
+                periods=lyapunov_periods,
+                rtol=max(rtol, 1e-13),
+                atol=max(atol, 1e-15),
+            )
         except (FloatingPointError, RuntimeError):
             lyap = None
-    tol = classification_tolerance(method, rtol)
+    tol = classification_tolerance(tr.method, rtol)
     verdicts = {}
     if tr.status == "invalid":
         why = {"why": tr.message}
-        return PointResult(tr, None, {c: Classification("undetermined", None, why)
-                                      for c in system.coordinates})  # fmt: skip
+        return PointResult(
+            tr, None, {c: Classification("undetermined", None, why) for c in system.coordinates}
+        )
     for c in system.coordinates:
-        i, j = system.index(c), system.index(f"d{c}")
+        i, j = system.index(c), system.velocity_index(c)
         points = tr.poincare[[i, j]]
         verdicts[c] = classify_points(
-            points, tol=tol, lyapunov=lyap, divergent=tr.status == "divergent",
+            points,
+            tol=tol,
+            lyapunov=lyap,
+            divergent=tr.status == "divergent",
             period=system.period,
             spectrum_peaks=spectrum(tr, c).peaks() if tr.status == "ok" else None,
-        )  # fmt: skip
+        )
     return PointResult(tr, lyap, verdicts)

@@ -41,6 +41,8 @@ class Classification:
     def describe(self) -> dict:
         return {"motion": self.motion, "period": self.period, "evidence": self.evidence}
 
+    to_dict = describe
+
 
 def periodicity(points: np.ndarray, tol: float) -> int | None:
     """Smallest n <= 32 with every point repeating after n periods, or None.
@@ -121,8 +123,11 @@ def classify_points(
         evidence["lyapunov"] = lyapunov.describe()
         floor = 0.02 / period if period else 2e-3
         margin = max(floor, 3.0 * lyapunov.spread)
-        lam = "positive" if lyapunov.exponent > margin else (
-            "negative" if lyapunov.exponent < -margin else "zero")  # fmt: skip
+        lam = (
+            "positive"
+            if lyapunov.exponent > margin
+            else ("negative" if lyapunov.exponent < -margin else "zero")
+        )
         evidence["lyapunov_sign"] = lam
         evidence["lyapunov_margin"] = margin
     if n is not None:
@@ -133,8 +138,9 @@ def classify_points(
     clusters = distinct_points(points, tol * scale)
     if clusters <= points.shape[1] // 2:
         evidence["distinct_points"] = clusters
-        evidence["why"] = (f"a finite set of {clusters} points: a period above {MAX_PERIOD}, or "
-                           "not settled")  # fmt: skip
+        evidence["why"] = (
+            f"a finite set of {clusters} points: a period above {MAX_PERIOD}, or not settled"
+        )
         return Classification("undetermined", None, evidence)
     # A torus section is a closed curve, dimension 1; the window is narrow because strange
     # attractors can sit close to it (Henon's map: 1.21).

@@ -7,8 +7,9 @@
  * a rejection, and the same initial-step selection.  Steps are clipped to land on every
  * sample time; after a clipped step the unclipped proposal is kept.
  *
- * The model (gs_prep, gs_rhs, GS_NX, GS_NP, GS_NQ) and the Butcher tables (taken from
- * SciPy's coefficient arrays) are inserted above this text by solver/native.py.
+ * The model (gs_prep, gs_rhs, GS_NX, GS_NP, GS_NQ) and the Butcher tables (the checked
+ * tableaux of ../tableau.py, SciPy's coefficient arrays) are inserted above this text by
+ * build.py.
  */
 
 #include <math.h>

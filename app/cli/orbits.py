@@ -1,0 +1,211 @@
+"""Commands on periodic orbits: ``shoot`` and ``continue``."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ._common import Fail, orbit_guess, parse_set, system_of, write_json
+
+__all__ = ["register"]
+
+
+def register(sub) -> None:
+    sh = sub.add_parser(
+        "shoot",
+        help="find a periodic orbit by shooting; Floquet multipliers",
+        description="Find the period-n orbit (period n T) by Newton shooting "
+        "from a simulated guess, with its Floquet multipliers, stability and "
+        "Liouville check.",
+    )
+    sh.add_argument("scene", metavar="SCENE")
+    sh.add_argument("--set", action="append", metavar="KEY=VALUE")
+    sh.add_argument("--period", type=int, default=1, help="n: the orbit's period is n T")
+    sh.add_argument("--segments", type=int, default=1, help="multiple shooting segments")
+    sh.add_argument(
+        "--monodromy",
+        choices=("ad", "variational", "fd"),
+        default=None,
+        help="monodromy route (default: ad; variational with located crossings for a dead zone)",
+    )
+    sh.add_argument(
+        "--compare-monodromy",
+        action="store_true",
+        help="also compute the monodromy the other two ways and compare",
+    )
+    sh.add_argument("--settle", type=int, default=300, help="periods simulated for the guess")
+    sh.add_argument("--json", action="store_true")
+    sh.add_argument("--out", metavar="DIR", help="also write orbit.json and multipliers.png")
+    sh.set_defaults(func=_cmd_shoot)
+
+    co = sub.add_parser(
+        "continue",
+        help="continue a periodic orbit in a parameter",
+        description="Pseudo-arclength continuation of the period-n orbit, "
+        "with fold, period-doubling and Neimark-Sacker points located.",
+    )
+    co.add_argument("scene", metavar="SCENE")
+    co.add_argument("--param", required=True)
+    co.add_argument("--from", dest="from_", type=float, required=True)
+    co.add_argument("--to", type=float, required=True)
+    co.add_argument("--period", type=int, default=1)
+    co.add_argument("--step", type=float, default=0.02, help="initial arclength step")
+    co.add_argument(
+        "--switch",
+        action="store_true",
+        help="switch onto the period-2n branch at each period doubling",
+    )
+    co.add_argument("--settle", type=int, default=300)
+    co.add_argument("--set", action="append", metavar="KEY=VALUE")
+    co.add_argument("--out", metavar="DIR")
+    co.set_defaults(func=_cmd_continue)
+
+
+def _cmd_shoot(args) -> int:
+    from gearsym.solver._json import dumps
+    from gearsym.solver.periodic import ShootingError, shoot
+
+    if args.period < 1 or args.segments < 1:
+        raise Fail("--period and --segments must be whole numbers >= 1")
+    system = system_of(args.scene, parse_set(args.set))
+    guess = orbit_guess(system, args.period, args.settle)
+    try:
+        orbit = shoot(system, guess, args.period, segments=args.segments, monodromy=args.monodromy)
+    except ShootingError as err:
+        raise Fail(f"shoot: {err}; residuals {[f'{r:.2g}' for r in err.history]}") from None
+    data = orbit.describe()
+    if args.out:
+        from gearsym.solver import plots
+
+        out = write_json(args.out, "orbit.json", data)
+        plots.multipliers_figure(
+            orbit.floquet.multipliers,
+            out / "multipliers.png",
+            title=f"{system.name}: period-{orbit.n} orbit",
+        )
+    if args.compare_monodromy:
+        from gearsym.solver.periodic import FlowMap, monodromy_agreement
+
+        data["monodromy_agreement"] = monodromy_agreement(FlowMap(system), orbit.x0, orbit.period)
+    if args.json:
+        print(dumps(data, indent=1))
+        return 0
+    fl = orbit.floquet
+    print(
+        f"{system.name}: period-{orbit.n} orbit, residual {orbit.residual:.2e} after "
+        f"{orbit.iterations} Newton iteration(s) ({args.monodromy or 'default'} monodromy, "
+        f"{args.segments} segment(s))"
+    )
+    print("  x0: " + ", ".join(f"{k} = {v:.10g}" for k, v in data["x0"].items()))
+    print(
+        "  multipliers: "
+        + ", ".join(f"{m.real:+.6f}{m.imag:+.6f}i (|{abs(m):.6f}|)" for m in fl.multipliers)
+    )
+    losing = {
+        "fold": "+1 (fold)",
+        "period-doubling": "-1 (period doubling)",
+        "neimark-sacker": "a complex pair (Neimark-Sacker)",
+    }[fl.kind]
+    print(
+        f"  {'stable' if fl.stable else 'unstable'}; the largest multiplier is on the side of "
+        f"{losing}; Liouville error |log det M - ∫ tr J| = {fl.liouville_error:.2e}"
+    )
+    for k, v in data.get("monodromy_agreement", {}).items():
+        print(f"  monodromy {k}: {v:.2e} (max difference / max entry)")
+    return 0
+
+
+def _cmd_continue(args) -> int:
+    from gearsym.solver import plots
+    from gearsym.solver._json import dumps
+    from gearsym.solver.periodic import (
+        ShootingError,
+        StroboscopicMap,
+        continue_orbit,
+        switch_period_doubling,
+    )
+
+    for name in ("from_", "to"):
+        if not math.isfinite(getattr(args, name)):
+            raise Fail(f"--{name.rstrip('_')} must be a finite number")
+    if not (args.step > 0 and math.isfinite(args.step)):
+        raise Fail(f"--step must be a positive number, got {args.step}")
+    if args.period < 1:
+        raise Fail(f"--period must be >= 1, got {args.period}")
+    system = system_of(args.scene, parse_set(args.set))
+    try:
+        start = system.with_values(**{args.param: args.from_})
+    except KeyError as err:
+        raise Fail(f"--param: {err.args[0]}") from None
+    except ValueError as err:
+        raise Fail(f"--from: {err}") from None
+    guess = orbit_guess(start, args.period, args.settle)
+    try:
+        branches = [
+            continue_orbit(
+                system,
+                args.param,
+                args.from_,
+                args.to,
+                guess,
+                n=args.period,
+                ds=args.step,
+                ds_max=4 * args.step,
+            )
+        ]
+    except ShootingError as err:
+        raise Fail(f"continue: the first orbit was not found: {err}") from None
+    except ValueError as err:
+        raise Fail(f"continue: {err}") from None
+    if args.switch:
+        for bif in list(branches[0].bifurcations):
+            if bif.kind == "period-doubling":
+                try:
+                    branches.append(
+                        switch_period_doubling(
+                            system,
+                            args.param,
+                            bif,
+                            args.period,
+                            args.to,
+                            ds=args.step,
+                            ds_max=4 * args.step,
+                        )
+                    )
+                except ShootingError as err:
+                    print(f"  branch switching at {bif.value:.6g} failed: {err}")
+    out = Path(args.out or f"continue_{system.name}_{args.param}")
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "branches.json").write_text(
+        dumps([b.describe() for b in branches], indent=1), encoding="utf-8"
+    )
+    state = system.coordinates[0]
+    plots.branch_figure(
+        branches,
+        out / "branches.png",
+        0,
+        state,
+        title=f"{system.name}: continuation in {args.param}",
+    )
+    for k, br in enumerate(branches):
+        smap = StroboscopicMap(system, br.n)
+        for b in br.bifurcations:
+            lam = b.value
+            _, M, _ = smap.jacobian(b.x0, system.parameters_with(**{args.param: lam}))
+            plots.multipliers_figure(
+                np.linalg.eigvals(M),
+                out / f"multipliers_{k}_{b.kind}_{lam:.6g}.png",
+                title=f"{b.kind} at {args.param} = {lam:.6g}",
+            )
+    for br in branches:
+        stable = sum(br.stable)
+        print(f"period-{br.n} branch: {len(br.values)} points, {stable} stable; {br.message}")
+        for b in br.bifurcations:
+            print(
+                f"  {b.kind:<16} {args.param} = {b.value:.8g}  multiplier "
+                f"{b.multiplier.real:+.6f}{b.multiplier.imag:+.6f}i"
+            )
+    print(f"wrote {out / 'branches.json'} and {out / 'branches.png'}")
+    return 0

@@ -1,0 +1,165 @@
+"""Commands on operating points: ``simulate`` and ``sweep``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ._common import (
+    Fail,
+    analysis_options,
+    analysis_settings,
+    parse_range,
+    parse_set,
+    system_of,
+    write_json,
+)
+
+__all__ = ["register"]
+
+
+def register(sub) -> None:
+    si = sub.add_parser(
+        "simulate",
+        help="simulate one operating point and classify it",
+        description="Simulate a scene, discard the transient, and report the "
+        "Poincaré points, motion type with its evidence, ranges, spectral "
+        "peaks and meshing-state shares of every mesh.",
+    )
+    si.add_argument("scene", metavar="SCENE", help="a scene path or built-in name")
+    analysis_options(si)
+    si.add_argument("--json", action="store_true", help="print everything as JSON")
+    si.add_argument("--out", metavar="DIR", help="also write point.json and point.png")
+    si.set_defaults(func=_cmd_simulate)
+
+    sw = sub.add_parser(
+        "sweep",
+        help="bifurcation diagram over one parameter",
+        description="Sweep one scene or model parameter with continuation "
+        "of the final state (forward, or --backward), or --independent points "
+        "run in parallel.",
+    )
+    sw.add_argument("scene", metavar="SCENE")
+    sw.add_argument("--param", required=True, help="parameter to sweep, e.g. lambda")
+    sw.add_argument(
+        "--range",
+        required=True,
+        metavar="START:STOP:NUM",
+        help="NUM values from START to STOP; write --range=-1:1:21 when START is negative",
+    )
+    sw.add_argument("--backward", action="store_true", help="continue from STOP to START")
+    sw.add_argument(
+        "--independent",
+        action="store_true",
+        help="no continuation: every point from the same initial state",
+    )
+    sw.add_argument(
+        "--executor",
+        choices=("serial", "processes", "dask"),
+        default="processes",
+        help="serial, local processes (default, all cores) or dask.distributed "
+        "(needs gearsym[dask]; a LocalCluster unless --scheduler)",
+    )
+    sw.add_argument(
+        "--scheduler", metavar="ADDRESS", help="dask scheduler address, e.g. tcp://head:8786"
+    )
+    sw.add_argument("--out", metavar="DIR")
+    sw.add_argument("--quiet", action="store_true", help="no progress bar")
+    analysis_options(sw)
+    sw.set_defaults(func=_cmd_sweep)
+
+
+def _cmd_simulate(args) -> int:
+    from gearsym.solver._json import dumps
+    from gearsym.solver.analysis import analyse_point
+    from gearsym.solver.integrate import SimulationError
+
+    system = system_of(args.scene, parse_set(args.set))
+    try:
+        result = analyse_point(system, **analysis_settings(args))
+    except (SimulationError, ValueError) as err:
+        raise Fail(f"simulate: {err}") from None
+    data = result.describe()
+    if args.out:
+        from gearsym.solver import plots
+
+        out = write_json(args.out, "point.json", data)
+        plots.point_figure(result.trajectory, out / "point.png", title=system.name)
+    if args.json:
+        print(dumps(data, indent=1))
+        return 0
+    tr = result.trajectory
+    print(
+        f"{system.name}: {tr.method}, rtol {tr.rtol:g}, {tr.transient} + {tr.periods} periods, "
+        f"{tr.wall_time:.2f} s, status {tr.status}"
+    )
+    if result.lyapunov is not None:
+        print(f"  largest Lyapunov exponent {result.lyapunov.exponent:.5f} per unit tau")
+    if tr.status != "ok":
+        print(f"  {tr.message}")
+
+    def num(v, fmt=".4f"):
+        return "n/a" if v is None else format(v, fmt)
+
+    for c, k in result.classification.items():
+        e = data["extremes"][c]
+        peaks = ", ".join(f"{p['frequency']:.3g}" for p in data["spectra"][c]["peaks"][:4])
+        shares = data["meshing_states"][c]
+        print(
+            f"  {c}: {k.motion:<15} range [{num(e['min'])}, {num(e['max'])}]  peaks at "
+            f"{peaks or 'n/a'}  forward/separated/backward {num(shares['forward'], '.2f')}/"
+            f"{num(shares['separated'], '.2f')}/{num(shares['backward'], '.2f')}"
+        )
+    if tr.left_valid_range is not None:
+        t, c, v = tr.left_valid_range
+        print(
+            f"  warning: {c} = {v:.3g} at tau = {t:.6g} is outside the backlash model's "
+            f"valid range |{c}| <= {system.contract.valid_range[c]:g}"
+        )
+    return 0
+
+
+def _cmd_sweep(args) -> int:
+    from gearsym.solver import plots
+    from gearsym.solver.integrate import SimulationError
+    from gearsym.solver.sweep import Progress, sweep
+    from gearsym.studies.report import runs_text
+
+    values = parse_range(args.range)
+    system = system_of(args.scene, parse_set(args.set))
+    out = Path(args.out or f"sweep_{system.name}_{args.param}")
+    bar = Progress(len(values), f"{args.param}", enabled=not args.quiet)
+    stored = len(list((out / "store" / "points").glob("[0-9]*.json")))
+    try:
+        result = sweep(
+            system,
+            args.param,
+            values,
+            continuation=not args.independent,
+            backward=args.backward,
+            executor=args.executor,
+            progress=bar,
+            scheduler=args.scheduler,
+            store=out / "store",
+            **analysis_settings(args),
+        )
+    except (SimulationError, ValueError) as err:
+        raise Fail(f"sweep: {err}") from None
+    failed = [p.value for p in result.points if not p.ok]
+    if stored:
+        print(f"resumed: {stored} of {len(values)} points came from {out / 'store'}")
+    path = result.save(out / "sweep.json")
+    fig = plots.bifurcation_diagram(
+        [result],
+        list(system.coordinates),
+        out / "bifurcation.png",
+        title=f"{system.name}: {args.param} sweep",
+    )
+    print(f"wrote {path} and {fig}")
+    for c in system.coordinates:
+        print(f"  {c}: {runs_text(values, result.motion(c))}")
+    if failed:
+        print(
+            f"  {len(failed)} point(s) did not finish normally (status in sweep.json): "
+            + ", ".join(f"{v:g}" for v in failed[:10])
+        )
+    return 0

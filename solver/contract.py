@@ -1,0 +1,172 @@
+"""What the solver knows about a model: the generated module's ``CONTRACT``, checked.
+
+A generated module states as data everything the solver needs (``derive/model.py`` builds
+it, ``derive/emit.py`` prints it): the state and parameter order, where each coordinate's
+velocity is, which parameter sets the excitation period, which parameters are static
+loads, the contact edges of each mesh coordinate, the switching surfaces (kinks) of a
+piecewise force law and the range where the force law is valid.  The solver reads only
+this; it never parses generated source or guesses from names.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+
+__all__ = ["CONTRACT_FORMAT", "Contract", "load_generated"]
+
+CONTRACT_FORMAT = 1
+_REQUIRED = ("NAME", "CONTRACT", "parameters", "rhs", "jacobian", "casadi_functions")
+
+
+@dataclass(frozen=True)
+class Contract:
+    """A model's contract (see the module docstring); immutable.
+
+    Attributes
+    ----------
+    states, coordinates, parameters : tuple of str
+        State order, mesh coordinates (a subset of the states), parameter order.
+    velocities : dict
+        coordinate -> index of its time derivative in the state vector.
+    forcing_frequency : str
+        The parameter omega whose value gives the excitation period 2 pi / omega.
+    loads : dict
+        coordinate -> name of its static-load parameter (coordinates without one absent).
+    contact : dict
+        coordinate -> (lower, upper) edges of the backlash, in coordinate units.
+    piecewise : bool
+        The right-hand side has kinks (``switching_surfaces``) that integrators locate.
+    switching_surfaces : tuple of (int, float)
+        ``(i, c)``: the kink ``x[i] = c``.
+    valid_range : dict or None
+        coordinate -> bound ``a``: the force law holds for ``|x| <= a`` only.
+    """
+
+    states: tuple[str, ...]
+    coordinates: tuple[str, ...]
+    parameters: tuple[str, ...]
+    velocities: dict
+    forcing_frequency: str
+    loads: dict
+    contact: dict
+    piecewise: bool
+    switching_surfaces: tuple
+    valid_range: dict | None
+
+    @classmethod
+    def of(cls, module: ModuleType) -> Contract:
+        """The checked contract of a generated module (``ValueError`` names what is wrong)."""
+        data = dict(module.CONTRACT)
+        name = getattr(module, "NAME", module.__name__)
+        if data.get("format") != CONTRACT_FORMAT:
+            raise ValueError(
+                f"model '{name}' states contract format {data.get('format')!r}, this solver "
+                f"reads format {CONTRACT_FORMAT}; regenerate it with `gearsym derive`"
+            )
+        fields = (
+            "states",
+            "coordinates",
+            "parameters",
+            "velocities",
+            "forcing_frequency",
+            "loads",
+            "contact",
+            "piecewise",
+            "switching_surfaces",
+            "valid_range",
+        )
+        missing = [k for k in fields if k not in data]
+        if missing:
+            raise ValueError(f"model '{name}': CONTRACT lacks {', '.join(missing)}")
+        c = cls(
+            states=tuple(data["states"]),
+            coordinates=tuple(data["coordinates"]),
+            parameters=tuple(data["parameters"]),
+            velocities=dict(data["velocities"]),
+            forcing_frequency=str(data["forcing_frequency"]),
+            loads=dict(data["loads"]),
+            contact={k: (float(a), float(b)) for k, (a, b) in dict(data["contact"]).items()},
+            piecewise=bool(data["piecewise"]),
+            switching_surfaces=tuple((int(i), float(v)) for i, v in data["switching_surfaces"]),
+            valid_range=None
+            if data["valid_range"] is None
+            else {k: float(v) for k, v in dict(data["valid_range"]).items()},
+        )
+        c._check(name)
+        return c
+
+    def _check(self, name: str) -> None:
+        problems = []
+        n = len(self.states)
+        if not set(self.coordinates) <= set(self.states):
+            problems.append("coordinates that are not states")
+        if set(self.velocities) != set(self.coordinates):
+            problems.append("velocities not given for exactly the coordinates")
+        if any(not 0 <= i < n for i in self.velocities.values()):
+            problems.append("a velocity index outside the state")
+        if self.forcing_frequency not in self.parameters:
+            problems.append(f"forcing frequency '{self.forcing_frequency}' is not a parameter")
+        if any(p not in self.parameters for p in self.loads.values()):
+            problems.append("a load that is not a parameter")
+        if any(not 0 <= i < n for i, _ in self.switching_surfaces):
+            problems.append("a switching surface outside the state")
+        if self.piecewise != bool(self.switching_surfaces):
+            problems.append("piecewise must go with switching surfaces and smooth with none")
+        if problems:
+            raise ValueError(f"model '{name}': inconsistent CONTRACT ({'; '.join(problems)})")
+
+    # -- questions the solver asks ----------------------------------------------------
+    def index(self, state: str) -> int:
+        try:
+            return self.states.index(state)
+        except ValueError:
+            raise KeyError(f"no state '{state}'; states: {', '.join(self.states)}") from None
+
+    def coordinate_indices(self) -> list[int]:
+        return [self.states.index(c) for c in self.coordinates]
+
+    def velocity(self, coordinate: str) -> int:
+        """Index of the time derivative of ``coordinate``."""
+        return self.velocities[coordinate]
+
+    def velocity_of_state(self, i: int) -> int | None:
+        """Index of the time derivative of state ``i`` when it is a coordinate, else None."""
+        name = self.states[i]
+        return self.velocities.get(name)
+
+    def valid_bounds(self) -> list[tuple[int, float]]:
+        """``(state index, bound)`` for each coordinate with a valid range."""
+        if self.valid_range is None:
+            return []
+        return [(self.states.index(c), a) for c, a in self.valid_range.items()]
+
+
+def load_generated(name_or_path: str | Path) -> ModuleType:
+    """Import ``generated/<name>.py`` by model name, or a generated file by path."""
+    path = Path(name_or_path)
+    if path.suffix == ".py":
+        if not path.exists():
+            raise FileNotFoundError(f"{path}: no such generated model file")
+        spec = importlib.util.spec_from_file_location(f"gearsym_generated_{path.stem}", path)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+    else:
+        try:
+            # Built-in names may be written with hyphens, as the scene files are.
+            name = str(name_or_path).replace("-", "_")
+            module = importlib.import_module(f"gearsym.generated.{name}")
+        except ModuleNotFoundError:
+            raise FileNotFoundError(
+                f"no generated model '{name_or_path}'; run `gearsym derive` on its scene"
+            ) from None
+    missing = [k for k in _REQUIRED if not hasattr(module, k)]
+    if missing:
+        raise ValueError(
+            f"{module.__name__} is not a gearsym model of this version (lacks "
+            f"{', '.join(missing)}); regenerate it with `gearsym derive`"
+        )
+    return module

@@ -1,0 +1,72 @@
+"""Compiled integration: the generated C right-hand side driven by C integrators.
+
+* ``build.py`` -- compile and cache the library of a generated model;
+* ``batch.py`` -- many parameter points in one call (lockstep groups or point by point),
+  the NumPy fallback without a compiler, and the compiled Lyapunov run;
+* ``_native.c`` -- the integrators (DOPRI5, DOP853, RK4, Benettin), whose tableaux come
+  from ``../tableau.py``.
+
+:func:`run` is the ``simulate`` back end of the ``native`` family: one point.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..result import Request, Run
+from . import batch, build
+from .batch import NATIVE_METHODS, STATUS, BatchResult, benettin, run_batch
+from .build import NativeUnavailable, cache_dir, compiler, library, source
+
+__all__ = [
+    "NATIVE_METHODS",
+    "STATUS",
+    "BatchResult",
+    "NativeUnavailable",
+    "benettin",
+    "cache_dir",
+    "compiler",
+    "library",
+    "reset",
+    "run",
+    "run_batch",
+    "source",
+]
+
+
+def reset() -> None:
+    """Forget this session's loaded libraries, failed builds and warnings (after changing
+    ``GEARSYM_CC`` or the cache, say); libraries cached on disk stay."""
+    build._loaded.clear()
+    build._paths.clear()
+    build._failed.clear()
+    batch._warned.clear()
+
+
+def run(system, req: Request) -> Run:
+    """One point through :func:`run_batch`, on its own steps."""
+    res = run_batch(
+        system.module,
+        system.p[None, :],
+        np.asarray(req.x0, float)[None, :],
+        method=req.method,
+        rtol=req.rtol,
+        atol=req.atol,
+        t0=req.t0,
+        transient=req.transient,
+        periods=req.periods,
+        samples_per_period=req.samples_per_period,
+        steps_per_period=req.steps_per_period,
+        bound=req.bound,
+        lockstep=False,
+    )
+    x = res.x[0].T.copy()
+    status = res.status[0]
+    nfev, nsteps = int(res.nfev[0]), int(res.nsteps[0])
+    if status == "ok":
+        return Run(x, "ok", "", nfev, nsteps)
+    t_fail = float(res.t_fail[0])
+    if status == "divergent":
+        message = f"a state passed |x| = {req.bound:g} at tau = {t_fail:.6g}"
+        return Run(x, "divergent", message, nfev, nsteps)
+    return Run(x, "failed", f"{req.method} stopped at tau = {t_fail:.6g}: {status}", nfev, nsteps)

@@ -1,0 +1,201 @@
+"""Build and cache the native library of a generated model.
+
+The generated module carries its right-hand side as C (``C_SOURCE``, printed by
+``derive/emit_c.py`` from the same SymPy expressions as the NumPy and CasADi code, with
+the excitation's harmonics reduced to one ``sincos`` per step stage).  It is compiled with
+the system C compiler (``cc``, or ``$GEARSYM_CC``) together with the integrators of
+``_native.c`` and the checked tableaux of ``../tableau.py`` into a shared library, loaded
+with ``ctypes`` and cached under ``<cache root>/native`` (``solver/cache.py``) keyed by
+the sha256 of its full source, the compiler and the CPU, so that a second run pays no
+compile time.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+import hashlib
+import os
+import platform
+import shutil
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ...cache import cache_root
+from ..tableau import c_tables
+
+__all__ = ["NativeUnavailable", "cache_dir", "compiler", "library", "source"]
+
+_FLAGS = (
+    "-O3",
+    "-march=native",
+    "-fno-math-errno",
+    "-fPIC",
+    "-shared",
+    "-Werror=implicit-function-declaration",
+)
+_loaded: dict[str, ctypes.CDLL] = {}
+_paths: dict[tuple, Path] = {}  # (module file, inputs hash, variational, compiler) -> library
+_failed: dict[str, str] = {}  # cache key -> why it could not be built (once per session)
+
+
+class NativeUnavailable(RuntimeError):
+    """No C compiler, or the compilation failed: the NumPy path is used instead."""
+
+
+def compiler() -> str | None:
+    """The C compiler to use: ``$GEARSYM_CC`` if set (``none`` disables), else cc/gcc/clang."""
+    env = os.environ.get("GEARSYM_CC")
+    if env is not None:
+        if env.strip().lower() in ("", "none", "0"):
+            return None
+        return shutil.which(env) or (env if Path(env).exists() else None)
+    for name in ("cc", "gcc", "clang"):
+        found = shutil.which(name)
+        if found:
+            return found
+    return None
+
+
+def cache_dir() -> Path:
+    """Where compiled libraries are kept: ``native/`` under the cache root."""
+    return cache_root() / "native"
+
+
+def source(module, variational: bool = False) -> str:
+    """Full C text of the library for a generated module (``variational``: the state
+    extended by a tangent vector, with ``gs_benettin``)."""
+    attr = "C_SOURCE_VARIATIONAL" if variational else "C_SOURCE"
+    if not hasattr(module, attr):
+        raise NativeUnavailable(
+            f"generated module '{module.NAME}' has no {attr}; regenerate it with `gearsym derive`"
+        )
+    body = (Path(__file__).with_name("_native.c")).read_text(encoding="utf-8")
+    head = ["#define GS_VARIATIONAL 1"] if variational else []
+    return "\n".join([*head, "#include <math.h>", getattr(module, attr), c_tables(), body])
+
+
+@functools.lru_cache(maxsize=8)
+def _compiler_id(cc: str) -> str:
+    """The compiler's version line and this CPU's identity: the libraries are built with
+    -march=native, so a cache shared between machines (a cluster's home) keeps one per CPU."""
+    try:
+        out = subprocess.run([cc, "--version"], capture_output=True, text=True, timeout=30)
+        version = out.stdout.splitlines()[0] if out.stdout else cc
+    except (OSError, subprocess.SubprocessError):
+        version = cc
+    cpu = platform.machine()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as fh:
+            for line in fh:
+                if line.startswith(("flags", "Features", "model name")):
+                    cpu += "|" + line.strip()
+    except OSError:
+        cpu += "|" + platform.processor()
+    return version + "|" + cpu
+
+
+def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
+    """Compile (or load from the cache) the native library of ``module``.
+
+    Returns the library and facts: ``path``, ``compiled`` (bool: built now), ``seconds``.
+    Raises :class:`NativeUnavailable` without a working compiler.
+    """
+    cc = compiler()
+    if cc is None:
+        raise NativeUnavailable("no C compiler found (install gcc or clang, or set GEARSYM_CC)")
+    memo = (
+        getattr(module, "__file__", module.NAME),
+        getattr(module, "INPUTS_SHA256", ""),
+        variational,
+        cc,
+        str(cache_dir()),
+    )
+    facts = {"compiled": False, "seconds": 0.0, "compiler": cc}
+    path = _paths.get(memo)
+    if path is not None and str(path) in _loaded:
+        facts["path"] = str(path)
+        return _loaded[str(path)], facts
+    text = source(module, variational)
+    key = hashlib.sha256(
+        "\n".join([text, _compiler_id(cc), " ".join(_FLAGS)]).encode()
+    ).hexdigest()[:20]
+    if key in _failed:
+        raise NativeUnavailable(_failed[key])
+    path = cache_dir() / f"{module.NAME}{'-var' if variational else ''}-{key}.so"
+    facts["path"] = str(path)
+    if str(path) in _loaded:
+        _paths[memo] = path
+        return _loaded[str(path)], facts
+    if not path.exists():
+        started = time.perf_counter()
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory(dir=path.parent) as tmp:
+            c_file = Path(tmp) / "model.c"
+            c_file.write_text(text, encoding="utf-8")
+            so = Path(tmp) / "lib.so"
+            try:
+                done = subprocess.run(
+                    [cc, *_FLAGS, "-o", str(so), str(c_file), "-lm"],
+                    capture_output=True,
+                    text=True,
+                    timeout=300,
+                )
+            except (OSError, subprocess.SubprocessError) as err:
+                _failed[key] = f"the C compiler {cc} could not be run: {err}"
+                raise NativeUnavailable(_failed[key]) from None
+            if done.returncode != 0:
+                first = (done.stderr or done.stdout).strip().splitlines()[:3]
+                _failed[key] = f"compiling {module.NAME} failed: {' / '.join(first)}"
+                raise NativeUnavailable(_failed[key])
+            os.replace(so, path)  # atomic: parallel workers never see half a library
+        facts.update(compiled=True, seconds=time.perf_counter() - started)
+    _paths[memo] = path
+    lib = ctypes.CDLL(str(path))
+    d, i, ll = ctypes.c_double, ctypes.c_int, ctypes.c_longlong
+    ptr = np.ctypeslib.ndpointer
+    lib.gs_run.restype = i
+    lib.gs_run.argtypes = [
+        i, i,
+        ptr(np.float64, flags="C"), ptr(np.float64, flags="C"),
+        d, d, i, i, i, d, d, i, d, ll,
+        ptr(np.float64, flags="C"), ptr(np.int64, flags="C"), ptr(np.int64, flags="C"),
+        ptr(np.int32, flags="C"), ptr(np.float64, flags="C"),
+    ]  # fmt: skip
+    lib.gs_run_lockstep.restype = i
+    lib.gs_run_lockstep.argtypes = [
+        i, i, i,
+        ptr(np.float64, flags="C"), ptr(np.float64, flags="C"),
+        d, d, i, i, i, d, d, d, ll,
+        ptr(np.float64, flags="C"), ptr(np.int64, flags="C"), ptr(np.int64, flags="C"),
+        ptr(np.int32, flags="C"), ptr(np.float64, flags="C"),
+    ]  # fmt: skip
+    lib.gs_eval.restype = None
+    lib.gs_eval.argtypes = [
+        d,
+        ptr(np.float64, flags="C"),
+        ptr(np.float64, flags="C"),
+        ptr(np.float64, flags="C"),
+    ]
+    lib.gs_eval_batch.restype = None
+    lib.gs_eval_batch.argtypes = [
+        d,
+        i,
+        ptr(np.float64, flags="C"),
+        ptr(np.float64, flags="C"),
+        ptr(np.float64, flags="C"),
+    ]
+    lib.gs_rhs_loop.restype = d
+    lib.gs_rhs_loop.argtypes = [ptr(np.float64, flags="C"), ptr(np.float64, flags="C"), ll, d]
+    if variational:
+        lib.gs_benettin.restype = i
+        lib.gs_benettin.argtypes = [
+            ptr(np.float64, flags="C"), ptr(np.float64, flags="C"), d, d, i, d, d, d, ll,
+            ptr(np.float64, flags="C"), ptr(np.int64, flags="C"),
+        ]  # fmt: skip
+    _loaded[str(path)] = lib
+    return lib, facts

@@ -1,0 +1,342 @@
+"""One front door for time integration: ``simulate(system, ..., method=...)``.
+
+Methods are records of a validated registry (``methods.py``); each family has one back
+end that takes a :class:`~.result.Request` and returns a :class:`~.result.Run`:
+
+* SciPy ``solve_ivp`` (``scipy_backend.py``): ``RK45`` (the reference study's
+  variable-step Runge-Kutta 4(5)), ``DOP853``, ``LSODA``, ``Radau``, on the generated NumPy
+  right-hand side (and its Jacobian for the implicit ones), stopping at every switching
+  surface of a piecewise model (``events.py``) so that the method's order holds across
+  the kinks;
+* CasADi ``integrator`` (``casadi_backend.py``): ``cvodes``, ``rk`` (fixed-step RK4 with
+  ``steps_per_period`` steps), ``collocation``, on the CasADi graph of the same equations;
+* compiled (``native/``): ``dop853``, ``dopri5`` and ``rk4`` on the generated C
+  right-hand side, the fastest; without a C compiler they fall back to NumPy with a
+  warning.
+
+Without ``method`` the fastest one that meets the tolerance is used (:func:`fastest_method`).
+The run is split into a transient of ``transient`` forcing periods, discarded, and a
+sampled window of ``periods`` periods with ``samples_per_period`` samples each, aligned
+with the forcing so that every ``samples_per_period``-th sample is a stroboscopic
+(Poincare) point.  Every result records the method, the tolerances, the work done, and
+how the run ended.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..system import System
+from .events import SimulationError
+from .methods import METHODS, get_method
+from .result import Request, first_exit
+
+__all__ = [
+    "METHODS",
+    "SimulationError",
+    "Trajectory",
+    "default_initial_state",
+    "fastest_method",
+    "simulate",
+]
+
+
+def fastest_method(rtol: float) -> str:
+    """The fastest back end that meets ``rtol`` on this model class, from the measured
+    speed/accuracy trade (``docs/performance.md``): compiled ``dop853`` (faster and more
+    accurate than compiled ``dopri5`` at every tolerance measured, 1e-3 to 1e-12);
+    ``cvodes``, the fastest uncompiled one, without a C compiler."""
+    from .native import compiler
+
+    del rtol  # one answer over the whole measured range; kept for the call's meaning
+    return "cvodes" if compiler() is None else "dop853"
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """A sampled response.
+
+    Attributes
+    ----------
+    t : ndarray, shape (K,)
+        Sample times (non-dimensional, tau) of the sampled window.
+    x : ndarray, shape (n, K)
+        States at ``t``.
+    samples_per_period : int
+        Samples per forcing period; ``x[:, ::samples_per_period]`` are Poincare points.
+    status : str
+        ``ok``, ``divergent`` (a state passed ``bound``), ``invalid`` (left the force
+        law's valid range with ``on_invalid="error"``) or ``failed``.
+    """
+
+    system: System
+    method: str
+    rtol: float
+    atol: float
+    transient: int
+    periods: int
+    samples_per_period: int
+    t: np.ndarray
+    x: np.ndarray
+    x_final: np.ndarray
+    t_final: float
+    status: str
+    message: str
+    nfev: int
+    nsteps: int
+    wall_time: float
+    boundary_crossings: int | None = None  # located crossings (SciPy back ends only)
+    left_valid_range: tuple | None = None  # (tau, state, value) of the first exit
+    options: dict = field(default_factory=dict)
+
+    @property
+    def period(self) -> float:
+        return self.system.period
+
+    @property
+    def poincare(self) -> np.ndarray:
+        """Stroboscopic points at the start of each sampled period, shape (n, periods)."""
+        return self.x[:, : self.periods * self.samples_per_period : self.samples_per_period]
+
+    def coordinate(self, name: str) -> np.ndarray:
+        return self.x[self.system.index(name)]
+
+    def velocity(self, coordinate: str) -> np.ndarray:
+        """The time derivative of mesh coordinate ``coordinate``."""
+        return self.x[self.system.velocity_index(coordinate)]
+
+    def describe(self) -> dict:
+        return {
+            "method": self.method,
+            "rtol": self.rtol,
+            "atol": self.atol,
+            "transient_periods": self.transient,
+            "sampled_periods": self.periods,
+            "samples_per_period": self.samples_per_period,
+            "status": self.status,
+            "message": self.message,
+            "nfev": self.nfev,
+            "nsteps": self.nsteps,
+            "wall_time_s": self.wall_time,
+            "boundary_crossings": self.boundary_crossings,
+            "left_valid_range": None
+            if self.left_valid_range is None
+            else dict(zip(("tau", "state", "value"), self.left_valid_range, strict=True)),
+            "options": self.options,
+        }
+
+    def to_dict(self, samples: bool = True) -> dict:
+        """The run's settings and outcome, with the samples (``t`` and each state)."""
+        out = {"system": self.system.describe(), "integration": self.describe()}
+        if samples:
+            out["t"] = self.t.tolist()
+            out["x"] = {s: self.x[k].tolist() for k, s in enumerate(self.system.states)}
+        return out
+
+    def to_table(self) -> tuple[list, list]:
+        """One row per sample: tau and every state."""
+        return ["tau", *self.system.states], np.vstack([self.t, self.x]).T.tolist()
+
+    def save(self, path):
+        """Write to ``path``: ``.json``, ``.csv`` or ``.mat`` (see ``solver/export.py``)."""
+        from ..export import save
+
+        return save(self, path)
+
+
+def _check(
+    system: System,
+    method,
+    rtol,
+    atol,
+    transient,
+    periods,
+    samples_per_period,
+    steps_per_period,
+    on_invalid,
+) -> None:
+    record = get_method(method)
+    if on_invalid not in ("warn", "error"):
+        raise ValueError(f"on_invalid must be 'warn' or 'error', got {on_invalid!r}")
+    for name, value in (("transient", transient), ("periods", periods)):
+        if not (isinstance(value, int) and value >= 0):
+            raise ValueError(f"{name} must be a whole number >= 0, got {value!r}")
+    if periods < 1 or samples_per_period < 1:
+        raise ValueError("periods and samples_per_period must be >= 1")
+    if not (isinstance(samples_per_period, int) and isinstance(steps_per_period, int)):
+        raise ValueError("samples_per_period and steps_per_period must be whole numbers")
+    unit = record.step_unit
+    if unit and (
+        steps_per_period < unit * samples_per_period
+        or steps_per_period % (unit * samples_per_period)
+    ):
+        raise ValueError(
+            f"steps_per_period ({steps_per_period}) must be a multiple of "
+            f"{f'{unit} x ' if unit > 1 else ''}samples_per_period ({samples_per_period}) "
+            f"for '{method}', so that every sample interval holds whole steps"
+        )
+    if not math.isfinite(system.omega) or system.omega <= 0:
+        raise ValueError(f"omega must be a positive number, got {system.omega:g}")
+    if record.family != "casadi" and rtol < 100 * np.finfo(float).eps:
+        raise ValueError(
+            f"rtol {rtol:g} is below what SciPy honours (2.2e-14); use cvodes or a larger rtol"
+        )
+    if not (rtol > 0 and atol > 0):
+        raise ValueError(f"tolerances must be > 0, got rtol={rtol}, atol={atol}")
+
+
+def simulate(
+    system: System,
+    x0=None,
+    *,
+    method: str | None = None,
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    transient: int = 300,
+    periods: int = 100,
+    samples_per_period: int = 64,
+    t0: float = 0.0,
+    steps_per_period: int = 512,
+    max_step: float | None = None,
+    bound: float = 1e3,
+    on_invalid: str = "warn",
+) -> Trajectory:
+    """Integrate ``system`` from ``x0`` and sample the response after a transient.
+
+    Parameters
+    ----------
+    system : System
+        The model and its parameter values.
+    x0 : array_like, shape (n,), optional
+        Initial state; default :func:`default_initial_state`.
+    method : str, optional
+        One of :data:`METHODS`; default the fastest that meets ``rtol``.
+    rtol, atol : float
+        Tolerances of the adaptive methods (fixed-step ones use ``steps_per_period``).
+    transient, periods : int
+        Forcing periods discarded, then sampled.
+    samples_per_period : int
+        Samples per period in the window (a power of two suits the FFT).
+    bound : float
+        A state beyond this magnitude ends the run as ``divergent``.
+    on_invalid : {"warn", "error"}
+        What to do when a mesh coordinate leaves the force law's valid range (a
+        polynomial fit, say): ``warn`` records the first exit (time, coordinate, value)
+        and goes on; ``error`` stops there with status ``invalid`` (samples after the exit
+        are not computed).
+    """
+    if method is None:
+        method = fastest_method(rtol)
+    _check(
+        system,
+        method,
+        rtol,
+        atol,
+        transient,
+        periods,
+        samples_per_period,
+        steps_per_period,
+        on_invalid,
+    )
+    x0 = default_initial_state(system) if x0 is None else np.asarray(x0, dtype=float)
+    if x0.shape != (system.n,) or not np.all(np.isfinite(x0)):
+        raise ValueError(f"x0 must be {system.n} finite numbers ({', '.join(system.states)})")
+    T = system.period
+    t_start = t0 + transient * T
+    grid = t_start + T * np.arange(periods * samples_per_period + 1) / samples_per_period
+    req = Request(
+        x0,
+        t0,
+        grid,
+        method,
+        rtol,
+        atol,
+        transient,
+        periods,
+        samples_per_period,
+        steps_per_period,
+        max_step,
+        bound,
+        on_invalid,
+    )
+    started = time.perf_counter()
+    run = _backend(get_method(method).family)(system, req)
+    x, status, message = run.x, run.status, run.message
+    exit_ = run.left_valid_range
+    if exit_ is None:
+        exit_ = first_exit(system, grid, x)
+    if exit_ is not None and on_invalid == "error" and status == "ok":
+        t_x, c_x, v_x = exit_
+        x[:, grid > t_x] = np.nan
+        status = "invalid"
+        bound_c = system.contract.valid_range[c_x]
+        message = (
+            f"{c_x} = {v_x:.6g} at tau = {t_x:.6g} is outside the backlash model's "
+            f"valid range |{c_x}| <= {bound_c:g}"
+        )
+    x_final = x[:, -1].copy()
+    # Keep the window without its closing sample: exactly `periods` whole periods.
+    t_out, x_out = grid[:-1], x[:, :-1]
+    if status != "invalid":
+        status, message = _check_bound(t_out, x_out, status, message, bound)
+    fixed = not get_method(method).adaptive
+    return Trajectory(
+        system=system,
+        method=method,
+        rtol=rtol,
+        atol=atol,
+        transient=transient,
+        periods=periods,
+        samples_per_period=samples_per_period,
+        t=t_out,
+        x=x_out,
+        x_final=x_final,
+        t_final=float(grid[-1]),
+        status=status,
+        message=message,
+        nfev=run.nfev,
+        nsteps=run.nsteps,
+        wall_time=time.perf_counter() - started,
+        boundary_crossings=run.crossings,
+        left_valid_range=exit_,
+        options={"steps_per_period": steps_per_period} if fixed else {},
+    )
+
+
+def _backend(family: str):
+    if family == "scipy":
+        from .scipy_backend import run
+    elif family == "casadi":
+        from .casadi_backend import run
+    else:
+        from .native import run
+    return run
+
+
+def default_initial_state(system: System) -> np.ndarray:
+    """Each coordinate pressed into contact by its static load (past the contact edge on
+    the load's side by the load, ``u = 1 + f`` for a forward load), at rest: close to the
+    loaded equilibrium for a force law near the dead zone."""
+    c = system.contract
+    x0 = np.zeros(system.n)
+    for coord, load in c.loads.items():
+        f = system.parameter(load)
+        if f == 0:
+            continue
+        lower, upper = c.contact.get(coord, (0.0, 0.0))
+        x0[c.index(coord)] = (upper if f > 0 else lower) + f
+    return x0
+
+
+def _check_bound(t, x, status, message, bound):
+    if status != "ok":
+        return status, message
+    bad = ~np.all(np.isfinite(x) & (np.abs(x) <= bound), axis=0)
+    if np.any(bad):
+        k = int(np.argmax(bad))
+        return "divergent", f"a state passed |x| = {bound:g} by tau = {t[k]:.6g}"
+    return status, message

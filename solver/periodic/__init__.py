@@ -1,0 +1,39 @@
+"""Periodic orbits, split along the mathematics.
+
+* ``flow.py`` -- the flow map and its derivative (AD, variational, finite differences),
+  and the stroboscopic map as an object of its own;
+* ``shooting.py`` -- single and multiple shooting as a pure residual ``G(X, T, p)``;
+* ``newton.py`` -- the one (damped) Newton solver;
+* ``floquet.py`` -- multipliers, stability, Liouville's check, bifurcation test functions;
+* ``continuation.py`` -- pseudo-arclength continuation with folds, period doublings and
+  Neimark-Sacker points located;
+* ``switching.py`` -- branch switching at a period doubling.
+"""
+
+from .continuation import Bifurcation, Branch, continue_orbit
+from .floquet import Floquet, bifurcation_tests, floquet
+from .flow import MONODROMY_METHODS, FlowMap, StroboscopicMap, monodromy_agreement
+from .newton import NewtonError, NewtonResult, newton
+from .shooting import Orbit, ShootingError, residual, shoot
+from .switching import switch_period_doubling
+
+__all__ = [
+    "MONODROMY_METHODS",
+    "Bifurcation",
+    "Branch",
+    "Floquet",
+    "FlowMap",
+    "NewtonError",
+    "NewtonResult",
+    "Orbit",
+    "ShootingError",
+    "StroboscopicMap",
+    "bifurcation_tests",
+    "continue_orbit",
+    "floquet",
+    "monodromy_agreement",
+    "newton",
+    "residual",
+    "shoot",
+    "switch_period_doubling",
+]

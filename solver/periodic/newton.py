@@ -1,0 +1,97 @@
+"""One Newton solver for every periodic-orbit problem (shooting and the continuation
+corrector): ``F(z) = 0`` with the Jacobian from the caller, optionally damped by
+backtracking on the residual's max-norm."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["NewtonError", "NewtonResult", "newton"]
+
+
+class NewtonError(RuntimeError):
+    """Newton's method did not converge; ``history`` holds the residual norms reached."""
+
+    def __init__(self, message: str, history: list):
+        super().__init__(message)
+        self.history = history
+
+
+@dataclass(frozen=True)
+class NewtonResult:
+    """The solution, its residual norm, the steps taken, the residual history, and what
+    the last evaluation returned besides residual and Jacobian (``extra``)."""
+
+    z: np.ndarray
+    residual: float
+    steps: int
+    history: list = field(default_factory=list)
+    extra: object = None
+
+
+def newton(
+    fun: Callable,
+    z0,
+    *,
+    tol: float,
+    max_iter: int,
+    damped: bool = True,
+    min_steps: int = 0,
+    singular: str = "singular Jacobian",
+) -> NewtonResult:
+    """Solve ``F(z) = 0`` from ``z0``.
+
+    Parameters
+    ----------
+    fun : callable
+        ``fun(z) -> (F, dF/dz, extra)``.
+    tol : float
+        Converged when ``max |F| <= tol`` (and at least ``min_steps`` steps were taken).
+    max_iter : int
+        Steps allowed.
+    damped : bool
+        Halve the step until the residual's max-norm decreases (down to 1/10^4).
+    singular : str
+        What a singular Jacobian means, for the error message.
+
+    Raises
+    ------
+    NewtonError
+        No convergence, a non-finite residual, a singular Jacobian or (damped) no
+        decrease along the Newton direction.
+    """
+    z = np.asarray(z0, dtype=float).copy()
+    F, J, extra = fun(z)
+    norm = float(np.max(np.abs(F)))
+    history = [norm]
+    steps = 0
+    while not (norm <= tol and steps >= min_steps):
+        if steps >= max_iter or not np.isfinite(norm):
+            raise NewtonError(
+                f"Newton did not converge in {steps} iterations (residual {norm:.3g})", history
+            )
+        try:
+            step = np.linalg.solve(J, -F)
+        except np.linalg.LinAlgError:
+            raise NewtonError(singular, history) from None
+        lam = 1.0
+        while True:
+            trial = z + lam * step
+            Ft, Jt, et = fun(trial)
+            nt = float(np.max(np.abs(Ft)))
+            if not damped or nt < norm:
+                break
+            lam /= 2
+            if lam < 1e-4:
+                raise NewtonError(
+                    f"Newton's line search found no decrease of the residual "
+                    f"({norm:.3g}) after {steps} iterations",
+                    history,
+                )
+        z, F, J, extra, norm = trial, Ft, Jt, et, nt
+        steps += 1
+        history.append(norm)
+    return NewtonResult(z, norm, steps, history, extra)

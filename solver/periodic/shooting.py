@@ -1,0 +1,168 @@
+"""Periodic orbits of the forced system by shooting.
+
+A period-n orbit (period nT, T = 2 pi / omega) through ``x0`` at time ``t0`` solves
+
+    single shooting:    ``G(x0) = phi_{nT}(x0; t0) - x0 = 0``,
+    multiple shooting:  ``x_{k+1} - phi_{nT/m}(x_k; t0 + k nT/m) = 0``, k = 0..m-1
+                        (x_m = x_0),
+
+by the damped Newton method of ``newton.py`` with the flow's Jacobian.  The residual is a
+pure function :func:`residual` of the segment states, the period and the parameter
+vector; the monodromy matrix (the product of the segment Jacobians) gives the Floquet
+multipliers (``floquet.py``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..system import System
+from .floquet import Floquet, floquet
+from .flow import FlowMap
+from .newton import NewtonError, newton
+
+__all__ = ["Floquet", "Orbit", "ShootingError", "floquet", "residual", "shoot"]
+
+ShootingError = NewtonError  # what shooting raises: the history says how far it got
+
+
+@dataclass(frozen=True)
+class Orbit:
+    """A periodic orbit: initial state at ``t0``, period n T, and its stability."""
+
+    system: System
+    x0: np.ndarray
+    t0: float
+    n: int
+    residual: float
+    iterations: int
+    history: list = field(default_factory=list)
+    monodromy: np.ndarray | None = None
+    floquet: Floquet | None = None
+    segments: int = 1
+
+    @property
+    def period(self) -> float:
+        return self.n * self.system.period
+
+    def describe(self) -> dict:
+        return {
+            "period_multiple": self.n,
+            "period_tau": self.period,
+            "t0": self.t0,
+            "x0": dict(zip(self.system.states, map(float, self.x0), strict=True)),
+            "residual": self.residual,
+            "newton_iterations": self.iterations,
+            "history": self.history,
+            "segments": self.segments,
+            "floquet": None if self.floquet is None else self.floquet.describe(),
+            "values": {k: float(v) for k, v in self.system.values.items()},
+        }
+
+    to_dict = describe
+
+    def to_table(self) -> tuple[list, list]:
+        """One row per Floquet multiplier: real and imaginary parts, modulus."""
+        mu = [] if self.floquet is None else self.floquet.multipliers
+        return ["re", "im", "abs"], [[float(m.real), float(m.imag), float(abs(m))] for m in mu]
+
+    def save(self, path):
+        """Write to ``path``: ``.json``, ``.csv`` or ``.mat`` (see ``solver/export.py``)."""
+        from ..export import save
+
+        return save(self, path)
+
+
+def residual(
+    flow: FlowMap,
+    X,
+    T: float,
+    p=None,
+    *,
+    t0: float = 0.0,
+    segments: int = 1,
+    monodromy: str | None = None,
+):
+    """The shooting residual ``G(X, T, p)`` and its Jacobian.
+
+    ``X`` stacks the ``segments`` segment states (each of the model's size); each segment
+    spans ``T / segments`` from ``t0 + k T / segments``.  Returns ``(G, dG/dX, blocks)``
+    with ``blocks[k] = (segment Jacobian, integral of trace J over the segment)``.
+    """
+    N = flow.system.n
+    dur = T / segments
+    R = np.empty(segments * N)
+    Jm = np.zeros((segments * N, segments * N))
+    blocks = []
+    for k in range(segments):
+        xk = X[k * N : (k + 1) * N]
+        xe, Mk, q = flow.with_jacobian(xk, dur, t0 + k * dur, p, method=monodromy)
+        blocks.append((Mk, q))
+        nxt = (k + 1) % segments
+        R[k * N : (k + 1) * N] = xe - X[nxt * N : (nxt + 1) * N]
+        Jm[k * N : (k + 1) * N, k * N : (k + 1) * N] += Mk
+        Jm[k * N : (k + 1) * N, nxt * N : (nxt + 1) * N] -= np.eye(N)
+    return R, Jm, blocks
+
+
+def shoot(
+    system: System,
+    x0,
+    n: int = 1,
+    *,
+    t0: float = 0.0,
+    segments: int = 1,
+    tol: float = 1e-11,
+    max_iter: int = 30,
+    monodromy: str | None = None,
+    flow: FlowMap | None = None,
+) -> Orbit:
+    """Newton shooting for the period-n orbit near ``x0`` (at time ``t0``).
+
+    ``segments`` > 1 uses multiple shooting: the initial segment states come from
+    integrating the guess.  Converged when the residual's max-norm is below ``tol``.
+    ``monodromy`` picks the route (``ad``, ``variational``, ``fd``); by default the
+    flow's own (located variational equations for a piecewise model, else AD).  Pass
+    ``flow`` to reuse one flow map (and its integrators) over many calls.
+    """
+    if n < 1 or segments < 1:
+        raise ValueError("period multiple n and segments must be >= 1")
+    flow = flow or FlowMap(system)
+    T = n * system.period
+    dur = T / segments
+    X = [np.asarray(x0, float)]
+    for k in range(1, segments):
+        X.append(flow(X[-1], dur, t0 + (k - 1) * dur, system.p))
+    X = np.concatenate(X)
+
+    def fun(X):
+        return residual(flow, X, T, system.p, t0=t0, segments=segments, monodromy=monodromy)
+
+    found = newton(
+        fun,
+        X,
+        tol=tol,
+        max_iter=max_iter,
+        singular="singular shooting Jacobian (a multiplier at +1?)",
+    )
+    N = system.n
+    # Monodromy over the whole period: the product of the segment Jacobians.
+    M = np.eye(N)
+    q = 0.0
+    for Mk, qk in found.extra:
+        M = Mk @ M
+        q += qk
+    return Orbit(
+        system,
+        found.z[:N].copy(),
+        t0,
+        n,
+        found.residual,
+        found.steps,
+        found.history,
+        M,
+        floquet(M, q),
+        segments,
+    )
