@@ -395,44 +395,26 @@ FEATURES = [
     ("reference (3 harmonics, polynomial 7, TE on)", {}),
     ("stiffness harmonics 0", {"stiffness_harmonics": 0}),
     ("stiffness harmonics 1", {"stiffness_harmonics": 1}),
-    ("backlash linear", {"backlash": '"linear"'}),
-    ("backlash dead zone", {"backlash": '"dead-zone"'}),
+    ("backlash linear", {"backlash": "linear"}),
+    ("backlash dead zone", {"backlash": "dead-zone"}),
     ("backlash polynomial 3", {"backlash_order": 3}),
     ("backlash polynomial 5", {"backlash_order": 5}),
-    ("backlash smooth", {"backlash": '"smooth"'}),
-    ("transmission error off", {"transmission_error": "false"}),
+    ("backlash smooth", {"backlash": "smooth"}),
+    ("transmission error off", {"transmission_error": False}),
 ]
 
 
 def _variant(tmp: Path, name: str, changes: dict) -> Path:
-    """A copy of the light-load scene with some [features] changed, derived into tmp."""
-    from gearsym.derive.build import build_files, write_files
+    """The light-load scene with some [features] changed, derived into tmp."""
+    from gearsym.derive import derive_model, load_target, variant
+    from gearsym.derive.emit import emit_module, write_atomic
     from gearsym.derive.scene import builtin_root
 
-    scenes = builtin_root()
-    text = (scenes / "reference-light.toml").read_text(encoding="utf-8")
-    text = text.replace('name = "reference-light"', f'name = "{name.replace("_", "-")}"')
-    text = text.replace(
-        'topology = "topologies/diso.toml"',
-        f'topology = "{(scenes / "topologies" / "diso.toml").as_posix()}"',
-    )
-    lines = []
-    for line in text.splitlines():
-        key = line.split("=")[0].strip()
-        if key in changes:
-            line = f"{key} = {changes[key]}"
-        lines.append(line)
-    if changes.get("backlash") in ('"linear"', '"dead-zone"', '"smooth"'):
-        lines = [
-            ln
-            for ln in lines
-            if not ln.strip().startswith(("backlash_order", "backlash_range", "backlash_step"))
-        ]
-    scene = tmp / f"{name}.toml"
-    scene.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    built = build_files([scene])
-    write_files(built.files, tmp)
-    return tmp / "generated" / f"{built.models[0].name}.py"
+    scene = load_target(builtin_root() / "reference-light.toml")
+    model = derive_model(variant(scene, name.replace("_", "-"), **changes))
+    path = tmp / "generated" / f"{model.name}.py"
+    write_atomic(path, emit_module(model, "gearsym bench"))
+    return path
 
 
 def features(quick: bool) -> list[dict]:

@@ -16,7 +16,7 @@ from .backlash import (
     fit_dead_zone,
 )
 from .model import Model, derive_model
-from .scene import Features, Scene, load_scene, load_target, resolve_target
+from .scene import Features, Scene, load_scene, load_target, resolve_target, variant
 from .topology import Topology, load_topology
 
 __all__ = [
@@ -37,4 +37,5 @@ __all__ = [
     "load_target",
     "load_topology",
     "resolve_target",
+    "variant",
 ]

@@ -192,6 +192,8 @@ def inputs_hash(scene: Scene) -> str:
         "parameters": scene.parameters,
         "kind": scene.kind,
     }
+    if scene.variations:  # a variant of the files (derive.scene.variant)
+        payload["variant"] = {"name": scene.name, "features": scene.variations}
     for key, path in (("scene", scene.source), ("topology", scene.topology.source)):
         payload[key] = tomllib.loads(Path(path).read_text(encoding="utf-8"))
     text = json.dumps(payload, sort_keys=True, default=str)

@@ -22,7 +22,7 @@ damping ratio from its ``[operating]`` table.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ._input import InputError, Table, load_toml, nearest, parse_expression
@@ -36,7 +36,15 @@ from .backlash import (
 )
 from .topology import Topology, load_topology, parse_topology
 
-__all__ = ["Features", "Scene", "builtin_root", "load_scene", "load_target", "resolve_target"]
+__all__ = [
+    "Features",
+    "Scene",
+    "builtin_root",
+    "load_scene",
+    "load_target",
+    "resolve_target",
+    "variant",
+]
 
 
 def builtin_root() -> Path:
@@ -88,6 +96,7 @@ class Scene:
     load_expressions: dict[str, str] | None
     source: str
     kind: str = "scene"  # "scene" or "topology" (a topology derived with default features)
+    variations: dict = field(default_factory=dict)  # [features] changed by variant()
 
     @property
     def omega(self) -> float | None:
@@ -143,6 +152,31 @@ def _features(t: Table | None) -> Features:
     )
     t.finish()
     return features
+
+
+def variant(scene: Scene, name: str, **features) -> Scene:
+    """``scene`` with some ``[features]`` keys changed, under another ``name``.
+
+    The keys and values are those of a scene file's ``[features]`` table
+    (``stiffness_harmonics=0``, ``backlash="dead-zone"``, ``backlash_order=5``,
+    ``transmission_error=False``, ...), read and checked by the same code as the file;
+    keys of another backlash kind are dropped when ``backlash`` changes.  The changes
+    enter the derivation's inputs hash, so a variant never passes for its original.
+    """
+    data = load_toml(Path(scene.source)) if scene.kind == "scene" else {}
+    table = dict(data.get("features", {}))
+    if "backlash" in features:
+        kind = features["backlash"]
+        for other, (keys, _) in _BACKLASH_BUILDERS.items():
+            if other != kind:
+                for key in keys:
+                    if key not in features:
+                        table.pop(key, None)
+    table.update(features)
+    where = f"{scene.source} (variant {name})"
+    checked = Table({"name": name}, where).target_name("name")
+    feats = _features(Table(table, where, "features"))
+    return replace(scene, name=checked, features=feats, variations=scene.variations | features)
 
 
 def resolve_target(name: str, *, kind: str | None = None) -> Path:

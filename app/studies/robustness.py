@@ -52,23 +52,19 @@ BASE = dict(transient=6, periods=2, samples_per_period=16, lyapunov_periods=0, s
 
 
 def harmonics_models(folder: Path) -> dict[str, Path]:
-    """Generate the reference light-load model with 0 and with 10 stiffness harmonics."""
-    from gearsym.derive.build import build_files, project_root, write_files
+    """Generate the reference light-load model with 0 and with 10 stiffness harmonics
+    (variants of the scene, derived into ``folder/generated``)."""
+    from gearsym.derive import derive_model, load_target, variant
+    from gearsym.derive.emit import emit_module, write_atomic
+    from gearsym.derive.scene import builtin_root
 
-    text = (project_root() / "scenes" / "reference-light.toml").read_text(encoding="utf-8")
-    topo = (project_root() / "scenes" / "topologies" / "diso.toml").as_posix()
-    text = text.replace('topology = "topologies/diso.toml"', f'topology = "{topo}"')
+    scene = load_target(builtin_root() / "reference-light.toml")
     out = {}
     for h in (0, 10):
-        scene = Path(folder) / f"harmonics_{h}.toml"
-        scene.write_text(
-            text.replace("stiffness_harmonics = 3 ", f"stiffness_harmonics = {h} ").replace(
-                'name = "reference-light"', f'name = "harmonics-{h}"'
-            ),
-            encoding="utf-8",
-        )
-        write_files(build_files([scene]).files, folder)
-        out[f"harmonics-{h}"] = Path(folder) / "generated" / f"harmonics_{h}.py"
+        model = derive_model(variant(scene, f"harmonics-{h}", stiffness_harmonics=h))
+        path = Path(folder) / "generated" / f"{model.name}.py"
+        write_atomic(path, emit_module(model, "gearsym.studies.robustness.harmonics_models"))
+        out[f"harmonics-{h}"] = path
     return out
 
 
