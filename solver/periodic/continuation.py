@@ -50,6 +50,9 @@ class Bifurcation:
 
 @dataclass
 class Branch:
+    """A continued branch of period-n orbits: per point the parameter value, the orbit's
+    state at tau = 0 (mod nT), its stability and multipliers; the bifurcations located."""
+
     parameter: str
     n: int
     values: list = field(default_factory=list)
@@ -58,6 +61,7 @@ class Branch:
     multipliers: list = field(default_factory=list)
     bifurcations: list = field(default_factory=list)
     message: str = ""
+    state_names: tuple = ()
 
     def describe(self) -> dict:
         return {
@@ -76,7 +80,8 @@ class Branch:
     def to_table(self) -> tuple[list, list]:
         """One row per branch point: the parameter, stability, largest |multiplier|, x0."""
         n = len(self.states[0]) if self.states else 0
-        columns = [self.parameter, "stable", "max_multiplier", *(f"x0_{i}" for i in range(n))]
+        names = self.state_names or tuple(f"x0_{i}" for i in range(n))
+        columns = [self.parameter, "stable", "max_multiplier", *names]
         rows = [
             [float(v), bool(s), float(np.max(np.abs(m))), *map(float, x)]
             for v, s, m, x in zip(
@@ -176,7 +181,7 @@ def continue_orbit(
     direction = np.sign(stop - start) or 1.0
     if np.sign(t[-1]) != direction:
         t = -t
-    branch = Branch(parameter, n)
+    branch = Branch(parameter, n, state_names=system.states)
     fl = floquet(M, q)
 
     def record(z, fl: Floquet):
