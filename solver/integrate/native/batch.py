@@ -113,29 +113,23 @@ def run_batch(
         # A piecewise force law (the dead zone): each point's kinks would shrink the step
         # of the whole group, so such models run point by point.
         lockstep = False
+    opts = dict(
+        method=method,
+        rtol=rtol,
+        atol=atol,
+        t0=t0,
+        transient=transient,
+        periods=periods,
+        samples_per_period=spp,
+        steps_per_period=steps_per_period,
+        bound=bound,
+        max_steps=max_steps,
+        lockstep=lockstep,
+        group=group,
+        fallback=fallback,
+    )
     if workers > 1 and P.shape[0] > 1:
-        return _parallel(
-            module,
-            P,
-            X0,
-            workers,
-            started,
-            dict(
-                method=method,
-                rtol=rtol,
-                atol=atol,
-                t0=t0,
-                transient=transient,
-                periods=periods,
-                samples_per_period=spp,
-                steps_per_period=steps_per_period,
-                bound=bound,
-                max_steps=max_steps,
-                lockstep=lockstep,
-                group=group,
-                fallback=fallback,
-            ),
-        )
+        return _parallel(module, P, X0, workers, started, opts)
     try:
         lib, facts = library(module)
     except NativeUnavailable as err:
@@ -144,23 +138,7 @@ def run_batch(
         if str(err) not in _warned:
             _warned.add(str(err))
             warnings.warn(f"{err}; integrating with NumPy instead (slower)", stacklevel=2)
-        return _numpy_batch(
-            module,
-            P,
-            X0,
-            method,
-            rtol,
-            atol,
-            t0,
-            transient,
-            periods,
-            spp,
-            steps_per_period,
-            bound,
-            t,
-            period,
-            started,
-        )
+        return _numpy_batch(module, P, X0, t, period, started, opts)
     N = P.shape[0]
     out = np.empty((N, k, n))
     nfev = np.zeros(N, dtype=np.int64)
@@ -256,27 +234,15 @@ def _parallel(module, P, X0, workers, started, kwargs) -> BatchResult:
     )
 
 
-def _numpy_batch(
-    module,
-    P,
-    X0,
-    method,
-    rtol,
-    atol,
-    t0,
-    transient,
-    periods,
-    spp,
-    steps_per_period,
-    bound,
-    t,
-    period,
-    started,
-) -> BatchResult:
+def _numpy_batch(module, P, X0, t, period, started, opts: dict) -> BatchResult:
     """The same integration without a compiler: SciPy's RK45/DOP853 point by point on the
     generated NumPy right-hand side (each with an escape event at ``bound``), or NumPy RK4
-    on all points at once, on the same grid as the C code."""
+    on all points at once, on the same grid as the C code (``opts``: run_batch's)."""
     from scipy.integrate import solve_ivp
+
+    method, rtol, atol, t0 = opts["method"], opts["rtol"], opts["atol"], opts["t0"]
+    transient, periods, bound = opts["transient"], opts["periods"], opts["bound"]
+    spp, steps_per_period = opts["samples_per_period"], opts["steps_per_period"]
 
     N, n = X0.shape
     Pt = P.T.copy()
