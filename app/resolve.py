@@ -21,12 +21,18 @@ from gearsym.solver.cache import cache_root
 from gearsym.solver.contract import CONTRACT_FORMAT, load_generated
 from gearsym.solver.system import System
 
-__all__ = ["load", "model_cache", "module_for"]
+__all__ = ["cached_module", "load", "model_cache", "module_for"]
 
 
 def model_cache() -> Path:
     """Where models derived from scene files are kept."""
     return cache_root() / "models"
+
+
+def cached_module(name: str, digest: str) -> Path:
+    """The derivation cache's file for model ``name`` with inputs hash ``digest`` (its
+    audit page goes beside it with the suffix ``.md``)."""
+    return model_cache() / f"{name.replace('-', '_')}_{digest[:12]}_c{CONTRACT_FORMAT}.py"
 
 
 def module_for(target: str | Path) -> ModuleType:
@@ -42,7 +48,7 @@ def module_for(target: str | Path) -> ModuleType:
         module = None
     if module is not None and getattr(module, "INPUTS_SHA256", "") == digest:
         return module
-    cached = model_cache() / f"{name}_{digest[:12]}_c{CONTRACT_FORMAT}.py"
+    cached = cached_module(name, digest)
     if not cached.exists():
         model = derive_model(scene)
         write_atomic(cached, emit_module(model, f"gearsym derive {path}"))

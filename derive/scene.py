@@ -186,10 +186,12 @@ def resolve_target(name: str, *, kind: str | None = None) -> Path:
         return path
     root = builtin_root()
     candidates = []
-    if kind in (None, "scene"):
-        candidates.append(root / f"{name}.toml")
-    if kind in (None, "topology"):
-        candidates.append(root / "topologies" / f"{name}.toml")
+    # Built-in names may be written with underscores, as the generated modules are.
+    for spelling in dict.fromkeys((name, name.replace("_", "-"))):
+        if kind in (None, "scene"):
+            candidates.append(root / f"{spelling}.toml")
+        if kind in (None, "topology"):
+            candidates.append(root / "topologies" / f"{spelling}.toml")
     for c in candidates:
         if c.exists():
             return c

@@ -158,3 +158,27 @@ def test_stiffness_command_reports_pem_iso_and_phase(tmp_path, capsys):
     assert main(["stiffness", "reference-light", "--mesh", "pg", "--harmonics", "5"]) == 0
     text = capsys.readouterr().out
     assert "k_5:" in text and "PEM / ISO" in text
+
+
+def test_built_in_names_take_underscores_and_user_scenes_derive_into_the_cache(
+    tmp_path, root, capsys, monkeypatch
+):
+    # Issue 11: built-in names with hyphens or underscores; a user's scene is derived into
+    # the user cache (never into the installed package) where the resolver finds it.
+    monkeypatch.setenv("GEARSYM_CACHE", str(tmp_path / "cache"))
+    code, out, err = run(capsys, "derive", "reference_light", "--dry-run")
+    assert code == 0, err
+    text = (root / "scenes" / "reference-light.toml").read_text()
+    text = text.replace('name = "reference-light"', 'name = "my-light"')
+    topo = (root / "scenes" / "topologies" / "diso.toml").as_posix()
+    text = text.replace('topology = "topologies/diso.toml"', f'topology = "{topo}"')
+    scene = tmp_path / "my-light.toml"
+    scene.write_text(text)
+    code, out, err = run(capsys, "derive", str(scene))
+    assert code == 0, err
+    written = sorted((tmp_path / "cache" / "models").iterdir())
+    assert [p.suffix for p in written] == [".md", ".py"], written
+    assert not (root / "generated" / "my_light.py").exists()
+    from gearsym.resolve import module_for
+
+    assert module_for(scene).__file__ == str(written[1])

@@ -61,11 +61,13 @@ def parse_range(text: str):
 
 def system_of(scene_arg: str, sets: dict[str, float]):
     """The System of a scene (built-in name or path) with ``--set`` values (resolver:
-    ``gearsym.resolve``)."""
-    from gearsym.resolve import load
+    ``gearsym.resolve``); a bad scene file raises its own InputError."""
+    from gearsym.resolve import module_for
+    from gearsym.solver.system import System
 
+    module = module_for(scene_arg)
     try:
-        return load(scene_arg, **sets)
+        return System.load(module, **sets)
     except KeyError as err:
         raise Fail(f"--set: {err.args[0]}") from None
     except ValueError as err:

@@ -106,10 +106,12 @@ def _cmd_derive(args) -> int:
         build_files,
         check,
         describe_json,
+        project_root,
         shipped_targets,
         write_files,
         write_stiffness_figure,
     )
+    from gearsym.derive.emit import write_atomic
     from gearsym.derive.scene import resolve_target
 
     if args.check:
@@ -138,31 +140,58 @@ def _cmd_derive(args) -> int:
     paths = shipped_targets() if shipped else [resolve_target(t) for t in args.targets]
     overrides = parse_set(args.set)
     built = build_files(paths, index=shipped, overrides=overrides)
-    root = Path(args.out) if args.out else _default_root(paths, overrides)
-    written = [] if args.dry_run else write_files(built.files, root)
-    if shipped and not args.dry_run:
-        written.append(write_stiffness_figure(root))
+    if args.out:
+        files, where = built.files, Path(args.out)
+    elif _as_shipped(paths, overrides):
+        files, where = built.files, project_root()
+    else:
+        files, where = _cache_files(built), None
+    if args.dry_run:
+        written = []
+    elif where is None:
+        written = [Path(p) for p in files]
+        for path, text in files.items():
+            write_atomic(Path(path), text)
+    else:
+        written = write_files(files, where)
+        if shipped:
+            written.append(write_stiffness_figure(where))
     if args.json:
         print(describe_json(built.models))
         return 0
     for model in built.models:
         _summary(model)
-    if written:
-        print(f"wrote {len(written)} files under {root}")
+    if where is None:
+        for path in written:
+            print(f"wrote {path}")
+    elif written:
+        print(f"wrote {len(written)} files under {where}")
     return 0
 
 
-def _default_root(paths, overrides) -> Path:
-    """The project tree for the shipped scenes and topologies as they are (that is what
-    ``derive --check`` compares); the user cache for anything else, so that a user's
-    scene (or a shipped one with --set) never writes into the installed package."""
-    from gearsym.derive.build import project_root, shipped_targets
-    from gearsym.resolve import model_cache
+def _as_shipped(paths, overrides) -> bool:
+    """The shipped scenes and topologies as they are: their files belong in the project
+    (that is what ``derive --check`` compares).  Anything else (a user's scene, or a
+    shipped one with --set) never writes into the installed package."""
+    from gearsym.derive.build import shipped_targets
 
     shipped = {Path(p).resolve() for p in shipped_targets()}
-    if not overrides and all(Path(p).resolve() in shipped for p in paths):
-        return project_root()
-    return model_cache()
+    return not overrides and all(Path(p).resolve() in shipped for p in paths)
+
+
+def _cache_files(built) -> dict[str, str]:
+    """The generated modules (and audit pages beside them) at the derivation cache's
+    names, where the scene resolver finds them (absolute paths)."""
+    from gearsym.resolve import cached_module
+
+    files = {}
+    for model in built.models:
+        module = cached_module(model.name, model.inputs_hash)
+        for rel, text in built.files.items():
+            if Path(rel).stem == model.name:
+                target = module if rel.endswith(".py") else module.with_suffix(".md")
+                files[str(target)] = text
+    return files
 
 
 def _summary(model) -> None:
