@@ -108,6 +108,17 @@ class Contract:
             problems.append("velocities not given for exactly the coordinates")
         if any(not 0 <= i < n for i in self.velocities.values()):
             problems.append("a velocity index outside the state")
+        if len(set(self.velocities.values())) != len(self.velocities):
+            problems.append("two coordinates share a velocity")
+        coords = set(self.coordinates)
+        tables = {"loads": self.loads, "contact": self.contact, "valid": self.valid_range or {}}
+        for key, table in tables.items():
+            if not set(table) <= coords:
+                problems.append(f"{key} names something that is not a coordinate")
+        if any(not lower <= upper for lower, upper in self.contact.values()):
+            problems.append("contact edges with lower > upper")
+        if any(not a > 0 for a in (self.valid_range or {}).values()):
+            problems.append("a valid range that is not > 0")
         if self.forcing_frequency not in self.parameters:
             problems.append(f"forcing frequency '{self.forcing_frequency}' is not a parameter")
         if any(p not in self.parameters for p in self.loads.values()):

@@ -56,7 +56,15 @@ def open_store(store: Path, manifest: dict) -> dict[int, SweepPoint]:
     done = {}
     for f in sorted((store / "points").glob("[0-9]*.json")):
         try:
-            done[int(f.stem)] = SweepPoint.from_dict(json.loads(f.read_text(encoding="utf-8")))
-        except (ValueError, KeyError, OSError):
+            data = json.loads(f.read_text(encoding="utf-8"))
+        except (ValueError, OSError):
             f.unlink(missing_ok=True)  # a torn file cannot exist (atomic writes); be safe
+            continue
+        try:
+            done[int(f.stem)] = SweepPoint.from_dict(data)
+        except (KeyError, TypeError, ValueError):
+            raise SweepStoreError(
+                f"{f} is not a sweep point this version reads; choose another output folder "
+                "or delete it"
+            ) from None
     return done

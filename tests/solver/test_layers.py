@@ -71,6 +71,9 @@ def test_an_inconsistent_contract_is_refused_with_what_is_wrong(duffing):
 
     with pytest.raises(ValueError, match="velocity index outside the state.*load that is not"):
         Contract.of(Fake)
+    Fake.CONTRACT = dict(duffing.module.CONTRACT, contact={"x": (1.0, -1.0)}, valid_range={"y": 3})
+    with pytest.raises(ValueError, match="valid names something.*lower > upper"):
+        Contract.of(Fake)
     Fake.CONTRACT = dict(duffing.module.CONTRACT, format=0)
     with pytest.raises(ValueError, match="regenerate it with `gearsym derive`"):
         Contract.of(Fake)

@@ -114,3 +114,13 @@ def test_a_sweep_killed_with_sigkill_resumes_and_matches(tmp_path):
     a = json.loads((killed / "sweep.json").read_text())["points"]
     b = json.loads((clean / "sweep.json").read_text())["points"]
     assert [_strip(p) for p in a] == [_strip(p) for p in b]
+
+
+def test_a_stored_point_of_another_format_is_refused_not_deleted(tmp_path):
+    system = System.load("reference_light")
+    sweep(system, "lambda", [0.0, 0.5], store=tmp_path, **SETTINGS)
+    stray = tmp_path / "points" / "00001.json"
+    stray.write_text(json.dumps({"value": 0.5}))  # valid JSON, not a point
+    with pytest.raises(SweepStoreError, match="00001.json is not a sweep point"):
+        sweep(system, "lambda", [0.0, 0.5], store=tmp_path, **SETTINGS)
+    assert stray.exists()
