@@ -120,7 +120,8 @@ def plain_rhs(q: dict):
 def baseline_point(module, p, x0, transient, periods, rtol=1e-8, atol=1e-10, method="RK45"):
     from scipy.integrate import solve_ivp
 
-    T = 2 * math.pi / p[0]
+    contract = module.CONTRACT
+    T = 2 * math.pi / p[contract["parameters"].index(contract["forcing_frequency"])]
     t_eval = (transient + np.arange(periods + 1)) * T
     sol = solve_ivp(
         plain_rhs(_named(module, p)),

@@ -54,7 +54,7 @@ def bifurcation_diagram(
                 color=_COLOURS[sw.direction],
                 label=f"{sw.direction} sweep",
             )
-        ax.set_ylabel(f"{state} (Poincaré), 1/half backlash")
+        ax.set_ylabel(f"{state} (Poincaré), half backlashes")
         ax.grid(alpha=0.3)
     axes[0, 0].legend(loc="best", markerscale=6, fontsize=8)
     axes[-1, 0].set_xlabel(sweeps[0].parameter)
@@ -77,7 +77,7 @@ def point_figure(tr: Trajectory, path: Path, title: str = "", periods_shown: int
         for edge in tr.system.contract.contact.get(c, ()):
             ax.axhline(edge, color="grey", lw=0.6, ls="--")
         ax.set_xlabel("τ (non-dimensional time)")
-        ax.set_ylabel(f"{c} (1/half backlash)")
+        ax.set_ylabel(f"{c} (half backlashes)")
         ax.set_title(f"{c}: time series (last {periods_shown} periods)", fontsize=9)
         ax = axes[row, 1]
         ax.plot(u, du, lw=0.3, color="tab:blue", alpha=0.6)
@@ -131,9 +131,11 @@ def map_figure(
     motion_v,
     path: Path,
     title: str = "",
-    names=("f1", "lambda", "u", "v"),
+    *,
+    names: tuple[str, str, str, str],
 ) -> Path:
-    """Maps over (f1, lambda): Max(u), Min(v) and the motion type of v."""
+    """Maps over two parameters (``names[0]`` on the y axis, ``names[1]`` on x): the max of
+    state ``names[2]``, the min of state ``names[3]`` and the motion type of ``names[3]``."""
     fig, axes = plt.subplots(1, 3, figsize=(15, 4))
 
     # Cells centred on the sampled values.
@@ -173,7 +175,7 @@ def map_figure(
 
 
 def branch_figure(
-    branches, path: Path, state_index: int = 0, state: str = "u", sweeps=None, title: str = ""
+    branches, path: Path, state: str | None = None, sweeps=None, title: str = ""
 ) -> Path:
     """Continuation branches over the brute-force diagram: stable solid, unstable dashed,
     bifurcations marked; Poincare points of brute-force sweeps in the background."""
@@ -197,12 +199,17 @@ def branch_figure(
         "period-doubling": ("D", "tab:purple"),
         "neimark-sacker": ("o", "tab:green"),
     }
+    if state is None and branches:
+        state = branches[0].state_names[0]
     for k, br in enumerate(branches):
+        index = br.state_names.index(state)
         lam = np.asarray(br.values)
-        y = np.array([s[state_index] for s in br.states])
+        y = np.array([s[index] for s in br.states])
         stable = np.asarray(br.stable)
         colour = f"C{k}"
         for flag, style in ((True, "-"), (False, "--")):
+            if not np.any(stable == flag):
+                continue  # no legend entry for a kind of point the branch does not have
             yy = np.where(stable == flag, y, np.nan)
             ax.plot(
                 lam,
@@ -214,12 +221,12 @@ def branch_figure(
             )
         for b in br.bifurcations:
             m, c = markers[b.kind]
-            ax.plot(b.value, b.x0[state_index], m, color=c, ms=7, label=b.kind)
+            ax.plot(b.value, b.x0[index], m, color=c, ms=7, label=b.kind)
     handles, labels = ax.get_legend_handles_labels()
     seen = dict(zip(labels, handles, strict=True))
     ax.legend(seen.values(), seen.keys(), fontsize=8, loc="best")
     ax.set_xlabel(branches[0].parameter if branches else "")
-    ax.set_ylabel(f"{state} at τ = 0 mod nT (1/half backlash)")
+    ax.set_ylabel(f"{state} at τ = 0 mod nT (half backlashes)")
     ax.grid(alpha=0.3)
     if title:
         ax.set_title(title)

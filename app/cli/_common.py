@@ -102,7 +102,13 @@ def analysis_options(sub) -> None:
         metavar="KEY=VALUE",
         help="set a scene or model parameter (repeatable)",
     )
-    sub.add_argument("--method", choices=METHODS, default=None, help="integrator")
+    sub.add_argument(
+        "--method",
+        choices=METHODS,
+        default=None,
+        help="integrator (default: the fastest that meets --rtol: dop853, or cvodes without a "
+        "C compiler; RK45 is the study's)",
+    )
     sub.add_argument("--rtol", type=float, default=1e-8)
     sub.add_argument("--atol", type=float, default=1e-10)
     sub.add_argument("--transient", type=int, default=300, help="periods discarded")

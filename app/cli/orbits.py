@@ -181,12 +181,10 @@ def _cmd_continue(args) -> int:
     (out / "branches.json").write_text(
         dumps([b.describe() for b in branches], indent=1), encoding="utf-8"
     )
-    state = system.coordinates[0]
     plots.branch_figure(
         branches,
         out / "branches.png",
-        0,
-        state,
+        system.coordinates[0],
         title=f"{system.name}: continuation in {args.param}",
     )
     for k, br in enumerate(branches):

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from ._common import (
     Fail,
     analysis_options,
@@ -70,7 +72,7 @@ def register(sub) -> None:
 
 def _cmd_simulate(args) -> int:
     from gearsym.solver._json import dumps
-    from gearsym.solver.analysis import analyse_point
+    from gearsym.solver.analysis import analyse_point, meshing_states, spectrum
     from gearsym.solver.integrate import SimulationError
 
     system = system_of(args.scene, parse_set(args.set))
@@ -100,15 +102,17 @@ def _cmd_simulate(args) -> int:
     def num(v, fmt=".4f"):
         return "n/a" if v is None else format(v, fmt)
 
+    shares = meshing_states(tr)
     for c, k in result.classification.items():
-        e = data["extremes"][c]
-        peaks = ", ".join(f"{p['frequency']:.3g}" for p in data["spectra"][c]["peaks"][:4])
-        shares = data["meshing_states"][c]
-        print(
-            f"  {c}: {k.motion:<15} range [{num(e['min'])}, {num(e['max'])}]  peaks at "
-            f"{peaks or 'n/a'}  forward/separated/backward {num(shares['forward'], '.2f')}/"
-            f"{num(shares['separated'], '.2f')}/{num(shares['backward'], '.2f')}"
-        )
+        u = tr.coordinate(c)
+        u = u[np.isfinite(u)]
+        low, high = (float(u.min()), float(u.max())) if u.size else (None, None)
+        peaks = ", ".join(f"{p['frequency']:.3g}" for p in spectrum(tr, c).peaks()[:4])
+        line = f"  {c}: {k.motion:<15} range [{num(low)}, {num(high)}]  peaks at {peaks or 'n/a'}"
+        if c in shares:
+            f, s, b = (num(shares[c][key], ".2f") for key in ("forward", "separated", "backward"))
+            line += f"  forward/separated/backward {f}/{s}/{b}"
+        print(line)
     if tr.left_valid_range is not None:
         t, c, v = tr.left_valid_range
         print(

@@ -107,13 +107,13 @@ def reproduce(
         motion_v,
         out / "map_f1_lambda.png",
         title="light-load scene with f1 varied",
+        names=("f1", "lambda", "u", "v"),
     )
     branches = _continue_cases(systems, by_case, quick, executor, workers)
     for case, _, f1 in CASES:
         plots.branch_figure(
             branches[case],
             out / f"continuation_{case}.png",
-            0,
             "u",
             sweeps=by_case[case],
             title=f"{case} load, f1 = {f1}: period-1 branch over the sweeps",

@@ -21,7 +21,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-__all__ = ["LocatedRun", "SimulationError", "integrate_located", "surface_events"]
+__all__ = [
+    "LocatedRun",
+    "SimulationError",
+    "escape_event",
+    "integrate_located",
+    "surface_events",
+]
 
 _HAIR = 1e-10  # how far behind the motion a surface the state sits on is moved
 _ON = 1e-9  # a state this close to a surface sits on it
@@ -60,6 +66,16 @@ def surface_events(surfaces: Sequence[tuple[int, float]], offset: dict[int, floa
         return event
 
     return [make(i, c, offset.get(k, 0.0)) for k, (i, c) in enumerate(surfaces)]
+
+
+def escape_event(bound: float):
+    """Terminal event: zero where the largest state magnitude reaches ``bound``."""
+
+    def escape(t, y):
+        return bound - np.max(np.abs(y))
+
+    escape.terminal = True
+    return escape
 
 
 def integrate_located(

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .events import integrate_located
+from .events import escape_event, integrate_located
 from .result import Request, Run
 
 __all__ = ["run"]
@@ -25,7 +25,7 @@ def run(system, req: Request) -> Run:
     x = np.full((system.n, grid.size), np.nan)
     exit_: list = [None]
     valid = _valid_event(system, terminal=req.on_invalid == "error")
-    escape = _escape_event(req.bound)
+    escape = escape_event(req.bound)
 
     def extra():
         events = [escape]
@@ -88,11 +88,3 @@ def _valid_event(system, terminal: bool):
     valid.terminal = terminal
     valid.direction = -1
     return valid
-
-
-def _escape_event(bound: float):
-    def escape(t, y):
-        return bound - np.max(np.abs(y))
-
-    escape.terminal = True
-    return escape

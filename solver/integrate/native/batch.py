@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...contract import Contract, load_generated
+from ..events import escape_event
 from ..tableau import RK4, rk_step
 from .build import NativeUnavailable, library
 
@@ -81,18 +82,16 @@ def run_batch(
         raise ValueError(f"unknown native method '{method}'; methods: {', '.join(NATIVE_METHODS)}")
     P = np.ascontiguousarray(np.atleast_2d(np.asarray(P, dtype=float)))
     X0 = np.ascontiguousarray(np.atleast_2d(np.asarray(X0, dtype=float)))
-    n = len(module.STATES)
-    if P.shape[1] != len(module.PARAMETERS) or X0.shape != (P.shape[0], n):
-        raise ValueError(
-            f"P must be (N, {len(module.PARAMETERS)}) and X0 (N, {n}); got {P.shape} and {X0.shape}"
-        )
+    contract = Contract.of(module)
+    n, n_p = len(contract.states), len(contract.parameters)
+    if P.shape[1] != n_p or X0.shape != (P.shape[0], n):
+        raise ValueError(f"P must be (N, {n_p}) and X0 (N, {n}); got {P.shape} and {X0.shape}")
     if not (np.all(np.isfinite(P)) and np.all(np.isfinite(X0))):
         bad = "P" if not np.all(np.isfinite(P)) else "X0"
         raise ValueError(
             f"{bad} holds a NaN or infinite value; every parameter and initial "
             "state must be a finite number"
         )
-    contract = Contract.of(module)
     w_name = contract.forcing_frequency
     omega = P[:, contract.parameters.index(w_name)]
     if not (np.all(np.isfinite(omega)) and np.all(omega > 0)) or np.ptp(omega) != 0.0:
@@ -276,10 +275,7 @@ def _numpy_batch(module, P, X0, t, period, started, opts: dict) -> BatchResult:
         nsteps = np.zeros(N, dtype=np.int64)
         status, t_fail = [], np.full(N, np.nan)
 
-        def escape(tt, yy):
-            return bound - np.max(np.abs(yy))
-
-        escape.terminal = True
+        escape = escape_event(bound)
         for i in range(N):
             sol = solve_ivp(
                 lambda tt, yy, pp=P[i]: module.rhs(tt, yy, pp),
