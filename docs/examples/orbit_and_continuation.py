@@ -14,21 +14,24 @@ import gearsym
 
 def main(out: Path) -> None:
     system = gearsym.load("reference-light", **{"lambda": 0.8})  # lambda is a Python keyword
-    run = gearsym.simulate(system, transient=100, periods=10)  # the fastest method by default
-    print(
-        f"simulated with {run.method}: {run.status}, u in [{run.x[0].min():.3f}, "
-        f"{run.x[0].max():.3f}] half backlashes"
-    )
+    run = gearsym.simulate(system, transient=100, periods=20)  # the fastest method by default
+    u = run.coordinate("u")  # mesh deflection in half backlashes, over the sampled window
+    print(f"simulated with {run.method}: {run.status}, u in [{u.min():.3f}, {u.max():.3f}]")
 
-    orbit = gearsym.shoot(system, run.x_final, 1)  # the period-1 orbit near the end state
+    # The period-1 orbit near the end state (t_final is a whole number of forcing
+    # periods, so the orbit is taken at tau = 0 mod T, shoot's default t0).
+    orbit = gearsym.shoot(system, run.x_final, 1)
     fl = orbit.floquet
     print(f"period-1 orbit: residual {orbit.residual:.1e} after {orbit.iterations} Newton steps")
-    print("Floquet multipliers:", ", ".join(f"{abs(m):.4f}" for m in fl.multipliers))
+    print("Floquet multipliers:", ", ".join(f"{m:.4f} (|{abs(m):.4f}|)" for m in fl.multipliers))
     print(f"stable: {fl.stable}; Liouville check |log det M - int tr J| = {fl.liouville_error:.1e}")
 
     branch = gearsym.continue_orbit(system, "lambda", 0.8, 1.0, orbit.x0, ds=0.05)
-    for value, stable in zip(branch.values, branch.stable, strict=True):
-        print(f"  lambda = {value:.4f}: {'stable' if stable else 'unstable'}")
+    for value, stable, mu in zip(branch.values, branch.stable, branch.multipliers, strict=True):
+        verdict = "stable" if stable else "unstable"
+        print(f"  lambda = {value:.4f}: {verdict}, largest |multiplier| {max(abs(mu)):.4f}")
+    for b in branch.bifurcations:  # folds, period doublings, Neimark-Sacker points located
+        print(f"  {b.kind} at lambda = {b.value:.6f}")
     print(f"{len(branch.values)} points; {branch.message}")
     for suffix in (".csv", ".mat"):
         print("wrote", branch.save(out / f"branch{suffix}"))
