@@ -62,6 +62,7 @@ class Branch:
     bifurcations: list = field(default_factory=list)
     message: str = ""
     state_names: tuple = ()
+    model: dict = field(default_factory=dict)  # name, hash, base values and scales
 
     def describe(self) -> dict:
         return {
@@ -75,7 +76,10 @@ class Branch:
             "message": self.message,
         }
 
-    to_dict = describe
+    def to_dict(self) -> dict:
+        """:meth:`describe` with the state names, the model (name, hash, base values) and
+        the scales back to SI."""
+        return self.model | {"states": list(self.state_names)} | self.describe()
 
     def to_table(self) -> tuple[list, list]:
         """One row per branch point: the parameter, stability, largest |multiplier|, x0."""
@@ -181,7 +185,13 @@ def continue_orbit(
     direction = np.sign(stop - start) or 1.0
     if np.sign(t[-1]) != direction:
         t = -t
-    branch = Branch(parameter, n, state_names=system.states)
+    model = {
+        "model": system.name,
+        "model_hash": system.model_hash,
+        "base_values": {k: float(v) for k, v in system.values.items()},
+        "scales": system.scales(),
+    }
+    branch = Branch(parameter, n, state_names=system.states, model=model)
     fl = floquet(M, q)
 
     def record(z, fl: Floquet):

@@ -61,7 +61,14 @@ class Orbit:
             "values": {k: float(v) for k, v in self.system.values.items()},
         }
 
-    to_dict = describe
+    def to_dict(self) -> dict:
+        """:meth:`describe` with the model, its hash and the scales back to SI."""
+        d = self.system.describe()
+        return {
+            "model": d["model"],
+            "model_hash": d["model_hash"],
+            "scales": self.system.scales(),
+        } | self.describe()
 
     def to_table(self) -> tuple[list, list]:
         """One row per Floquet multiplier: real and imaginary parts, modulus."""
@@ -129,6 +136,9 @@ def shoot(
     """
     if n < 1 or segments < 1:
         raise ValueError("period multiple n and segments must be >= 1")
+    x0 = np.asarray(x0, dtype=float)
+    if x0.shape != (system.n,) or not np.all(np.isfinite(x0)):
+        raise ValueError(f"x0 must be {system.n} finite numbers ({', '.join(system.states)})")
     flow = flow or FlowMap(system)
     T = n * system.period
     dur = T / segments
