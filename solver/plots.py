@@ -201,12 +201,14 @@ def branch_figure(
     }
     if state is None and branches:
         state = branches[0].state_names[0]
-    for k, br in enumerate(branches):
+    # One colour per period: branches of the same period share their legend entry.
+    colours = {n: f"C{i}" for i, n in enumerate(sorted({br.n for br in branches}))}
+    for br in branches:
         index = br.state_names.index(state)
         lam = np.asarray(br.values)
         y = np.array([s[index] for s in br.states])
         stable = np.asarray(br.stable)
-        colour = f"C{k}"
+        colour = colours[br.n]
         for flag, style in ((True, "-"), (False, "--")):
             if not np.any(stable == flag):
                 continue  # no legend entry for a kind of point the branch does not have
@@ -223,7 +225,9 @@ def branch_figure(
             m, c = markers[b.kind]
             ax.plot(b.value, b.x0[index], m, color=c, ms=7, label=b.kind)
     handles, labels = ax.get_legend_handles_labels()
-    seen = dict(zip(labels, handles, strict=True))
+    seen: dict = {}
+    for label, handle in zip(labels, handles, strict=True):
+        seen.setdefault(label, handle)
     ax.legend(seen.values(), seen.keys(), fontsize=8, loc="best")
     ax.set_xlabel(branches[0].parameter if branches else "")
     ax.set_ylabel(f"{state} at τ = 0 mod nT (half backlashes)")
