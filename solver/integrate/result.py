@@ -11,7 +11,8 @@ __all__ = ["Request", "Run", "first_exit"]
 
 @dataclass(frozen=True)
 class Request:
-    """One integration, as ``simulate`` checked it.
+    """One integration, as ``simulate`` checked it (``x0`` and ``grid`` are None only
+    while the options are being checked).
 
     The run starts at ``t0`` in state ``x0``; after ``transient`` forcing periods it is
     sampled on ``grid`` (``periods * samples_per_period + 1`` times, the last one closing

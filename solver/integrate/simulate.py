@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -151,17 +151,11 @@ class Trajectory:
         return save(self, path)
 
 
-def _check(
-    system: System,
-    method,
-    rtol,
-    atol,
-    transient,
-    periods,
-    samples_per_period,
-    steps_per_period,
-    on_invalid,
-) -> None:
+def _check(system: System, req: Request) -> None:
+    """The request's options, each with one line naming what is wrong."""
+    method, rtol, atol = req.method, req.rtol, req.atol
+    transient, periods, on_invalid = req.transient, req.periods, req.on_invalid
+    samples_per_period, steps_per_period = req.samples_per_period, req.steps_per_period
     record = get_method(method)
     if on_invalid not in ("warn", "error"):
         raise ValueError(f"on_invalid must be 'warn' or 'error', got {on_invalid!r}")
@@ -234,38 +228,29 @@ def simulate(
     """
     if method is None:
         method = fastest_method(rtol)
-    _check(
-        system,
-        method,
-        rtol,
-        atol,
-        transient,
-        periods,
-        samples_per_period,
-        steps_per_period,
-        on_invalid,
+    req = Request(
+        x0=None,
+        t0=t0,
+        grid=None,
+        method=method,
+        rtol=rtol,
+        atol=atol,
+        transient=transient,
+        periods=periods,
+        samples_per_period=samples_per_period,
+        steps_per_period=steps_per_period,
+        max_step=max_step,
+        bound=bound,
+        on_invalid=on_invalid,
     )
+    _check(system, req)
     x0 = default_initial_state(system) if x0 is None else np.asarray(x0, dtype=float)
     if x0.shape != (system.n,) or not np.all(np.isfinite(x0)):
         raise ValueError(f"x0 must be {system.n} finite numbers ({', '.join(system.states)})")
     T = system.period
     t_start = t0 + transient * T
     grid = t_start + T * np.arange(periods * samples_per_period + 1) / samples_per_period
-    req = Request(
-        x0,
-        t0,
-        grid,
-        method,
-        rtol,
-        atol,
-        transient,
-        periods,
-        samples_per_period,
-        steps_per_period,
-        max_step,
-        bound,
-        on_invalid,
-    )
+    req = replace(req, x0=x0, grid=grid)
     started = time.perf_counter()
     run = _backend(get_method(method).family)(system, req)
     x, status, message = run.x, run.status, run.message
