@@ -29,7 +29,7 @@ def _parser() -> argparse.ArgumentParser:
         "--debug", action="store_true", help="show full tracebacks instead of one-line errors"
     )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for group in (derive, study, point, orbits):
+    for group in (derive, point, orbits, study):
         group.register(sub)
     return parser
 

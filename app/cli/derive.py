@@ -14,11 +14,12 @@ __all__ = ["register"]
 def register(sub) -> None:
     d = sub.add_parser(
         "derive",
-        help="derive models; write generated/ and docs/",
-        description="Derive the non-dimensional model of scenes or "
-        "topologies, write generated/<name>.py and docs/derivation/<name>.md. "
-        "Without targets: every shipped scene and topology, and "
-        "docs/derivation.md.",
+        help="derive models; write the generated code and its audit page",
+        description="Derive the non-dimensional model of scenes or topologies and write "
+        "the generated module and its audit page. Without targets: every shipped scene and "
+        "topology into the project's generated/ and docs/ (with docs/derivation.md). A "
+        "user's scene, or any target with --set, goes to the user cache "
+        "($GEARSYM_CACHE/models, default ~/.cache/gearsym/models) unless --out.",
     )
     d.add_argument(
         "targets",
