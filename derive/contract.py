@@ -1,0 +1,84 @@
+"""The model's contract: what a solver needs to know about a derived model, as data.
+
+Every generated module carries it as ``CONTRACT`` (``emit.py``); the solver reads only this
+(``solver/contract.py`` checks it) and never parses generated source or guesses from
+names.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from .backlash import DEAD_ZONE_EDGES
+
+__all__ = ["CONTRACT_FORMAT", "model_contract"]
+
+# Version of the contract's layout; a solver refuses a format it does not read.
+CONTRACT_FORMAT = 1
+
+
+def model_contract(model) -> dict:
+    """What a solver needs to know about ``model``, as plain Python literals (a new
+    dict on each call, so a caller's edits cannot leak into the model).
+
+    ``format``
+        :data:`CONTRACT_FORMAT`.
+    ``states``, ``coordinates``, ``parameters``
+        State order, the mesh coordinates (in half backlashes), parameter order of ``p``.
+    ``velocities``
+        coordinate -> index in the state vector of its time derivative, read off the
+        first-order equations (the right-hand side of a coordinate is a state).
+    ``forcing_frequency``
+        The parameter ``omega``; the excitation period is ``2 pi / omega``.
+    ``loads``
+        coordinate -> its static-load parameter (coordinates that have one).
+    ``contact``
+        coordinate -> ``(lower, upper)`` edges of the backlash, ``(-1.0, 1.0)`` in half
+        backlashes: forward contact for ``u > upper``, separated for
+        ``lower <= u <= upper``, backward contact for ``u < lower``.
+    ``piecewise``
+        True when the right-hand side contains a ``Piecewise`` (it has kinks).
+    ``switching_surfaces``
+        ``(state index i, value c)`` for each kink ``x[i] = c`` of the right-hand side:
+        per coordinate in coordinate order, its backlash model's kinks (upper edge,
+        then lower); ``()`` when smooth.
+    ``valid_range``
+        coordinate -> bound ``a``, the force law holding for ``|u| <= a`` only (a
+        polynomial fit of the dead zone); None when valid everywhere.
+    """
+    index = {s: k for k, s in enumerate(model.state_symbols)}
+    velocities = {}
+    for c in model.coordinates:
+        rate = model.rhs[model.states.index(c)]
+        if rate not in index:
+            raise AssertionError(f"the right-hand side of {c} is not a state: {rate}")
+        velocities[c] = index[rate]
+    pieces = {p for e in model.rhs for p in e.atoms(sp.Piecewise)}
+    kinked = {s for p in pieces for s in p.free_symbols}
+    backlash = model.features.backlash
+    surfaces = tuple(
+        (model.states.index(c), float(edge))
+        for c in model.coordinates
+        if model.state_symbols[model.states.index(c)] in kinked
+        for edge in backlash.kinks
+    )
+    if bool(pieces) != bool(surfaces):
+        raise AssertionError(
+            f"backlash '{backlash.kind}' lists kinks {backlash.kinks} but the right-hand "
+            f"side {'has' if pieces else 'has no'} Piecewise"
+        )
+    names = model.parameter_names
+    valid = backlash.valid_range
+    return {
+        "format": CONTRACT_FORMAT,
+        "states": tuple(model.states),
+        "coordinates": tuple(model.coordinates),
+        "velocities": velocities,
+        "parameters": tuple(names),
+        "forcing_frequency": model.forcing_frequency,
+        "loads": {c: f for c, f in model.load_parameters.items() if f in names},
+        "contact": {c: tuple(float(e) for e in DEAD_ZONE_EDGES) for c in model.coordinates},
+        "piecewise": bool(pieces),
+        "switching_surfaces": surfaces,
+        "valid_range": None if valid is None else {c: float(valid) for c in model.coordinates},
+    }
