@@ -192,7 +192,11 @@ def branch_figure(
                 ".",
                 markersize=2,
                 color="0.6",
-                label=f"brute force ({sw.direction})" if sw is sweeps[0] else None,
+                label="brute force ("
+                + " and ".join(dict.fromkeys(w.direction for w in sweeps))
+                + ")"
+                if sw is sweeps[0]
+                else None,
             )
     markers = {
         "fold": ("s", "tab:red"),

@@ -76,6 +76,9 @@ def _cmd_shoot(args) -> int:
     except ShootingError as err:
         raise Fail(f"shoot: {err}; residuals {[f'{r:.2g}' for r in err.history]}") from None
     data = orbit.describe()
+    least = orbit.smallest_period() if orbit.n > 1 else 1
+    if least < orbit.n:
+        data["smallest_period_multiple"] = least
     if args.out:
         from gearsym.solver import plots
 
@@ -99,6 +102,11 @@ def _cmd_shoot(args) -> int:
         f"{args.segments} segment(s))"
     )
     print("  x0: " + ", ".join(f"{k} = {v:.10g}" for k, v in data["x0"].items()))
+    if least < orbit.n:
+        print(
+            f"  note: this orbit repeats after {least} period(s): it is a period-{least} "
+            f"orbit (its multipliers are those of period-{least}, raised to {orbit.n // least})"
+        )
     print(
         "  multipliers: "
         + ", ".join(f"{m.real:+.6f}{m.imag:+.6f}i (|{abs(m):.6f}|)" for m in fl.multipliers)

@@ -235,7 +235,9 @@ def continue_orbit(
                 record(np.concatenate([last.x0, [end]]), last.floquet)
             except (ShootingError, ValueError, RuntimeError):
                 pass
-            branch.message = f"reached the end of [{lo:g}, {hi:g}]"
+            branch.message = f"reached the end of [{lo:g}, {hi:g}] at {parameter} = {end:g}"
+            if end != stop:
+                branch.message += " (the side it started from: the branch turned at a fold)"
             break
         z, t, tests = z_new, t_new, tests_new
         record(z, floquet(M_new, q_new))

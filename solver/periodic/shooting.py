@@ -70,6 +70,18 @@ class Orbit:
             "scales": self.system.scales(),
         } | self.describe()
 
+    def smallest_period(self, flow: FlowMap | None = None, tol: float = 1e-8) -> int:
+        """The smallest m dividing n with ``phi_{mT}(x0) = x0`` (to ``tol`` relative to
+        the state's size): a period-n orbit found by shooting may be a period-m one."""
+        flow = flow or FlowMap(self.system)
+        scale = max(1.0, float(np.max(np.abs(self.x0))))
+        for m in range(1, self.n):
+            if self.n % m == 0:
+                end = flow(self.x0, m * self.system.period, self.t0, self.system.p)
+                if np.max(np.abs(end - self.x0)) <= tol * scale:
+                    return m
+        return self.n
+
     def to_table(self) -> tuple[list, list]:
         """One row per Floquet multiplier: real and imaginary parts, modulus."""
         mu = [] if self.floquet is None else self.floquet.multipliers

@@ -122,3 +122,13 @@ def test_continuation_builds_one_flow_map_for_the_whole_branch(monkeypatch):
     built.clear()
     branch = continue_orbit(system, "lambda", 0.8, 1.0, x0, ds=0.05, ds_max=0.2)
     assert len(branch.values) > 3 and len(built) == 1
+
+
+def test_a_period_one_orbit_shot_as_period_three_says_its_smallest_period():
+    # Reference: the period-1 orbit at lambda = 0.8 (shot with n = 1) is a fixed point of
+    # the three-period map too; shooting with n = 3 finds it and must not call it period-3.
+    system = System.load("reference_light", **{"lambda": 0.8})
+    one = shoot(system, [1.0, -1.0, 0.0, 0.0])
+    three = shoot(system, one.x0, 3)
+    np.testing.assert_allclose(three.x0, one.x0, atol=1e-8)
+    assert three.smallest_period() == 1 and one.smallest_period() == 1
