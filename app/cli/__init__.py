@@ -3,6 +3,7 @@
 * ``derive.py`` -- derive, backlash, stiffness;
 * ``point.py`` -- simulate, sweep;
 * ``orbits.py`` -- shoot, continue;
+* ``atlas.py`` -- map;
 * ``study.py`` -- reproduce, bench;
 * ``_common.py`` -- the one-line failure and the shared options.
 
@@ -15,7 +16,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from . import derive, orbits, point, study
+from . import atlas, derive, orbits, point, study
 from ._common import Fail
 
 __all__ = ["main"]
@@ -29,7 +30,7 @@ def _parser() -> argparse.ArgumentParser:
         "--debug", action="store_true", help="show full tracebacks instead of one-line errors"
     )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for group in (derive, point, orbits, study):
+    for group in (derive, point, orbits, atlas, study):
         group.register(sub)
     return parser
 

@@ -75,3 +75,71 @@ def casadi_functions():
     xdot = ca.vertcat(x[1], acc)
     f = ca.Function("rhs", [tau, x, p], [xdot])
     return f, ca.Function("jacobian", [tau, x, p], [ca.jacobian(xdot, x)])
+
+
+# The same right-hand side in C for the compiled integrators (written by hand, in the form
+# the derivation emits: gs_prep, gs_rhs, gs_rhs_batch on structure-of-arrays groups).
+_C_COMMON = r"""
+#define GS_NP 5
+#define GS_NQ 1
+static void gs_prep(const double *p, double *q) { q[0] = 0.0; (void)p; }
+"""
+_C_FORCE = "p[2] * cos(p[0] * tau) - p[1] * x[1] - p[3] * x[0] - p[4] * x[0] * x[0] * x[0]"
+
+C_SOURCE = (
+    "#define GS_NX 2\n"
+    + _C_COMMON
+    + r"""
+static inline void gs_rhs(double tau, const double *x, const double *p, const double *q,
+                          double *dx)
+{
+    dx[0] = x[1];
+    dx[1] = """
+    + _C_FORCE
+    + r""";
+    (void)q;
+}
+
+static void gs_rhs_batch(double tau, int n, const double *X, const double *P,
+                         const double *Q, double *DX)
+{
+    for (int j = 0; j < n; ++j) {
+        double x[2] = {X[j], X[n + j]}, p[5], dx[2];
+        for (int k = 0; k < 5; ++k) p[k] = P[k * n + j];
+        gs_rhs(tau, x, p, Q, dx);
+        DX[j] = dx[0];
+        DX[n + j] = dx[1];
+    }
+}
+"""
+)
+
+C_SOURCE_VARIATIONAL = (
+    "#define GS_NX 4\n"
+    + _C_COMMON
+    + r"""
+static inline void gs_rhs(double tau, const double *x, const double *p, const double *q,
+                          double *dx)
+{
+    dx[0] = x[1];
+    dx[1] = """
+    + _C_FORCE
+    + r""";
+    dx[2] = x[3];
+    dx[3] = -(p[3] + 3.0 * p[4] * x[0] * x[0]) * x[2] - p[1] * x[3];
+    (void)q;
+}
+
+static void gs_rhs_batch(double tau, int n, const double *X, const double *P,
+                         const double *Q, double *DX)
+{
+    for (int j = 0; j < n; ++j) {
+        double x[4], p[5], dx[4];
+        for (int i = 0; i < 4; ++i) x[i] = X[i * n + j];
+        for (int k = 0; k < 5; ++k) p[k] = P[k * n + j];
+        gs_rhs(tau, x, p, Q, dx);
+        for (int i = 0; i < 4; ++i) DX[i * n + j] = dx[i];
+    }
+}
+"""
+)

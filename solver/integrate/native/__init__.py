@@ -3,6 +3,8 @@
 * ``build.py`` -- compile and cache the library of a generated model;
 * ``batch.py`` -- many parameter points in one call (lockstep groups or point by point),
   the NumPy fallback without a compiler, and the compiled Lyapunov run;
+* ``maps.py`` -- the same engine for regime maps: Poincare points, extremes at every step,
+  the valid range and the exponent's tangent vector, with no Python step per point;
 * ``_native.c`` -- the integrators (DOPRI5, DOP853, RK4, Benettin), whose tableaux come
   from ``../tableau.py``.
 

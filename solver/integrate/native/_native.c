@@ -283,43 +283,101 @@ double gs_rhs_loop(const double *p, const double *x0, long long n, double dt)
  * The excitation terms are computed once per stage for the group (gs_rhs_batch) and the
  * per-point arithmetic vectorises.  The error norm of the group is the largest of its
  * points' norms, so every point meets the tolerance.  A point that diverges or turns
- * non-finite is marked, frozen and left out of the error norm. */
+ * non-finite is marked, frozen and left out of the error norm.
+ *
+ * One engine serves plain sampled runs (gs_run_lockstep) and maps (gs_map_lockstep): the
+ * group stops at t0 + (first + k) period / spp, k = 0 .. n_stops - 1, and `gs_extras`
+ * says what a map keeps at each stop and after each accepted step. */
 #include <stdlib.h>
 
-int gs_run_lockstep(int method, int npts, int group, const double *P, const double *X0,
-                    double t0, double period, int n_transient, int n_sample, int spp,
-                    double rtol, double atol, double bound, long long max_steps, double *OUT,
-                    long long *NFEV, long long *NSTEP, int *STATUS, double *TFAIL)
+#define GS_LEFT_RANGE 5
+
+typedef struct {
+    int n_state;         /* components of the physical state (GS_NX / 2 with a tangent) */
+    int tangent;         /* 1: components n_state .. 2 n_state - 1 are a tangent vector */
+    int first_kept;      /* stop from which Poincare points and extremes are kept */
+    int lyap_from;       /* log growth of the tangent is summed over stops after this one */
+    const double *range; /* n_state bounds |x_i| <= range[i] (the force law's valid range) */
+    double *poinc;       /* npts x (n_stops - first_kept) x n_state */
+    double *xmin;        /* npts x n_state, over accepted steps and stops in the window */
+    double *xmax;
+    double *lyap;        /* npts x (n_stops - 1 - lyap_from): running exponent */
+} gs_extras;
+
+/* Status of point j (structure of arrays, n points) after a step: bound and valid range on
+ * the physical state, finiteness on the rest. */
+static int gs_check_soa(const double *Y, int n, int j, double bound, const gs_extras *m)
+{
+    const int ns = m ? m->n_state : GS_NX;
+    for (int i = 0; i < GS_NX; ++i) {
+        const double y = Y[(long)i * n + j];
+        if (!isfinite(y)) return GS_NOT_FINITE;
+        if (i < ns && fabs(y) > bound) return GS_DIVERGENT;
+        if (i < ns && m && m->range && fabs(y) > m->range[i]) return GS_LEFT_RANGE;
+    }
+    return GS_OK;
+}
+
+static void gs_extremes(const double *Y, int n, int g0, const int *alive, const gs_extras *m)
+{
+    for (int j = 0; j < n; ++j) {
+        if (!alive[j]) continue;
+        double *lo = m->xmin + (long)(g0 + j) * m->n_state;
+        double *hi = m->xmax + (long)(g0 + j) * m->n_state;
+        for (int i = 0; i < m->n_state; ++i) {
+            const double y = Y[(long)i * n + j];
+            if (y < lo[i]) lo[i] = y;
+            if (y > hi[i]) hi[i] = y;
+        }
+    }
+}
+
+static int gs_lockstep(int method, int npts, int group, const double *P, const double *X0,
+                       double t0, double period, int first, int n_stops, int spp, double rtol,
+                       double atol, double bound, long long max_steps, double *OUT,
+                       long long *NFEV, long long *NSTEP, int *STATUS, double *TFAIL,
+                       const gs_extras *m)
 {
     const gs_tableau *T = method == 0 ? &GS_RK45 : &GS_DOP853;
-    const int ns = T->ns, n_out = n_sample * spp + 1;
+    const int ns = T->ns;
     const double exponent = -1.0 / (T->error_order + 1);
     if (group < 1) group = 1;
     const int G = group;
+    const int n_kept = m ? n_stops - m->first_kept : 0;
+    const int n_lyap = m && m->tangent ? n_stops - 1 - m->lyap_from : 0;
     double *Pg = malloc(sizeof(double) * GS_NP * G), *Qg = malloc(sizeof(double) * GS_NQ * G);
     double *Y = malloc(sizeof(double) * GS_NX * G), *YT = malloc(sizeof(double) * GS_NX * G);
     double *YN = malloc(sizeof(double) * GS_NX * G);
     double *K = malloc(sizeof(double) * (GS_MAXS + 1) * GS_NX * G);
     int *alive = malloc(sizeof(int) * G);
     double *E5s = malloc(sizeof(double) * G), *E3s = malloc(sizeof(double) * G);
-    if (!Pg || !Qg || !Y || !YT || !YN || !K || !alive || !E5s || !E3s) return -1;
+    double *growth = malloc(sizeof(double) * G);
+    if (!Pg || !Qg || !Y || !YT || !YN || !K || !alive || !E5s || !E3s || !growth) return -1;
     for (int g0 = 0; g0 < npts; g0 += G) {
         const int n = npts - g0 < G ? npts - g0 : G;
         long long nfev = 0, nsteps = 0;
         double h_abs = INFINITY, t = t0;
-        const double t_end = t0 + (double)(n_transient + n_sample) * period;
+        const double t_end = t0 + ((double)(first + n_stops - 1) / spp) * period;
         for (int j = 0; j < n; ++j) {
             const double *p = P + (long)(g0 + j) * GS_NP;
+            const double *x0 = X0 + (long)(g0 + j) * GS_NX;
             double q[GS_NQ], f[GS_NX];
             gs_prep(p, q);
             for (int k = 0; k < GS_NP; ++k) Pg[k * n + j] = p[k];
             for (int k = 0; k < GS_NQ; ++k) Qg[k * n + j] = q[k];
-            for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = X0[(long)(g0 + j) * GS_NX + i];
-            gs_rhs(t0, X0 + (long)(g0 + j) * GS_NX, p, q, f);
+            for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = x0[i];
+            gs_rhs(t0, x0, p, q, f);
             alive[j] = 1;
+            growth[j] = 0.0;
             STATUS[g0 + j] = GS_OK;
             TFAIL[g0 + j] = NAN;
-            int c = gs_check(X0 + (long)(g0 + j) * GS_NX, bound);
+            if (m) {
+                for (int i = 0; i < m->n_state; ++i) {
+                    m->xmin[(long)(g0 + j) * m->n_state + i] = INFINITY;
+                    m->xmax[(long)(g0 + j) * m->n_state + i] = -INFINITY;
+                }
+            }
+            int c = gs_check_soa(Y, n, j, bound, m);
             if (c == GS_OK) c = gs_check(f, INFINITY);
             if (c != GS_OK) {
                 alive[j] = 0;
@@ -328,16 +386,17 @@ int gs_run_lockstep(int method, int npts, int group, const double *P, const doub
                 for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = 0.0;
                 continue;
             }
-            const double h0 = gs_initial_step(t0, X0 + (long)(g0 + j) * GS_NX, f, t_end - t0,
-                                              T->error_order, rtol, atol, p, q, &nfev);
+            const double h0 = gs_initial_step(t0, x0, f, t_end - t0, T->error_order, rtol, atol,
+                                              p, q, &nfev);
             if (h0 < h_abs) h_abs = h0;
         }
         if (!isfinite(h_abs)) h_abs = 1e-6 * period;
         nfev = nfev / (n > 0 ? n : 1) + 1;
         gs_rhs_batch(t0, n, Y, Pg, Qg, K); /* K[0] = f(t0, y0) */
         int group_status = GS_OK;
-        for (int ko = 0; ko < n_out; ++ko) {
-            const double target = t0 + ((double)n_transient * spp + ko) * period / (double)spp;
+        for (int ko = 0; ko < n_stops; ++ko) {
+            const double target = t0 + (double)(first + ko) * period / (double)spp;
+            const int in_window = m && ko > m->first_kept;
             while (t < target && group_status == GS_OK) {
                 const double min_step = 10.0 * fabs(nextafter(t, INFINITY) - t);
                 double h = h_abs < min_step ? min_step : h_abs;
@@ -433,24 +492,64 @@ int gs_run_lockstep(int method, int npts, int group, const double *P, const doub
                 }
                 nsteps += 1;
                 if (nsteps >= max_steps && group_status == GS_OK) group_status = GS_TOO_MANY_STEPS;
+                int dead = 0;
                 for (int j = 0; j < n; ++j) {
                     if (!alive[j]) continue;
-                    double yj[GS_NX];
-                    for (int i = 0; i < GS_NX; ++i) yj[i] = Y[i * n + j];
-                    const int c = gs_check(yj, bound);
+                    const int c = gs_check_soa(Y, n, j, bound, m);
                     if (c != GS_OK) {
                         alive[j] = 0;
                         STATUS[g0 + j] = c;
                         TFAIL[g0 + j] = t;
                         for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = 0.0;
-                        gs_rhs_batch(t, n, Y, Pg, Qg, K); /* refresh FSAL stage */
+                        dead = 1;
                     }
                 }
+                if (dead) gs_rhs_batch(t, n, Y, Pg, Qg, K); /* refresh FSAL stage */
+                if (in_window) gs_extremes(Y, n, g0, alive, m);
             }
-            for (int j = 0; j < n; ++j) {
-                double *out = OUT + ((long)(g0 + j) * n_out + ko) * GS_NX;
-                const int ok = alive[j] && group_status == GS_OK;
-                for (int i = 0; i < GS_NX; ++i) out[i] = ok ? Y[i * n + j] : NAN;
+            const int group_ok = group_status == GS_OK;
+            if (OUT) {
+                const int n_out = n_stops;
+                for (int j = 0; j < n; ++j) {
+                    double *out = OUT + ((long)(g0 + j) * n_out + ko) * GS_NX;
+                    const int ok = alive[j] && group_ok;
+                    for (int i = 0; i < GS_NX; ++i) out[i] = ok ? Y[i * n + j] : NAN;
+                }
+            }
+            if (!m) continue;
+            if (ko >= m->first_kept) {
+                if (ko == m->first_kept) gs_extremes(Y, n, g0, alive, m);
+                for (int j = 0; j < n; ++j) {
+                    double *out = m->poinc + ((long)(g0 + j) * n_kept + ko - m->first_kept) *
+                                                 m->n_state;
+                    const int ok = alive[j] && group_ok;
+                    for (int i = 0; i < m->n_state; ++i) out[i] = ok ? Y[i * n + j] : NAN;
+                }
+            }
+            if (m->tangent && group_ok) {
+                /* Benettin: renormalise the tangent vector every stop, sum log |w| after
+                 * lyap_from; the FSAL stage changes with the rescaling. */
+                for (int j = 0; j < n; ++j) {
+                    if (!alive[j]) continue;
+                    double g = 0.0;
+                    for (int i = m->n_state; i < GS_NX; ++i) g += Y[(long)i * n + j] * Y[(long)i * n + j];
+                    g = sqrt(g);
+                    if (!(g > 0.0) || !isfinite(g)) {
+                        alive[j] = 0;
+                        STATUS[g0 + j] = GS_NOT_FINITE;
+                        TFAIL[g0 + j] = t;
+                        for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = 0.0;
+                        continue;
+                    }
+                    for (int i = m->n_state; i < GS_NX; ++i) Y[(long)i * n + j] /= g;
+                    if (ko > m->lyap_from) {
+                        growth[j] += log(g);
+                        m->lyap[(long)(g0 + j) * n_lyap + ko - m->lyap_from - 1] =
+                            growth[j] / ((double)(ko - m->lyap_from) * period / spp);
+                    }
+                }
+                gs_rhs_batch(t, n, Y, Pg, Qg, K);
+                nfev += 1;
             }
         }
         for (int j = 0; j < n; ++j) {
@@ -460,10 +559,44 @@ int gs_run_lockstep(int method, int npts, int group, const double *P, const doub
                 STATUS[g0 + j] = group_status;
                 TFAIL[g0 + j] = t;
             }
+            if (m && m->tangent && STATUS[g0 + j] != GS_OK)
+                for (int k = 0; k < n_lyap; ++k) m->lyap[(long)(g0 + j) * n_lyap + k] = NAN;
         }
     }
     free(Pg); free(Qg); free(Y); free(YT); free(YN); free(K); free(alive); free(E5s); free(E3s);
+    free(growth);
     return 0;
+}
+
+/* Sampled runs: OUT npts x (n_sample spp + 1) x GS_NX at t0 + (n_transient + k / spp) T. */
+int gs_run_lockstep(int method, int npts, int group, const double *P, const double *X0,
+                    double t0, double period, int n_transient, int n_sample, int spp,
+                    double rtol, double atol, double bound, long long max_steps, double *OUT,
+                    long long *NFEV, long long *NSTEP, int *STATUS, double *TFAIL)
+{
+    return gs_lockstep(method, npts, group, P, X0, t0, period, n_transient * spp,
+                       n_sample * spp + 1, spp, rtol, atol, bound, max_steps, OUT, NFEV, NSTEP,
+                       STATUS, TFAIL, 0);
+}
+
+/* Maps: stops at every period t0 + k T, k = 0 .. n_transient + n_sample.  Keeps the
+ * Poincare points of the last n_sample + 1 stops (POINC), the extremes of the physical
+ * state over the sampled window at every accepted step (XMIN, XMAX), the valid range
+ * (RANGE, or NULL) as a status, and with tangent = 1 (the variational library: X0 holds
+ * x and a tangent vector) the running largest Lyapunov exponent over the last n_lyap
+ * periods (LYAP npts x n_lyap). */
+int gs_map_lockstep(int method, int npts, int group, const double *P, const double *X0,
+                    double t0, double period, int n_transient, int n_sample, int tangent,
+                    int n_lyap, const double *RANGE, double rtol, double atol, double bound,
+                    long long max_steps, double *POINC, double *XMIN, double *XMAX,
+                    double *LYAP, long long *NFEV, long long *NSTEP, int *STATUS, double *TFAIL)
+{
+    const int n_stops = n_transient + n_sample + 1;
+    if (tangent && (n_lyap < 1 || n_lyap > n_stops - 1)) return -2;
+    gs_extras m = {tangent ? GS_NX / 2 : GS_NX, tangent, n_transient,
+                   tangent ? n_stops - 1 - n_lyap : 0, RANGE, POINC, XMIN, XMAX, LYAP};
+    return gs_lockstep(method, npts, group, P, X0, t0, period, 0, n_stops, 1, rtol, atol,
+                       bound, max_steps, 0, NFEV, NSTEP, STATUS, TFAIL, &m);
 }
 
 /* One right-hand-side evaluation (tests compare it with the NumPy code). */

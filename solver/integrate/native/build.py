@@ -174,6 +174,15 @@ def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
         ptr(np.float64, flags="C"), ptr(np.int64, flags="C"), ptr(np.int64, flags="C"),
         ptr(np.int32, flags="C"), ptr(np.float64, flags="C"),
     ]  # fmt: skip
+    lib.gs_map_lockstep.restype = i
+    lib.gs_map_lockstep.argtypes = [
+        i, i, i,
+        ptr(np.float64, flags="C"), ptr(np.float64, flags="C"),
+        d, d, i, i, i, i, ctypes.c_void_p, d, d, d, ll,
+        ptr(np.float64, flags="C"), ptr(np.float64, flags="C"), ptr(np.float64, flags="C"),
+        ctypes.c_void_p, ptr(np.int64, flags="C"), ptr(np.int64, flags="C"),
+        ptr(np.int32, flags="C"), ptr(np.float64, flags="C"),
+    ]  # fmt: skip
     lib.gs_eval.restype = None
     lib.gs_eval.argtypes = [
         d,

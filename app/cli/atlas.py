@@ -1,0 +1,236 @@
+"""``gearsym map``: regime maps over two parameters with several initial states."""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from pathlib import Path
+
+from ._common import Fail, parse_range, parse_set, system_of
+
+__all__ = ["register"]
+
+
+def register(sub) -> None:
+    mp = sub.add_parser(
+        "map",
+        help="regime map over two parameters: motion, exponent, coexisting attractors",
+        description="For every point of an x by y grid, integrate K initial states (the "
+        "previous x value's end state forward and backward, plus seeded random states) in "
+        "the compiled map engine, classify each run (motion per coordinate, largest "
+        "Lyapunov exponent, Max/Min, meshing regime) and group the runs into attractors. "
+        "Writes map.json, map.csv and five figures; resumes from DIR/store.",
+    )
+    mp.add_argument("scene", metavar="SCENE", help="a scene path or built-in name")
+    for axis in ("x", "y"):
+        mp.add_argument(
+            f"--{axis}",
+            required=True,
+            metavar="NAME=START:STOP:NUM",
+            help=f"the {axis} axis: a scene or model parameter (or an open value) and NUM "
+            "values from START to STOP",
+        )
+    mp.add_argument(
+        "--initial-states",
+        type=int,
+        default=4,
+        metavar="K",
+        help="initial states per grid point: forward, backward, then K - 2 random (default 4)",
+    )
+    mp.add_argument("--seed", type=int, default=0, help="seed of the random initial states")
+    mp.add_argument(
+        "--box",
+        action="append",
+        metavar="STATE=LO:HI",
+        help="where random initial states are drawn, per state (repeatable; default: "
+        "coordinates one half backlash beyond each contact edge, velocities in [-1, 1])",
+    )
+    mp.add_argument(
+        "--set", action="append", metavar="KEY=VALUE", help="set a scene or model parameter"
+    )
+    mp.add_argument("--method", choices=("dop853", "dopri5"), default="dop853")
+    mp.add_argument("--rtol", type=float, default=1e-8)
+    mp.add_argument("--atol", type=float, default=1e-10)
+    mp.add_argument("--transient", type=int, default=300, help="periods discarded")
+    mp.add_argument("--periods", type=int, default=100, help="periods sampled")
+    mp.add_argument(
+        "--lyapunov-periods",
+        type=int,
+        default=200,
+        help="the exponent is summed over the last N periods of the run (0: none)",
+    )
+    mp.add_argument("--executor", choices=("serial", "processes", "dask"), default="processes")
+    mp.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
+    mp.add_argument("--scheduler", metavar="ADDRESS", help="dask scheduler address")
+    mp.add_argument("--out", metavar="DIR", help="output folder (default map_<model>_<x>_<y>)")
+    mp.add_argument(
+        "--json",
+        action="store_true",
+        help="print one JSON record per (grid point, attractor) on stdout",
+    )
+    mp.add_argument("--quiet", action="store_true", help="no progress bar")
+    mp.set_defaults(func=_cmd_map)
+
+
+def _axis(text: str, flag: str):
+    name, sep, spec = text.partition("=")
+    if not sep or not name.strip():
+        raise Fail(f"{flag} {text}: expected NAME=START:STOP:NUM, for example lambda=0:1:51")
+    try:
+        values = parse_range(spec)
+    except Fail as err:
+        why = str(err).split(": ", 1)[1].split(" (write")[0]
+        raise Fail(
+            f"{flag} {text}: {why} (write {flag}={name}=-0.5:1:11 when START is negative)"
+        ) from None
+    return name.strip(), values
+
+
+def _box(items) -> dict:
+    out = {}
+    for item in items or []:
+        state, sep, spec = item.partition("=")
+        lo, sep2, hi = spec.partition(":")
+        try:
+            if not (sep and sep2):
+                raise ValueError
+            bounds = (float(lo), float(hi))
+        except ValueError:
+            raise Fail(f"--box {item}: expected STATE=LO:HI, for example --box=v=-2:2") from None
+        if not (all(map(math.isfinite, bounds)) and bounds[0] <= bounds[1]):
+            raise Fail(f"--box {item}: LO and HI must be finite with LO <= HI")
+        out[state.strip()] = bounds
+    return out
+
+
+def _resolver(scene: str, system, sets: dict, names: tuple[str, str]):
+    """System of one grid point: ordinary parameters by ``with_values``; open values
+    (those the derivation needs, when the derive layer knows them) through the resolver's
+    derivation cache, one model per distinct set of open values."""
+    try:
+        from gearsym.derive.open_values import is_open_value
+    except ImportError:  # a derive layer without open values
+
+        def is_open_value(_name: str) -> bool:
+            return False
+
+    open_axes = [n for n in names if is_open_value(n)]
+    if not open_axes:
+        return None
+    from gearsym.resolve import load
+
+    memo: dict = {}
+
+    def resolve(values: dict):
+        key = tuple((n, values[n]) for n in open_axes)
+        if key not in memo:
+            memo[key] = load(scene, **sets, **dict(key))
+        rest = {k: v for k, v in values.items() if k not in open_axes}
+        return memo[key].with_values(**rest)
+
+    return resolve
+
+
+def _cmd_map(args) -> int:
+    from gearsym.solver.plots_maps import map_figures
+    from gearsym.solver.sweep.atlas import regime_map
+
+    xn, xv = _axis(args.x, "--x")
+    yn, yv = _axis(args.y, "--y")
+    if xn == yn:
+        raise Fail(f"--x and --y name the same parameter '{xn}'; map two different ones")
+    if args.initial_states < 1:
+        raise Fail(f"--initial-states must be >= 1, got {args.initial_states}")
+    for name in ("transient", "lyapunov_periods"):
+        if getattr(args, name) < 0:
+            raise Fail(f"--{name.replace('_', '-')} must be >= 0")
+    if args.periods < 1:
+        raise Fail("--periods must be >= 1")
+    if args.lyapunov_periods > args.transient + args.periods:
+        raise Fail(
+            f"--lyapunov-periods {args.lyapunov_periods} is more than the run "
+            f"({args.transient} + {args.periods} periods); lower it or lengthen --transient"
+        )
+    if not (args.rtol > 0 and args.atol > 0):
+        raise Fail("--rtol and --atol must be positive numbers")
+    sets = parse_set(args.set)
+    box = _box(args.box)
+    system = system_of(args.scene, sets)
+    unknown = sorted(set(box) - set(system.states))
+    if unknown:
+        raise Fail(f"--box {unknown[0]}: not a state; states: {', '.join(system.states)}")
+    resolve = _resolver(args.scene, system, sets, (xn, yn))
+    first = resolve or (lambda v: system.with_values(**v))
+    for flag, name, values in (("--x", xn, xv), ("--y", yn, yv)):
+        try:
+            first({xn: xv[0], yn: yv[0]} | {name: values[0]})
+            first({xn: xv[-1], yn: yv[-1]} | {name: values[-1]})
+        except KeyError as err:
+            raise Fail(f"{flag} {name}: {err.args[0]}") from None
+        except ValueError as err:
+            raise Fail(f"{flag} {name}: {err}") from None
+    out = Path(args.out or f"map_{system.name}_{xn}_{yn}")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / ".write-test"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as err:
+        raise Fail(
+            f"--out {out}: cannot write there ({err.strerror}); choose another folder"
+        ) from None
+    stored = len(list((out / "store" / "columns").glob("*.json")))
+    try:
+        result = regime_map(
+            system,
+            (xn, xv),
+            (yn, yv),
+            initial_states=args.initial_states,
+            seed=args.seed,
+            box=box,
+            transient=args.transient,
+            periods=args.periods,
+            lyapunov_periods=args.lyapunov_periods,
+            method=args.method,
+            rtol=args.rtol,
+            atol=args.atol,
+            executor=args.executor,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            store=out / "store",
+            progress=not (args.quiet or args.json),
+            resolve=resolve,
+        )
+    except ValueError as err:
+        raise Fail(f"map: {err}") from None
+    json_path = result.save(out / "map.json")
+    result.save(out / "map.csv")
+    figures = map_figures(result, out)
+    if args.json:
+        from gearsym.solver._json import clean
+
+        for record in result.records():
+            sys.stdout.write(json.dumps(clean(record)) + "\n")
+        return 0
+    if stored:
+        print(f"resumed: {stored} finished columns came from {out / 'store'}")
+    _summary(result)
+    print(f"wrote {json_path}, map.csv and {len(figures)} figures in {out}")
+    return 0
+
+
+def _summary(m) -> None:
+    from collections import Counter
+
+    n = len(m.x_values) * len(m.y_values)
+    print(
+        f"{m.model}: {len(m.x_values)} x {len(m.y_values)} grid ({m.x} x {m.y}), "
+        f"{m.settings['initial_states']} initial states each, {m.wall_time:.1f} s"
+    )
+    for c in m.coordinates:
+        counts = Counter(m.grid("motion", c).ravel())
+        parts = ", ".join(f"{k} {v / n:.0%}" for k, v in counts.most_common())
+        print(f"  motion of {c} (dominant attractor): {parts}")
+    many = int((m.grid("attractors") > 1).sum())
+    print(f"  grid points with more than one outcome: {many} of {n}")

@@ -1,0 +1,197 @@
+"""From map runs to attractors: each run classified, runs of one grid point grouped.
+
+A run (one initial state at one grid point) is classified per mesh coordinate from its
+Poincare points and the exponent (``analysis.classify_points``), and its meshing regime
+is read from the extremes of each mesh coordinate against the contract's contact edges
+(Kahraman and Singh 1990, "Non-linear dynamics of a spur gear pair", J. Sound Vib. 142):
+
+* ``no impact``: the mesh stays in contact on one side the whole time;
+* ``single-sided impact``: it separates and comes back to the same flank;
+* ``double-sided impact``: it reaches both flanks (back-side impacts);
+* ``no contact``: it never reaches either flank in the window.
+
+Runs of one grid point reach the same attractor when they end with the same outcome
+(status, motion per coordinate) and
+
+* periodic: their last n Poincare points coincide as sets (up to a cyclic shift), within
+  ``same_tol`` times the size of the orbit;
+* otherwise: their extremes over the window agree within ``cloud_tol`` of the attractor's
+  size (a chaotic or quasi-periodic set sampled over 100 periods fills its bounding box to
+  within a few per cent; two distinct ones rarely share it).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..analysis.classify import classify_points
+from ..analysis.lyapunov import LyapunovEstimate
+
+__all__ = ["Attractor", "RunOutcome", "group_runs", "meshing_regime", "outcome"]
+
+SAME_TOL = 1e-4  # periodic orbits: Poincare sets closer than this (relative) are one
+CLOUD_TOL = 0.05  # non-periodic sets: extremes closer than this (relative) are one
+
+
+def meshing_regime(lo: float, hi: float, lower: float, upper: float) -> str:
+    """Kahraman and Singh's regime of a mesh coordinate with extremes ``lo``, ``hi`` and
+    contact edges ``lower < upper`` (contact beyond them)."""
+    if not (np.isfinite(lo) and np.isfinite(hi)):
+        return "undetermined"
+    front, back = hi > upper, lo < lower
+    if front and back:
+        return "double-sided impact"
+    if lo > upper or hi < lower:
+        return "no impact"
+    if front or back:
+        return "single-sided impact"
+    return "no contact"
+
+
+@dataclass(frozen=True)
+class RunOutcome:
+    """One run: start label, status, motion and period per coordinate, exponent with its
+    spread, extremes per state, meshing regime per mesh, the Poincare cloud's spread per
+    coordinate, and the last Poincare points (to compare runs and to restart from)."""
+
+    start: str
+    status: str
+    motion: dict
+    period: dict
+    lyapunov: float | None
+    lyapunov_spread: float | None
+    xmax: np.ndarray
+    xmin: np.ndarray
+    meshing: dict
+    spread: dict
+    tail: np.ndarray  # (m, n): the last Poincare points
+    evidence: dict = field(default_factory=dict)
+
+    @property
+    def key(self) -> tuple:
+        return (self.status, tuple(sorted(self.motion.items())))
+
+
+def outcome(
+    system, start: str, status: str, poincare, xmin, xmax, running, *, tol, rtol, atol
+) -> RunOutcome:
+    """Classify one run of a map (``poincare`` (K, n), ``running`` exponent or None)."""
+    c = system.contract
+    lyap = None
+    if running is not None and status == "ok" and np.all(np.isfinite(running)):
+        half = running[len(running) // 2 :]
+        lyap = LyapunovEstimate(
+            float(running[-1]),
+            running,
+            len(running),
+            float(half.max() - half.min()),
+            rtol,
+            atol,
+            "compiled DOP853 (map)",
+        )
+    motion, period, spread, evidence = {}, {}, {}, {}
+    for coord in system.coordinates:
+        i, j = c.index(coord), c.velocity(coord)
+        pts = poincare[:, [i, j]].T
+        spread[coord] = float(np.ptp(pts[0])) if np.all(np.isfinite(pts)) else None
+        if status == "ok":
+            v = classify_points(pts, tol=tol, lyapunov=lyap, period=system.period)
+            motion[coord], period[coord] = v.motion, v.period
+            if "why" in v.evidence:
+                evidence[coord] = v.evidence["why"]
+        else:
+            motion[coord] = "divergent" if status == "divergent" else "undetermined"
+            period[coord] = None
+    meshing = {}
+    for coord, (lower, upper) in c.contact.items():
+        k = c.index(coord)
+        meshing[coord] = (
+            meshing_regime(xmin[k], xmax[k], lower, upper) if status == "ok" else "undetermined"
+        )
+    return RunOutcome(
+        start=start,
+        status=status,
+        motion=motion,
+        period=period,
+        lyapunov=None if lyap is None else lyap.exponent,
+        lyapunov_spread=None if lyap is None else lyap.spread,
+        xmax=np.asarray(xmax, float),
+        xmin=np.asarray(xmin, float),
+        meshing=meshing,
+        spread=spread,
+        tail=np.asarray(poincare[-min(len(poincare), 2 * 32) :], float),
+        evidence=evidence,
+    )
+
+
+@dataclass(frozen=True)
+class Attractor:
+    """An attractor (or a failure outcome: divergent, left the valid range) at one grid
+    point, with the share of initial states that reached it and which ones."""
+
+    share: float
+    starts: tuple[str, ...]
+    run: RunOutcome
+
+    def to_dict(self, states) -> dict:
+        r = self.run
+        return {
+            "share": self.share,
+            "starts": list(self.starts),
+            "status": r.status,
+            "motion": dict(r.motion),
+            "period": dict(r.period),
+            "lyapunov": r.lyapunov,
+            "lyapunov_spread": r.lyapunov_spread,
+            "max": dict(zip(states, map(float, r.xmax), strict=True)),
+            "min": dict(zip(states, map(float, r.xmin), strict=True)),
+            "meshing": dict(r.meshing),
+            "poincare_spread": dict(r.spread),
+            "state": [float(v) for v in r.tail[-1]],
+            **({"why": dict(r.evidence)} if r.evidence else {}),
+        }
+
+
+def _cycle(run: RunOutcome) -> int | None:
+    """The common period of all coordinates (their least common multiple), or None."""
+    periods = list(run.period.values())
+    if run.status != "ok" or not periods or any(p is None for p in periods):
+        return None
+    return int(np.lcm.reduce(periods))
+
+
+def same_attractor(a: RunOutcome, b: RunOutcome) -> bool:
+    if a.key != b.key:
+        return False
+    if a.status != "ok":
+        return True  # one failure outcome per kind
+    n = _cycle(a)
+    if n is not None and n <= min(len(a.tail), len(b.tail)):
+        A, B = a.tail[-n:], b.tail[-n:]
+        size = max(float(np.ptp(np.vstack([A, B]), axis=0).max()), 1.0)
+        gaps = [np.abs(A - np.roll(B, s, axis=0)).max() for s in range(n)]
+        return min(gaps) <= SAME_TOL * size
+    size = max(float(np.max(a.xmax - a.xmin)), float(np.max(b.xmax - b.xmin)), 1e-12)
+    gap = max(np.abs(a.xmax - b.xmax).max(), np.abs(a.xmin - b.xmin).max())
+    return gap <= CLOUD_TOL * size
+
+
+def group_runs(runs: list[RunOutcome]) -> list[Attractor]:
+    """Group the runs of one grid point into attractors, largest share first (ties: the
+    order of the starts, so the forward start's attractor comes first)."""
+    groups: list[list[RunOutcome]] = []
+    for r in runs:
+        for g in groups:
+            if same_attractor(g[0], r):
+                g.append(r)
+                break
+        else:
+            groups.append([r])
+    total = max(len(runs), 1)
+    order = sorted(range(len(groups)), key=lambda k: -len(groups[k]))
+    return [
+        Attractor(len(groups[k]) / total, tuple(r.start for r in groups[k]), groups[k][0])
+        for k in order
+    ]

@@ -1,0 +1,208 @@
+"""The result of a regime map: per grid point its attractors; records, grids and files."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .attractors import Attractor, RunOutcome
+
+__all__ = ["Cell", "RegimeMap", "outcome_from_dict", "outcome_to_dict"]
+
+
+def outcome_to_dict(r: RunOutcome) -> dict:
+    return {
+        "start": r.start,
+        "status": r.status,
+        "motion": r.motion,
+        "period": r.period,
+        "lyapunov": r.lyapunov,
+        "lyapunov_spread": r.lyapunov_spread,
+        "xmax": r.xmax.tolist(),
+        "xmin": r.xmin.tolist(),
+        "meshing": r.meshing,
+        "spread": r.spread,
+        "tail": r.tail.tolist(),
+        "evidence": r.evidence,
+    }
+
+
+def outcome_from_dict(d: dict) -> RunOutcome:
+    def arr(v):
+        return np.array([np.nan if e is None else e for e in v], dtype=float)
+
+    tail = np.array([[np.nan if e is None else e for e in row] for row in d["tail"]], float)
+    return RunOutcome(
+        start=d["start"],
+        status=d["status"],
+        motion=dict(d["motion"]),
+        period=dict(d["period"]),
+        lyapunov=d["lyapunov"],
+        lyapunov_spread=d["lyapunov_spread"],
+        xmax=arr(d["xmax"]),
+        xmin=arr(d["xmin"]),
+        meshing=dict(d["meshing"]),
+        spread=dict(d["spread"]),
+        tail=tail,
+        evidence=dict(d.get("evidence", {})),
+    )
+
+
+@dataclass(frozen=True)
+class Cell:
+    """One grid point: its two values and its attractors (largest share first)."""
+
+    x: float
+    y: float
+    attractors: tuple[Attractor, ...]
+
+    @property
+    def dominant(self) -> Attractor:
+        return self.attractors[0]
+
+
+@dataclass(frozen=True)
+class RegimeMap:
+    """Attractors over an x by y grid (``cells[ix][iy]``), with the settings that made it.
+
+    ``grid(field, state)`` gives a (ny, nx) array of the dominant attractor's value
+    (the one most initial states reached; ties go to the forward start):
+    ``motion``, ``period``, ``meshing`` (per coordinate), ``max``, ``min``,
+    ``poincare_spread`` (per state / coordinate), ``lyapunov``, ``attractors`` (count).
+    """
+
+    model: str
+    model_hashes: tuple[str, ...]
+    x: str
+    x_values: np.ndarray
+    y: str
+    y_values: np.ndarray
+    states: tuple[str, ...]
+    coordinates: tuple[str, ...]
+    values: dict
+    settings: dict
+    cells: tuple[tuple[Cell, ...], ...]
+    wall_time: float
+    digest: str = ""
+
+    @property
+    def meshes(self) -> tuple[str, ...]:
+        """The coordinates with contact edges (a meshing regime)."""
+        return tuple(c for c in self.coordinates if c in self.cells[0][0].dominant.run.meshing)
+
+    def records(self) -> list[dict]:
+        """One record per (grid point, attractor), the two values under their names."""
+        out = []
+        for column in self.cells:
+            for cell in column:
+                for k, a in enumerate(cell.attractors):
+                    out.append(
+                        {
+                            self.x: cell.x,
+                            self.y: cell.y,
+                            "attractor": k,
+                            "attractors": len(cell.attractors),
+                            **a.to_dict(self.states),
+                        }
+                    )
+        return out
+
+    def grid(self, field: str, key: str | None = None) -> np.ndarray:
+        def value(cell: Cell):
+            if field == "attractors":  # attractors proper: failures are not counted
+                return sum(a.run.status == "ok" for a in cell.attractors)
+            d = cell.dominant.to_dict(self.states)[field]
+            return d if key is None else d.get(key)
+
+        rows = [[value(self.cells[ix][iy]) for ix in range(len(self.x_values))]
+                for iy in range(len(self.y_values))]  # fmt: skip
+        if field in ("motion", "meshing", "status"):
+            return np.array(rows, dtype=object)
+        return np.array([[np.nan if v is None else v for v in r] for r in rows], dtype=float)
+
+    def to_dict(self) -> dict:
+        return {
+            "kind": "regime map",
+            "model": self.model,
+            "model_hashes": list(self.model_hashes),
+            "x": {"name": self.x, "values": self.x_values.tolist()},
+            "y": {"name": self.y, "values": self.y_values.tolist()},
+            "states": list(self.states),
+            "coordinates": list(self.coordinates),
+            "values": self.values,
+            "settings": self.settings,
+            "wall_time_s": self.wall_time,
+            "records": self.records(),
+        }
+
+    def to_table(self) -> tuple[list, list]:
+        columns = [self.x, self.y, "attractor", "attractors", "share", "status", "lyapunov"]
+        columns += [f"motion_{c}" for c in self.coordinates]
+        columns += [f"meshing_{c}" for c in self.coordinates]
+        columns += [f"max_{s}" for s in self.states] + [f"min_{s}" for s in self.states]
+        rows = []
+        for r in self.records():
+            rows.append(
+                [r[self.x], r[self.y], r["attractor"], r["attractors"], r["share"]]
+                + [r["status"], r["lyapunov"]]
+                + [r["motion"][c] for c in self.coordinates]
+                + [r["meshing"].get(c) for c in self.coordinates]
+                + [r["max"][s] for s in self.states]
+                + [r["min"][s] for s in self.states]
+            )
+        return columns, rows
+
+    def save(self, path) -> Path:
+        from ..export import save
+
+        return save(self, path)
+
+    @classmethod
+    def load(cls, path) -> RegimeMap:
+        """A map saved with ``save(... .json)`` (the attractors' tails are not kept: one
+        Poincare point per attractor, its ``state``)."""
+        d = json.loads(Path(path).read_text(encoding="utf-8"))
+        if d.get("kind") != "regime map":
+            raise ValueError(f"{path} is not a saved regime map")
+        x, y = d["x"]["name"], d["y"]["name"]
+        xv, yv = np.array(d["x"]["values"]), np.array(d["y"]["values"])
+        states = tuple(d["states"])
+        cells: dict = {}
+        for r in d["records"]:
+            run = RunOutcome(
+                start=r["starts"][0],
+                status=r["status"],
+                motion=r["motion"],
+                period=r["period"],
+                lyapunov=r["lyapunov"],
+                lyapunov_spread=r["lyapunov_spread"],
+                xmax=np.array([r["max"][s] for s in states], float),
+                xmin=np.array([r["min"][s] for s in states], float),
+                meshing=r["meshing"],
+                spread=r["poincare_spread"],
+                tail=np.array([r["state"]], float),
+                evidence=r.get("why", {}),
+            )
+            key = (float(r[x]), float(r[y]))
+            cells.setdefault(key, []).append(Attractor(r["share"], tuple(r["starts"]), run))
+        grid = tuple(
+            tuple(Cell(float(a), float(b), tuple(cells[(float(a), float(b))])) for b in yv)
+            for a in xv
+        )
+        return cls(
+            d["model"],
+            tuple(d["model_hashes"]),
+            x,
+            xv,
+            y,
+            yv,
+            states,
+            tuple(d["coordinates"]),
+            d["values"],
+            d["settings"],
+            grid,
+            d["wall_time_s"],
+        )
