@@ -7,8 +7,8 @@ Three pieces of evidence are weighed:
    ``tol`` follows the integrator's tolerance (``max(1e-6, 1e3 rtol)`` times the size
    of the point cloud, at least 1e-3 of it for fixed-step methods).
 2. **The largest Lyapunov exponent** of the whole system (variational equations): > 0
-   chaotic, ~ 0 quasi-periodic, < 0 periodic.  "~ 0" is judged against its own finite-time
-   fluctuation.
+   chaotic, ~ 0 quasi-periodic, < 0 periodic.  "~ 0" is judged against its stated
+   uncertainty (``lyapunov.uncertainty``), never finer than a growth of e^0.02 per period.
 3. **The correlation dimension** of the Poincare set (Grassberger and Procaccia 1983,
    "Characterization of strange attractors", PRL 50): ~ 0 for a finite set of points, ~ 1
    for the closed curve a two-frequency torus leaves (0.85 to 1.15 is read as a curve),
@@ -16,6 +16,14 @@ Three pieces of evidence are weighed:
    cross-check.  Alone it is weak: Henon's attractor has 1.21.
 
 When the evidence disagrees the verdict is ``undetermined`` and says why.
+
+The evidence always holds the extent (max - min) of the Poincare cloud in the coordinate
+and in its velocity (``poincare_extent``): a coordinate slaved to a chaotic one inherits
+its verdict, but a cloud of extent 1e-4 half backlashes is a different thing from one of
+extent 1, and a reader weighs "quasi-periodic" or "chaotic" against it.  The correlation
+dimension needs points: with fewer than ``DIMENSION_POINTS`` (400) the evidence says so
+(``sample_limit``); ``analyse_point`` extends the sample to that size before deciding a
+non-periodic verdict.
 """
 
 from __future__ import annotations
@@ -26,10 +34,18 @@ import numpy as np
 
 from .lyapunov import LyapunovEstimate
 
-__all__ = ["Classification", "classify_points", "correlation_dimension", "periodicity"]
+__all__ = [
+    "DIMENSION_POINTS",
+    "Classification",
+    "classify_points",
+    "correlation_dimension",
+    "extent",
+    "periodicity",
+]
 
 MAX_PERIOD = 32
 CURVE = (0.85, 1.15)  # correlation dimensions read as a closed curve
+DIMENSION_POINTS = 400  # fewer points: the correlation dimension is stated as limited
 
 
 @dataclass(frozen=True)
@@ -78,6 +94,14 @@ def correlation_dimension(points: np.ndarray) -> float | None:
     return float(slope)
 
 
+def extent(points: np.ndarray) -> dict:
+    """Max - min of the Poincare points (d, K) in the coordinate and in its velocity."""
+    if points.shape[1] == 0:
+        return {"displacement": None, "velocity": None}
+    ptp = np.ptp(points, axis=1)
+    return {"displacement": float(ptp[0]), "velocity": float(ptp[1]) if ptp.size > 1 else None}
+
+
 def distinct_points(points: np.ndarray, tol: float) -> int:
     """Number of clusters of points closer than ``tol`` (greedy; enough to tell a finite
     set of points from a curve or a cloud)."""
@@ -110,6 +134,7 @@ def classify_points(
         evidence["spectrum_peaks"] = spectrum_peaks
     if divergent or not np.all(np.isfinite(points)):
         return Classification("divergent", None, evidence)
+    evidence["poincare_extent"] = extent(points)
     # Relative to the cloud's size, but never finer than `tol` in absolute terms: the
     # coordinates are in half backlashes, O(1).
     scale = max(float(np.ptp(points, axis=1).max()), 1.0)
@@ -122,7 +147,7 @@ def classify_points(
     if lyapunov is not None:
         evidence["lyapunov"] = lyapunov.describe()
         floor = 0.02 / period if period else 2e-3
-        margin = max(floor, 3.0 * lyapunov.spread)
+        margin = max(floor, lyapunov.uncertainty)
         lam = (
             "positive"
             if lyapunov.exponent > margin
@@ -142,6 +167,12 @@ def classify_points(
             f"a finite set of {clusters} points: a period above {MAX_PERIOD}, or not settled"
         )
         return Classification("undetermined", None, evidence)
+    if points.shape[1] < DIMENSION_POINTS:
+        evidence["sample_limit"] = (
+            f"correlation dimension from {points.shape[1]} Poincare points; below "
+            f"{DIMENSION_POINTS} it is noisy and biased low, so a curve and a strange "
+            "attractor are told apart mainly by the exponent"
+        )
     # A torus section is a closed curve, dimension 1; the window is narrow because strange
     # attractors can sit close to it (Henon's map: 1.21).
     curve = dim is not None and CURVE[0] <= dim <= CURVE[1]

@@ -2,15 +2,25 @@
 
 ``analyse_point`` is the convenience call on top of :func:`simulate`,
 :func:`largest_lyapunov` and :func:`classify_points`; sweeps call it once per point.
+
+Adaptive Poincare sample: a coordinate whose verdict from the sampled window is not
+period-n (chaotic, quasi-periodic or undetermined) is classified again on at least
+``dimension_points`` (default 400) Poincare points, the run being continued from its end
+state for the missing periods: the correlation dimension that tells a torus section from
+a strange attractor is unreliable on 100 points.  The evidence records the count
+(``poincare_points``, ``extended_from``); ``dimension_points=0`` keeps the window's
+points and the evidence states the limit instead (``sample_limit``).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..integrate import Trajectory, get_method, simulate
 from ..system import System
-from .classify import Classification, classify_points
+from .classify import DIMENSION_POINTS, Classification, classify_points
 from .lyapunov import LyapunovEstimate, largest_lyapunov
 from .spectra import extremes, meshing_states, spectrum
 
@@ -76,10 +86,13 @@ def analyse_point(
     lyapunov_periods: int = 200,
     steps_per_period: int = 512,
     on_invalid: str = "warn",
+    dimension_points: int = DIMENSION_POINTS,
 ) -> PointResult:
     """Simulate, estimate the largest exponent from the end state, classify each mesh.
 
     ``method`` defaults to the fastest that meets ``rtol`` (see :func:`simulate`).
+    ``dimension_points``: Poincare points a non-periodic verdict is decided on (the run
+    is extended when the window has fewer; 0: never extend, see the module docstring).
     """
     tr = simulate(
         system,
@@ -126,4 +139,33 @@ def analyse_point(
             period=system.period,
             spectrum_peaks=spectrum(tr, c).peaks() if tr.status == "ok" else None,
         )
+    unsettled = [c for c, k in verdicts.items() if k.period is None and k.motion != "divergent"]
+    more = dimension_points - tr.poincare.shape[1]
+    if unsettled and more > 0 and tr.status == "ok":
+        ext = simulate(
+            system,
+            tr.x_final,
+            method=tr.method,
+            rtol=rtol,
+            atol=atol,
+            t0=tr.t_final,
+            transient=0,
+            periods=more,
+            samples_per_period=1,
+            steps_per_period=steps_per_period,
+            on_invalid=on_invalid,
+        )
+        if ext.status == "ok":
+            poincare = np.concatenate([tr.poincare, ext.poincare], axis=1)
+            for c in unsettled:
+                i, j = system.index(c), system.velocity_index(c)
+                k = classify_points(
+                    poincare[[i, j]],
+                    tol=tol,
+                    lyapunov=lyap,
+                    period=system.period,
+                    spectrum_peaks=verdicts[c].evidence.get("spectrum_peaks"),
+                )
+                k.evidence["extended_from"] = int(tr.poincare.shape[1])
+                verdicts[c] = k
     return PointResult(tr, lyap, verdicts)

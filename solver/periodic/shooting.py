@@ -10,6 +10,14 @@ by the damped Newton method of ``newton.py`` with the flow's Jacobian.  The resi
 pure function :func:`residual` of the segment states, the period and the parameter
 vector; the monodromy matrix (the product of the segment Jacobians) gives the Floquet
 multipliers (``floquet.py``).
+
+Minimal period.  A fixed point of ``phi_{nT}`` may be one of ``phi_{mT}`` for a divisor m
+of n: shooting for period 3 from a guess near the period-1 orbit converges to it.
+:func:`shoot` therefore records the orbit's minimal period (the smallest divisor m with
+``phi_{mT}(x0) = x0``); :meth:`Orbit.reduced` re-solves such an orbit at its own period,
+so that its multipliers are those of period m, not their n/m-th powers; and
+:func:`search` tries guess after guess until it finds an orbit whose minimal period is
+the requested one, returning the lower-period orbit (and saying so) when none is.
 """
 
 from __future__ import annotations
@@ -23,7 +31,16 @@ from .floquet import Floquet, floquet
 from .flow import FlowMap
 from .newton import NewtonError, newton
 
-__all__ = ["Floquet", "Orbit", "ShootingError", "floquet", "residual", "shoot"]
+__all__ = [
+    "Floquet",
+    "Orbit",
+    "OrbitSearch",
+    "ShootingError",
+    "floquet",
+    "residual",
+    "search",
+    "shoot",
+]
 
 ShootingError = NewtonError  # what shooting raises: the history says how far it got
 
@@ -42,6 +59,7 @@ class Orbit:
     monodromy: np.ndarray | None = None
     floquet: Floquet | None = None
     segments: int = 1
+    minimal_period: int | None = None  # smallest m | n with phi_{mT}(x0) = x0 (None: unchecked)
 
     @property
     def period(self) -> float:
@@ -50,6 +68,7 @@ class Orbit:
     def describe(self) -> dict:
         return {
             "period_multiple": self.n,
+            "minimal_period_multiple": self.minimal_period,
             "period_tau": self.period,
             "t0": self.t0,
             "x0": dict(zip(self.system.states, map(float, self.x0), strict=True)),
@@ -72,15 +91,19 @@ class Orbit:
 
     def smallest_period(self, flow: FlowMap | None = None, tol: float = 1e-8) -> int:
         """The smallest m dividing n with ``phi_{mT}(x0) = x0`` (to ``tol`` relative to
-        the state's size): a period-n orbit found by shooting may be a period-m one."""
-        flow = flow or FlowMap(self.system)
-        scale = max(1.0, float(np.max(np.abs(self.x0))))
-        for m in range(1, self.n):
-            if self.n % m == 0:
-                end = flow(self.x0, m * self.system.period, self.t0, self.system.p)
-                if np.max(np.abs(end - self.x0)) <= tol * scale:
-                    return m
-        return self.n
+        the state's size): a period-n orbit found by shooting may be a period-m one.
+        :func:`shoot` already records it as ``minimal_period``."""
+        return _minimal_period(
+            flow or FlowMap(self.system), self.system, self.x0, self.n, self.t0, tol
+        )
+
+    def reduced(self, **shoot_options) -> Orbit:
+        """This orbit solved again at its minimal period (itself when that is n), so
+        that its Floquet multipliers are the period-m ones."""
+        m = self.minimal_period or self.n
+        if m == self.n:
+            return self
+        return shoot(self.system, self.x0, m, t0=self.t0, **shoot_options)
 
     def to_table(self) -> tuple[list, list]:
         """One row per Floquet multiplier: real and imaginary parts, modulus."""
@@ -176,6 +199,10 @@ def shoot(
     for Mk, qk in found.extra:
         M = Mk @ M
         q += qk
+    x = found.z[:N].copy()
+    # The Newton tolerance sets how closely a lower period must close the orbit too.
+    close = max(1e-8, 1e3 * tol)
+    minimal = _minimal_period(flow, system, x, n, t0, close)
     return Orbit(
         system,
         found.z[:N].copy(),
@@ -185,6 +212,72 @@ def shoot(
         found.steps,
         found.history,
         M,
-        floquet(M, q),
+        floquet(M, q, rtol=flow.rtol),
         segments,
+        minimal,
     )
+
+
+def _minimal_period(flow: FlowMap, system: System, x0, n: int, t0: float, tol: float) -> int:
+    """The smallest divisor m of n with ``|phi_{mT}(x0) - x0| <= tol max(1, |x0|)``."""
+    scale = max(1.0, float(np.max(np.abs(x0))))
+    for m in range(1, n):
+        if n % m == 0:
+            end = flow(x0, m * system.period, t0, system.p)
+            if np.max(np.abs(end - x0)) <= tol * scale:
+                return m
+    return n
+
+
+@dataclass(frozen=True)
+class OrbitSearch:
+    """What :func:`search` found: ``orbit`` of minimal period ``requested`` (or None),
+    else ``lower``, the first lower-period orbit the guesses led to (solved at its own
+    period), and one record per guess tried."""
+
+    requested: int
+    orbit: Orbit | None
+    lower: Orbit | None
+    attempts: list = field(default_factory=list)
+
+    @property
+    def found(self) -> bool:
+        return self.orbit is not None
+
+    def to_dict(self) -> dict:
+        best = self.orbit or self.lower
+        return {
+            "requested_period_multiple": self.requested,
+            "found": self.found,
+            "attempts": self.attempts,
+            "orbit": None if best is None else best.to_dict(),
+        }
+
+
+def search(system: System, n: int, guesses, **shoot_options) -> OrbitSearch:
+    """Shoot for period n from each guess in turn until the orbit's minimal period is n.
+
+    ``guesses`` is an iterable of states (it may be lazy: a guess that costs a settling
+    simulation is made only when needed).  Raises :class:`ShootingError` when no guess
+    converges at all."""
+    attempts, lower, last = [], None, None
+    for k, guess in enumerate(guesses):
+        try:
+            orbit = shoot(system, guess, n, **shoot_options)
+        except NewtonError as err:
+            attempts.append({"guess": k, "outcome": f"no convergence: {err}"})
+            last = err
+            continue
+        m = orbit.minimal_period or n
+        attempts.append({"guess": k, "outcome": f"period-{m}"})
+        if m == n:
+            return OrbitSearch(n, orbit, None, attempts)
+        if lower is None:
+            lower = orbit.reduced(**shoot_options)
+    if lower is None:
+        tried = len(attempts)
+        raise NewtonError(
+            f"no guess converged ({tried} tried); last: {last}",
+            [] if last is None else last.history,
+        )
+    return OrbitSearch(n, None, lower, attempts)
