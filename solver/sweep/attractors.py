@@ -53,7 +53,7 @@ def meshing_regime(lo: float, hi: float, lower: float, upper: float) -> str:
 @dataclass(frozen=True)
 class RunOutcome:
     """One run: start label, status, motion and period per coordinate, exponent with its
-    spread, extremes per state, meshing regime per mesh, the Poincare cloud's spread per
+    uncertainty (``analysis.lyapunov.uncertainty``), extremes per state, meshing regime per mesh, the Poincare cloud's spread per
     coordinate, and the last Poincare points (to compare runs and to restart from)."""
 
     start: str
@@ -61,7 +61,7 @@ class RunOutcome:
     motion: dict
     period: dict
     lyapunov: float | None
-    lyapunov_spread: float | None
+    lyapunov_uncertainty: float | None  # a bound on the exponent's error (about 95 %)
     xmax: np.ndarray
     xmin: np.ndarray
     meshing: dict
@@ -90,6 +90,7 @@ def outcome(
             rtol,
             atol,
             "compiled DOP853 (map)",
+            system.period,
         )
     motion, period, spread, evidence = {}, {}, {}, {}
     for coord in system.coordinates:
@@ -116,7 +117,7 @@ def outcome(
         motion=motion,
         period=period,
         lyapunov=None if lyap is None else lyap.exponent,
-        lyapunov_spread=None if lyap is None else lyap.spread,
+        lyapunov_uncertainty=None if lyap is None else lyap.uncertainty,
         xmax=np.asarray(xmax, float),
         xmin=np.asarray(xmin, float),
         meshing=meshing,
@@ -144,7 +145,7 @@ class Attractor:
             "motion": dict(r.motion),
             "period": dict(r.period),
             "lyapunov": r.lyapunov,
-            "lyapunov_spread": r.lyapunov_spread,
+            "lyapunov_uncertainty": r.lyapunov_uncertainty,
             "max": dict(zip(states, map(float, r.xmax), strict=True)),
             "min": dict(zip(states, map(float, r.xmin), strict=True)),
             "meshing": dict(r.meshing),
