@@ -53,8 +53,9 @@ def meshing_regime(lo: float, hi: float, lower: float, upper: float) -> str:
 @dataclass(frozen=True)
 class RunOutcome:
     """One run: start label, status, motion and period per coordinate, exponent with its
-    uncertainty (``analysis.lyapunov.uncertainty``), extremes per state, meshing regime per mesh, the Poincare cloud's spread per
-    coordinate, and the last Poincare points (to compare runs and to restart from)."""
+    uncertainty (``analysis.lyapunov.uncertainty``), extremes per state, meshing regime
+    per mesh, the Poincare cloud's spread per coordinate, and the last Poincare points (to
+    compare runs and to restart from)."""
 
     start: str
     status: str
