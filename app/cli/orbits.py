@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ._common import Fail, orbit_guess, parse_set, system_of, write_json
+from ._start import resolve_start, start_options
 
 __all__ = ["register"]
 
@@ -17,12 +18,24 @@ def register(sub) -> None:
         "shoot",
         help="find a periodic orbit by shooting; Floquet multipliers",
         description="Find the period-n orbit (period n T) by Newton shooting "
-        "from a simulated guess, with its Floquet multipliers, stability and "
-        "Liouville check.",
+        "from a simulated guess (or --x0 / --from-sweep), with its Floquet multipliers, "
+        "stability judged within the monodromy's estimated error, and Liouville check. "
+        "The orbit's minimal period is checked: when a guess leads to an orbit of lower "
+        "period, --tries more guesses settled from seeded random states are tried; when "
+        "none has minimal period n, the lower-period orbit is reported as what it is "
+        "and the exit status is 1.",
     )
     sh.add_argument("scene", metavar="SCENE")
     sh.add_argument("--set", action="append", metavar="KEY=VALUE")
     sh.add_argument("--period", type=int, default=1, help="n: the orbit's period is n T")
+    sh.add_argument(
+        "--tries",
+        type=int,
+        default=6,
+        help="more guesses when the first leads to a lower period (default 6)",
+    )
+    sh.add_argument("--seed", type=int, default=0, help="seed of those guesses' random starts")
+    start_options(sh)
     sh.add_argument("--segments", type=int, default=1, help="multiple shooting segments")
     sh.add_argument(
         "--monodromy",
@@ -35,7 +48,13 @@ def register(sub) -> None:
         action="store_true",
         help="also compute the monodromy the other two ways and compare",
     )
-    sh.add_argument("--settle", type=int, default=300, help="periods simulated for the guess")
+    sh.add_argument(
+        "--settle",
+        type=int,
+        default=None,
+        help="periods n T simulated for the guess (default 300; 0 with --x0 or "
+        "--from-sweep: their state is the guess as given)",
+    )
     sh.add_argument("--json", action="store_true")
     sh.add_argument("--out", metavar="DIR", help="also write orbit.json and multipliers.png")
     sh.set_defaults(func=_cmd_shoot)
@@ -63,22 +82,68 @@ def register(sub) -> None:
     co.set_defaults(func=_cmd_continue)
 
 
+def _guesses(system, n: int, first, tries: int, seed: int, settle: int):
+    """The first guess, then states settled for ``settle`` n T from seeded random starts
+    in a box around it (made lazily: only when the first leads to a lower period)."""
+    from gearsym.solver.integrate import SimulationError, simulate
+
+    yield first
+    rng = np.random.default_rng(seed)
+    half = max(1.0, float(np.max(np.abs(first))))
+    for _ in range(tries):
+        x = first + rng.uniform(-half, half, size=first.size)
+        try:
+            run = simulate(system, x, transient=max(settle, 1) * n, periods=1, samples_per_period=1)
+        except (SimulationError, ValueError):
+            continue
+        if run.status == "ok":
+            yield run.x_final
+
+
 def _cmd_shoot(args) -> int:
     from gearsym.solver._json import dumps
-    from gearsym.solver.periodic import ShootingError, shoot
+    from gearsym.solver.integrate import SimulationError, simulate
+    from gearsym.solver.periodic import ShootingError
+    from gearsym.solver.periodic.shooting import search
 
     if args.period < 1 or args.segments < 1:
         raise Fail("--period and --segments must be whole numbers >= 1")
-    system = system_of(args.scene, parse_set(args.set))
-    guess = orbit_guess(system, args.period, args.settle)
+    if args.tries < 0:
+        raise Fail(f"--tries must be >= 0, got {args.tries}")
+    start = resolve_start(args)
+    system = start.system
+    if start.x0 is None:
+        settle = 300 if args.settle is None else args.settle
+        guess = orbit_guess(system, args.period, settle)
+    else:
+        settle = 0 if args.settle is None else args.settle
+        if settle < 0:
+            raise Fail(f"--settle must be >= 0, got {settle}")
+        guess = start.x0
+        if settle:
+            try:
+                run = simulate(
+                    system, guess, transient=settle * args.period, periods=1, samples_per_period=1
+                )
+            except (SimulationError, ValueError) as err:
+                raise Fail(f"shoot: settling from {start.source} failed: {err}") from None
+            if run.status != "ok":
+                raise Fail(f"shoot: settling from {start.source} ended {run.status}")
+            guess = run.x_final
+    tries = args.tries if args.period > 1 else 0
+    guesses = _guesses(system, args.period, guess, tries, args.seed, max(settle, 300))
     try:
-        orbit = shoot(system, guess, args.period, segments=args.segments, monodromy=args.monodromy)
+        found = search(
+            system, args.period, guesses, segments=args.segments, monodromy=args.monodromy
+        )
     except ShootingError as err:
         raise Fail(f"shoot: {err}; residuals {[f'{r:.2g}' for r in err.history]}") from None
+    orbit = found.orbit or found.lower
     data = orbit.describe()
-    least = orbit.smallest_period() if orbit.n > 1 else 1
-    if least < orbit.n:
-        data["smallest_period_multiple"] = least
+    data["requested_period_multiple"] = args.period
+    data["found_requested_period"] = found.found
+    data["attempts"] = found.attempts
+    data["initial_state"] = start.describe()
     if args.out:
         from gearsym.solver import plots
 
@@ -92,21 +157,24 @@ def _cmd_shoot(args) -> int:
         from gearsym.solver.periodic import FlowMap, monodromy_agreement
 
         data["monodromy_agreement"] = monodromy_agreement(FlowMap(system), orbit.x0, orbit.period)
+    status = 0 if found.found else 1
     if args.json:
         print(dumps(data, indent=1))
-        return 0
-    fl = orbit.floquet
+        return status
+    if not found.found:
+        print(
+            f"no orbit of minimal period {args.period} found from {len(found.attempts)} "
+            f"guess(es); they led to the period-{orbit.n} orbit below (exit status 1)"
+        )
     print(
         f"{system.name}: period-{orbit.n} orbit, residual {orbit.residual:.2e} after "
         f"{orbit.iterations} Newton iteration(s) ({args.monodromy or 'default'} monodromy, "
         f"{args.segments} segment(s))"
     )
+    if start.x0 is not None:
+        print(f"  guess from {start.source}" + (f", settled {settle} periods" if settle else ""))
     print("  x0: " + ", ".join(f"{k} = {v:.10g}" for k, v in data["x0"].items()))
-    if least < orbit.n:
-        print(
-            f"  note: this orbit repeats after {least} period(s): it is a period-{least} "
-            f"orbit (its multipliers are those of period-{least}, raised to {orbit.n // least})"
-        )
+    fl = orbit.floquet
     print(
         "  multipliers: "
         + ", ".join(f"{m.real:+.6f}{m.imag:+.6f}i (|{abs(m):.6f}|)" for m in fl.multipliers)
@@ -116,13 +184,21 @@ def _cmd_shoot(args) -> int:
         "period-doubling": "-1 (period doubling)",
         "neimark-sacker": "a complex pair (Neimark-Sacker)",
     }[fl.kind]
-    print(
-        f"  {'stable' if fl.stable else 'unstable'}; the largest multiplier is on the side of "
-        f"{losing}; Liouville error |log det M - ∫ tr J| = {fl.liouville_error:.2e}"
-    )
+    if fl.stability == "neutral":
+        verdict = (
+            f"neutral: the largest multiplier is on the unit circle (|mu| - 1 = "
+            f"{abs(fl.critical) - 1:+.1e}, within ±{fl.tolerance:.1e}, the monodromy's "
+            "estimated error)"
+        )
+    else:
+        verdict = (
+            f"{fl.stability} (|mu| - 1 = {abs(fl.critical) - 1:+.1e}, tolerance "
+            f"±{fl.tolerance:.1e}); the largest multiplier is on the side of {losing}"
+        )
+    print(f"  {verdict}; Liouville error |log det M - ∫ tr J| = {fl.liouville_error:.2e}")
     for k, v in data.get("monodromy_agreement", {}).items():
         print(f"  monodromy {k}: {v:.2e} (max difference / max entry)")
-    return 0
+    return status
 
 
 def _cmd_continue(args) -> int:

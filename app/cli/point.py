@@ -15,6 +15,7 @@ from ._common import (
     system_of,
     write_json,
 )
+from ._start import resolve_start, start_options
 
 __all__ = ["register"]
 
@@ -29,6 +30,7 @@ def register(sub) -> None:
     )
     si.add_argument("scene", metavar="SCENE", help="a scene path or built-in name")
     analysis_options(si)
+    start_options(si)
     si.add_argument("--json", action="store_true", help="print everything as JSON")
     si.add_argument("--out", metavar="DIR", help="also write point.json and point.png")
     si.set_defaults(func=_cmd_simulate)
@@ -75,12 +77,14 @@ def _cmd_simulate(args) -> int:
     from gearsym.solver.analysis import analyse_point, meshing_states, spectrum
     from gearsym.solver.integrate import SimulationError
 
-    system = system_of(args.scene, parse_set(args.set))
+    start = resolve_start(args)
+    system = start.system
     try:
-        result = analyse_point(system, **analysis_settings(args))
+        result = analyse_point(system, start.x0, **analysis_settings(args))
     except (SimulationError, ValueError) as err:
         raise Fail(f"simulate: {err}") from None
     data = result.describe()
+    data["initial_state"] = start.describe()
     if args.out:
         from gearsym.solver import plots
 
@@ -94,8 +98,14 @@ def _cmd_simulate(args) -> int:
         f"{system.name}: {tr.method}, rtol {tr.rtol:g}, {tr.transient} + {tr.periods} periods, "
         f"{tr.wall_time:.2f} s, status {tr.status}"
     )
+    if start.x0 is not None:
+        print(f"  started from {start.source}: " + ", ".join(f"{v:.6g}" for v in start.x0))
     if result.lyapunov is not None:
-        print(f"  largest Lyapunov exponent {result.lyapunov.exponent:.5f} per unit tau")
+        ly = result.lyapunov
+        print(
+            f"  largest Lyapunov exponent {ly.exponent:.5f} ± {ly.uncertainty:.1e} per unit tau "
+            f"(over {ly.periods} periods)"
+        )
     if tr.status != "ok":
         print(f"  {tr.message}")
 
@@ -113,6 +123,16 @@ def _cmd_simulate(args) -> int:
             f, s, b = (num(shares[c][key], ".2f") for key in ("forward", "separated", "backward"))
             line += f"  forward/separated/backward {f}/{s}/{b}"
         print(line)
+        ev = k.evidence
+        if k.period is None and "poincare_extent" in ev:
+            ext = ev["poincare_extent"]
+            dim = ev.get("correlation_dimension")
+            print(
+                f"      Poincaré cloud of {ev['poincare_points']} points: extent "
+                f"{num(ext['displacement'], '.2e')} in {c}, {num(ext['velocity'], '.2e')} in "
+                f"its velocity; correlation dimension {num(dim, '.2f')}"
+                + (f"; {ev['why']}" if "why" in ev else "")
+            )
     if tr.left_valid_range is not None:
         t, c, v = tr.left_valid_range
         print(
