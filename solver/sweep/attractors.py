@@ -10,14 +10,16 @@ is read from the extremes of each mesh coordinate against the contract's contact
 * ``double-sided impact``: it reaches both flanks (back-side impacts);
 * ``no contact``: it never reaches either flank in the window.
 
-Runs of one grid point reach the same attractor when they end with the same outcome
-(status, motion per coordinate) and
+Runs of one grid point reach the same attractor when they end with the same status and
 
-* periodic: their last n Poincare points coincide as sets (up to a cyclic shift), within
-  ``same_tol`` times the size of the orbit;
-* otherwise: their extremes over the window agree within ``cloud_tol`` of the attractor's
-  size (a chaotic or quasi-periodic set sampled over 100 periods fills its bounding box to
-  within a few per cent; two distinct ones rarely share it).
+* periodic with the same period per coordinate: their last n Poincare points coincide as
+  sets (up to a cyclic shift), within ``SAME_TOL`` times the size of the orbit;
+* both not periodic: their extremes over the window agree within ``CLOUD_TOL`` of the
+  attractor's size (a chaotic or quasi-periodic set sampled over 100 periods fills its
+  bounding box to within a few per cent; two distinct ones rarely share it).  Their
+  verdicts (quasi-periodic, chaotic, undetermined) may differ: they rest on finite samples
+  of the same set.  The attractor takes the majority's verdicts and, when its runs
+  disagree, reports the count of each (``verdicts``).
 """
 
 from __future__ import annotations
@@ -69,10 +71,6 @@ class RunOutcome:
     spread: dict
     tail: np.ndarray  # (m, n): the last Poincare points
     evidence: dict = field(default_factory=dict)
-
-    @property
-    def key(self) -> tuple:
-        return (self.status, tuple(sorted(self.motion.items())))
 
 
 def outcome(
@@ -135,7 +133,8 @@ class Attractor:
 
     share: float
     starts: tuple[str, ...]
-    run: RunOutcome
+    run: RunOutcome  # the representative: the first run with the majority's verdicts
+    votes: dict = field(default_factory=dict)  # per coordinate, when the runs disagree
 
     def to_dict(self, states) -> dict:
         r = self.run
@@ -153,6 +152,7 @@ class Attractor:
             "poincare_spread": dict(r.spread),
             "state": [float(v) for v in r.tail[-1]],
             **({"why": dict(r.evidence)} if r.evidence else {}),
+            **({"verdicts": self.votes} if self.votes else {}),
         }
 
 
@@ -164,8 +164,19 @@ def _cycle(run: RunOutcome) -> int | None:
     return int(np.lcm.reduce(periods))
 
 
+def _kind(run: RunOutcome) -> tuple:
+    """What two runs must share before their geometry is compared: the failure status,
+    or periodic with the same period per coordinate, or not periodic (quasi-periodic,
+    chaotic and undetermined verdicts of one set differ only in finite-sample evidence)."""
+    if run.status != "ok":
+        return (run.status,)
+    if _cycle(run) is None:
+        return ("not periodic",)
+    return ("periodic", tuple(sorted(run.period.items())))
+
+
 def same_attractor(a: RunOutcome, b: RunOutcome) -> bool:
-    if a.key != b.key:
+    if _kind(a) != _kind(b):
         return False
     if a.status != "ok":
         return True  # one failure outcome per kind
@@ -178,6 +189,20 @@ def same_attractor(a: RunOutcome, b: RunOutcome) -> bool:
     size = max(float(np.max(a.xmax - a.xmin)), float(np.max(b.xmax - b.xmin)), 1e-12)
     gap = max(np.abs(a.xmax - b.xmax).max(), np.abs(a.xmin - b.xmin).max())
     return gap <= CLOUD_TOL * size
+
+
+def _attractor(members: list[RunOutcome], total: int) -> Attractor:
+    """The majority's verdicts (ties: the earlier start) and, if the runs disagree, the
+    count of each verdict per coordinate."""
+    verdicts = [tuple(sorted(r.motion.items())) for r in members]
+    best = max(verdicts, key=lambda v: (verdicts.count(v), -verdicts.index(v)))
+    run = members[verdicts.index(best)]
+    votes = {}
+    for coord in run.motion:
+        seen = [r.motion[coord] for r in members]
+        if len(set(seen)) > 1:
+            votes[coord] = {m: seen.count(m) for m in dict.fromkeys(seen)}
+    return Attractor(len(members) / total, tuple(r.start for r in members), run, votes)
 
 
 def group_runs(runs: list[RunOutcome]) -> list[Attractor]:
@@ -193,7 +218,4 @@ def group_runs(runs: list[RunOutcome]) -> list[Attractor]:
             groups.append([r])
     total = max(len(runs), 1)
     order = sorted(range(len(groups)), key=lambda k: -len(groups[k]))
-    return [
-        Attractor(len(groups[k]) / total, tuple(r.start for r in groups[k]), groups[k][0])
-        for k in order
-    ]
+    return [_attractor(groups[k], total) for k in order]

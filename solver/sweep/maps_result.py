@@ -187,7 +187,8 @@ class RegimeMap:
                 evidence=r.get("why", {}),
             )
             key = (float(r[x]), float(r[y]))
-            cells.setdefault(key, []).append(Attractor(r["share"], tuple(r["starts"]), run))
+            votes = r.get("verdicts", {})
+            cells.setdefault(key, []).append(Attractor(r["share"], tuple(r["starts"]), run, votes))
         grid = tuple(
             tuple(Cell(float(a), float(b), tuple(cells[(float(a), float(b))])) for b in yv)
             for a in xv
