@@ -14,7 +14,7 @@ from .continuation import Bifurcation, Branch, continue_orbit
 from .floquet import Floquet, bifurcation_tests, floquet
 from .flow import MONODROMY_METHODS, FlowMap, StroboscopicMap, monodromy_agreement
 from .newton import NewtonError, NewtonResult, newton
-from .shooting import Orbit, ShootingError, residual, shoot
+from .shooting import Orbit, OrbitSearch, ShootingError, residual, search, shoot
 from .switching import switch_period_doubling
 
 __all__ = [
@@ -26,6 +26,7 @@ __all__ = [
     "NewtonError",
     "NewtonResult",
     "Orbit",
+    "OrbitSearch",
     "ShootingError",
     "StroboscopicMap",
     "bifurcation_tests",
@@ -34,6 +35,7 @@ __all__ = [
     "monodromy_agreement",
     "newton",
     "residual",
+    "search",
     "shoot",
     "switch_period_doubling",
 ]
