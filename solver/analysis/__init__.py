@@ -9,7 +9,7 @@ Lyapunov exponent, and everything about one operating point.
 
 from .classify import Classification, classify_points, correlation_dimension, periodicity
 from .lyapunov import LyapunovEstimate, largest_lyapunov
-from .point import PointResult, analyse_point, classification_tolerance
+from .point import PointResult, analyse_point, analyse_trajectory, classification_tolerance
 from .spectra import Spectrum, extremes, meshing_states, spectrum
 
 __all__ = [
@@ -18,6 +18,7 @@ __all__ = [
     "PointResult",
     "Spectrum",
     "analyse_point",
+    "analyse_trajectory",
     "classification_tolerance",
     "classify_points",
     "correlation_dimension",

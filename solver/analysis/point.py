@@ -24,7 +24,7 @@ from .classify import DIMENSION_POINTS, Classification, classify_points
 from .lyapunov import LyapunovEstimate, largest_lyapunov
 from .spectra import extremes, meshing_states, spectrum
 
-__all__ = ["PointResult", "analyse_point", "classification_tolerance"]
+__all__ = ["PointResult", "analyse_point", "analyse_trajectory", "classification_tolerance"]
 
 
 @dataclass(frozen=True)
@@ -106,6 +106,31 @@ def analyse_point(
         steps_per_period=steps_per_period,
         on_invalid=on_invalid,
     )
+    return analyse_trajectory(
+        tr,
+        rtol=rtol,
+        atol=atol,
+        lyapunov_periods=lyapunov_periods,
+        steps_per_period=steps_per_period,
+        on_invalid=on_invalid,
+        dimension_points=dimension_points,
+    )
+
+
+def analyse_trajectory(
+    tr,
+    *,
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    lyapunov_periods: int = 200,
+    steps_per_period: int = 512,
+    on_invalid: str = "warn",
+    dimension_points: int = DIMENSION_POINTS,
+) -> PointResult:
+    """The analysis of :func:`analyse_point` on a simulated trajectory (from
+    ``simulate`` or ``simulate_many``): the exponent from its end state, then the
+    verdict per mesh, with the sample extended for a non-periodic one."""
+    system = tr.system
     lyap = None
     if tr.status == "ok" and lyapunov_periods > 0:
         # The variational equations at the run's own tolerances (compiled DOP853, or

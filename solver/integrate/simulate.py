@@ -42,6 +42,7 @@ __all__ = [
     "default_initial_state",
     "fastest_method",
     "simulate",
+    "simulate_many",
 ]
 
 
@@ -226,6 +227,48 @@ def simulate(
         and goes on; ``error`` stops there with status ``invalid`` (samples after the exit
         are not computed).
     """
+    started = time.perf_counter()
+    req = _request(system, x0, method, rtol, atol, transient, periods, samples_per_period, t0,
+                   steps_per_period, max_step, bound, on_invalid)  # fmt: skip
+    run = _backend(get_method(req.method).family)(system, req)
+    return _trajectory(system, req, run, started)
+
+
+def simulate_many(systems, x0s=None, *, workers: int = 1, **options) -> list[Trajectory]:
+    """:func:`simulate` for many parameter points of one model, with the same options.
+
+    The compiled methods integrate all points in one call of the lockstep engine
+    (``native.run_batch``; ``workers`` processes); the others run :func:`simulate` point
+    by point.  Trajectory ``i`` is what ``simulate(systems[i], x0s[i], **options)`` gives,
+    up to the step sequence the group shares (so within the tolerance).
+    """
+    systems = list(systems)
+    x0s = [None] * len(systems) if x0s is None else list(x0s)
+    if len(x0s) != len(systems):
+        raise ValueError(f"{len(systems)} systems but {len(x0s)} initial states")
+    if not systems:
+        return []
+    method = options.get("method") or fastest_method(options.get("rtol", 1e-8))
+    if get_method(method).family != "native" or len({s.module for s in systems}) != 1:
+        return [simulate(s, x, **options) for s, x in zip(systems, x0s, strict=True)]
+    started = time.perf_counter()
+    keys = ("rtol", "atol", "transient", "periods", "samples_per_period", "t0",
+            "steps_per_period", "max_step", "bound", "on_invalid")  # fmt: skip
+    defaults = (1e-8, 1e-10, 300, 100, 64, 0.0, 512, None, 1e3, "warn")
+    unknown = set(options) - set(keys) - {"method"}
+    if unknown:
+        raise TypeError(f"unknown option(s) {sorted(unknown)}")
+    args = [options.get(k, d) for k, d in zip(keys, defaults, strict=True)]
+    reqs = [_request(s, x, method, *args) for s, x in zip(systems, x0s, strict=True)]
+    from .native import run_many
+
+    runs = run_many(systems, reqs, workers=workers)
+    return [_trajectory(s, q, r, started) for s, q, r in zip(systems, reqs, runs, strict=True)]
+
+
+def _request(system, x0, method, rtol, atol, transient, periods, samples_per_period, t0,
+             steps_per_period, max_step, bound, on_invalid) -> Request:  # fmt: skip
+    """The checked request of one run, with its initial state and sample grid."""
     if method is None:
         method = fastest_method(rtol)
     req = Request(
@@ -250,14 +293,17 @@ def simulate(
     T = system.period
     t_start = t0 + transient * T
     grid = t_start + T * np.arange(periods * samples_per_period + 1) / samples_per_period
-    req = replace(req, x0=x0, grid=grid)
-    started = time.perf_counter()
-    run = _backend(get_method(method).family)(system, req)
+    return replace(req, x0=x0, grid=grid)
+
+
+def _trajectory(system, req: Request, run, started: float) -> Trajectory:
+    """A back end's run as a Trajectory: the valid range, the window, the bound."""
+    grid, method, bound = req.grid, req.method, req.bound
     x, status, message = run.x, run.status, run.message
     exit_ = run.left_valid_range
     if exit_ is None:
         exit_ = first_exit(system, grid, x)
-    if exit_ is not None and on_invalid == "error" and status == "ok":
+    if exit_ is not None and req.on_invalid == "error" and status == "ok":
         t_x, c_x, v_x = exit_
         x[:, grid > t_x] = np.nan
         status = "invalid"
@@ -275,11 +321,11 @@ def simulate(
     return Trajectory(
         system=system,
         method=method,
-        rtol=rtol,
-        atol=atol,
-        transient=transient,
-        periods=periods,
-        samples_per_period=samples_per_period,
+        rtol=req.rtol,
+        atol=req.atol,
+        transient=req.transient,
+        periods=req.periods,
+        samples_per_period=req.samples_per_period,
         t=t_out,
         x=x_out,
         x_final=x_final,
@@ -291,7 +337,7 @@ def simulate(
         wall_time=time.perf_counter() - started,
         boundary_crossings=run.crossings,
         left_valid_range=exit_,
-        options={"steps_per_period": steps_per_period} if fixed else {},
+        options={"steps_per_period": req.steps_per_period} if fixed else {},
     )
 
 

@@ -32,6 +32,7 @@ __all__ = [
     "reset",
     "run",
     "run_batch",
+    "run_many",
     "source",
 ]
 
@@ -51,6 +52,24 @@ def run(system, req: Request) -> Run:
         system.module,
         system.p[None, :],
         np.asarray(req.x0, float)[None, :],
+        lockstep=False,
+        **_options(req),
+    )
+    return _as_run(res, 0, req)
+
+
+def run_many(systems, reqs, workers: int = 1) -> list[Run]:
+    """Many points of one model with one request each (same options, own ``x0``) in one
+    call of the lockstep engine; ``workers`` processes."""
+    first = reqs[0]
+    P = np.array([s.p for s in systems])
+    X0 = np.array([np.asarray(q.x0, float) for q in reqs])
+    res = run_batch(systems[0].module, P, X0, lockstep=True, workers=workers, **_options(first))
+    return [_as_run(res, i, q) for i, q in enumerate(reqs)]
+
+
+def _options(req: Request) -> dict:
+    return dict(
         method=req.method,
         rtol=req.rtol,
         atol=req.atol,
@@ -60,14 +79,16 @@ def run(system, req: Request) -> Run:
         samples_per_period=req.samples_per_period,
         steps_per_period=req.steps_per_period,
         bound=req.bound,
-        lockstep=False,
     )
-    x = res.x[0].T.copy()
-    status = res.status[0]
-    nfev, nsteps = int(res.nfev[0]), int(res.nsteps[0])
+
+
+def _as_run(res, i: int, req: Request) -> Run:
+    x = res.x[i].T.copy()
+    status = res.status[i]
+    nfev, nsteps = int(res.nfev[i]), int(res.nsteps[i])
     if status == "ok":
         return Run(x, "ok", "", nfev, nsteps)
-    t_fail = float(res.t_fail[0])
+    t_fail = float(res.t_fail[i])
     if status == "divergent":
         message = f"a state passed |x| = {req.bound:g} at tau = {t_fail:.6g}"
         return Run(x, "divergent", message, nfev, nsteps)
