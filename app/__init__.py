@@ -15,31 +15,42 @@ Rooms: ``gearsym.derive`` (SymPy, SI), ``gearsym.solver`` (non-dimensional numer
 (``gearsym.resolve``), the CLI (``gearsym.cli``) and the studies (``gearsym.studies``).
 """
 
-from gearsym.derive import InputError, derive_model, load_target
-from gearsym.solver import (
-    METHODS,
-    Branch,
-    Contract,
-    FlowMap,
-    Orbit,
-    PointResult,
-    ShootingError,
-    SimulationError,
-    StroboscopicMap,
-    SweepPoint,
-    SweepResult,
-    System,
-    Trajectory,
-    continue_orbit,
-    shoot,
-    simulate,
-    sweep,
-    switch_period_doubling,
-)
-from gearsym.solver import analyse_point as analyse
-from gearsym.solver.export import save
+import importlib as _importlib
 
-from .resolve import load
+# Names resolve on first use (PEP 562), so that `gearsym <command>` imports only what the
+# command needs: a sweep of a shipped scene never loads SymPy or the derivation.
+_EXPORTS = {
+    "InputError": "gearsym.derive._input",
+    "derive_model": "gearsym.derive",
+    "load_target": "gearsym.derive",
+    "save": "gearsym.solver.export",
+    "load": "gearsym.resolve",
+    "analyse": ("gearsym.solver", "analyse_point"),
+    **{
+        name: "gearsym.solver"
+        for name in (
+            "METHODS", "Branch", "Contract", "FlowMap", "Orbit", "PointResult",
+            "ShootingError", "SimulationError", "StroboscopicMap", "SweepPoint",
+            "SweepResult", "System", "Trajectory", "continue_orbit", "shoot", "simulate",
+            "sweep", "switch_period_doubling",
+        )
+    },
+}  # fmt: skip
+
+
+def __getattr__(name: str):
+    where = _EXPORTS.get(name)
+    if where is None:
+        raise AttributeError(f"module 'gearsym' has no attribute {name!r}")
+    module, attr = where if isinstance(where, tuple) else (where, name)
+    value = getattr(_importlib.import_module(module), attr)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_EXPORTS))
+
 
 __version__ = "0.1.0"
 

@@ -5,19 +5,44 @@ and :func:`fit_dead_zone`; ``gearsym.derive.build`` writes the generated code an
 audit pages.
 """
 
+import importlib as _importlib
+
 from ._input import InputError
 from ._version import __version__
-from .backlash import (
-    DeadZone,
-    LinearContact,
-    PolynomialFit,
-    SmoothDeadZone,
-    dead_zone,
-    fit_dead_zone,
-)
-from .model import Model, derive_model
-from .scene import Features, Scene, load_scene, load_target, resolve_target, variant
-from .topology import Topology, load_topology
+
+# The rest resolves on first use (PEP 562): SymPy and SciPy load only when a derivation
+# (or the scene reader) is asked for.
+_EXPORTS = {
+    "DeadZone": "backlash",
+    "LinearContact": "backlash",
+    "PolynomialFit": "backlash",
+    "SmoothDeadZone": "backlash",
+    "dead_zone": "backlash",
+    "fit_dead_zone": "backlash",
+    "Model": "model",
+    "derive_model": "model",
+    "Features": "scene",
+    "Scene": "scene",
+    "load_scene": "scene",
+    "load_target": "scene",
+    "resolve_target": "scene",
+    "variant": "scene",
+    "Topology": "topology",
+    "load_topology": "topology",
+}
+
+
+def __getattr__(name: str):
+    if name not in _EXPORTS:
+        raise AttributeError(f"module 'gearsym.derive' has no attribute {name!r}")
+    value = getattr(_importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_EXPORTS))
+
 
 __all__ = [
     "__version__",

@@ -19,7 +19,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 __all__ = [
     "LocatedRun",
@@ -116,6 +115,8 @@ def integrate_located(
     SimulationError
         The solver failed, or the state cannot leave a surface.
     """
+    from scipy.integrate import solve_ivp  # SciPy loads only when a run needs it
+
     options = options or {}
     t, y = float(t0), np.array(y0, dtype=float)
     nfev = nsteps = crossings = stalls = 0

@@ -9,11 +9,12 @@ and Wanner 1993, "Solving Ordinary Differential Equations I", II.4-II.5).
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["DOP853", "DOPRI5", "RK4", "ButcherTableau", "c_tables", "rk_step"]
+__all__ = ["DOP853", "DOPRI5", "RK4", "ButcherTableau", "c_tables", "rk_step"]  # noqa: F822
 
 
 @dataclass(frozen=True)
@@ -76,6 +77,7 @@ RK4 = ButcherTableau(
 )  # fmt: skip
 
 
+@functools.cache
 def _dormand_prince():
     from scipy.integrate._ivp import dop853_coefficients as d
     from scipy.integrate._ivp.rk import RK45
@@ -96,11 +98,18 @@ def _dormand_prince():
     return dopri5, dop853
 
 
-DOPRI5, DOP853 = _dormand_prince()
+def __getattr__(name: str):
+    # DOPRI5 and DOP853 are read from SciPy on first use (SciPy's import is slow and a
+    # run on an already compiled library does not need them).
+    if name in ("DOPRI5", "DOP853"):
+        return _dormand_prince()[name == "DOP853"]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def c_tables() -> str:
     """The tableaux of the compiled integrators as C arrays (no transcription by hand)."""
+
+    DOPRI5, DOP853 = _dormand_prince()  # noqa: N806 (the module's names for them)
 
     def arr(name, values):
         flat = np.asarray(values, dtype=float).ravel()

@@ -79,6 +79,19 @@ def source(module, variational: bool = False) -> str:
     return "\n".join([*head, "#include <math.h>", getattr(module, attr), c_tables(), body])
 
 
+def _key_text(module, variational: bool) -> str:
+    """What the library's text depends on: the model's C, the engine and the tableaux'
+    source (SciPy's version)."""
+    from importlib.metadata import version
+
+    attr = "C_SOURCE_VARIATIONAL" if variational else "C_SOURCE"
+    if not hasattr(module, attr):
+        source(module, variational)  # raises NativeUnavailable with the reason
+    engine = (Path(__file__).with_name("_native.c")).read_text(encoding="utf-8")
+    return "\n".join([f"variational={variational}", getattr(module, attr), engine,
+                      f"scipy {version('scipy')}"])  # fmt: skip
+
+
 @functools.lru_cache(maxsize=8)
 def _compiler_id(cc: str) -> str:
     """The compiler's version line and this CPU's identity: the libraries are built with
@@ -120,9 +133,11 @@ def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
     if path is not None and str(path) in _loaded:
         facts["path"] = str(path)
         return _loaded[str(path)], facts
-    text = source(module, variational)
+    # The key names everything the library is built from without building its text: the
+    # tableaux are SciPy's coefficient arrays, so SciPy's version stands for them (and
+    # SciPy itself is not imported for a library that is already compiled).
     key = hashlib.sha256(
-        "\n".join([text, _compiler_id(cc), " ".join(_FLAGS)]).encode()
+        "\n".join([_key_text(module, variational), _compiler_id(cc), " ".join(_FLAGS)]).encode()
     ).hexdigest()[:20]
     if key in _failed:
         raise NativeUnavailable(_failed[key])
@@ -136,7 +151,7 @@ def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
         path.parent.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryDirectory(dir=path.parent) as tmp:
             c_file = Path(tmp) / "model.c"
-            c_file.write_text(text, encoding="utf-8")
+            c_file.write_text(source(module, variational), encoding="utf-8")
             so = Path(tmp) / "lib.so"
             try:
                 done = subprocess.run(
