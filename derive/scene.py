@@ -231,7 +231,17 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
                 + f"; built-in: {', '.join(known)}",
             )
         topo_path = builtin
-    topology = load_topology(topo_path)
+    open_t = top.table("open", None)
+    if open_t is None:
+        topology = load_topology(topo_path)
+    else:
+        # the study's open values, set in the scene (derive/open_values.py)
+        from .open_values import apply_open_values
+
+        values = {key: open_t.number(key) for key in open_t.data}
+        open_t.finish()
+        data = apply_open_values(load_toml(topo_path), values, f"{source} [open]")
+        topology = parse_topology(data, str(topo_path))
     features = _features(top.table("features", None))
 
     pt = top.table("parameters")

@@ -253,6 +253,17 @@ def _gear(t: Table, materials: dict[str, Material]) -> Gear:
 
 
 def _stiffness(t: Table, pair: PairGeometry, gears: tuple[Gear, Gear]) -> MeshStiffness:
+    # An open value (derive/open_values.py): a factor on every harmonic, the mean kept.
+    scale = t.number("harmonic_scale", 1.0, low=0.0)
+    k = _stiffness_of(t, pair, gears)
+    if scale == 1.0:
+        return k
+    return MeshStiffness(
+        k.mean, tuple(scale * c for c in k.cos), tuple(scale * c for c in k.sin), k.source
+    )
+
+
+def _stiffness_of(t: Table, pair: PairGeometry, gears: tuple[Gear, Gear]) -> MeshStiffness:
     source = t.string("source", choices=("harmonics", "contact-line", "potential-energy"))
     if source == "potential-energy":
         return _pem_stiffness(t, pair, gears)

@@ -62,14 +62,21 @@ def parse_range(text: str):
 def system_of(scene_arg: str, sets: dict[str, float]):
     """The System of a scene (built-in name or path) with ``--set`` values (resolver:
     ``gearsym.resolve``); a bad scene file raises its own InputError."""
-    from gearsym.resolve import module_for
+    from gearsym.resolve import module_for, split_open_values
     from gearsym.solver.system import System
 
-    module = module_for(scene_arg)
+    opened, rest = split_open_values(sets)
+    module = module_for(scene_arg, opened)
     try:
-        return System.load(module, **sets)
+        return System.load(module, **rest)
     except KeyError as err:
-        raise Fail(f"--set: {err.args[0]}") from None
+        from gearsym.derive._input import nearest
+        from gearsym.derive.open_values import OPEN_VALUES
+
+        unknown = [k for k in rest if k not in module.PARAMETERS]
+        hint = nearest(unknown[0], OPEN_VALUES) if unknown else ""
+        more = f"{hint}; open values (derived anew): {', '.join(OPEN_VALUES)}"
+        raise Fail(f"--set: {err.args[0]}{more}") from None
     except ValueError as err:
         raise Fail(f"--set: {err}") from None
 

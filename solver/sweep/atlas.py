@@ -64,7 +64,7 @@ class _Column:
     ix: int
     kind: str  # "forward", "backward" or "random"
     files: tuple[str, ...]
-    P: np.ndarray  # (ny * m, P)
+    P: tuple  # ny * m parameter vectors (models may differ along an open-value axis)
     X0: np.ndarray | None  # (ny * m, n); None: chained (previous column's end states)
     starts: tuple[str, ...]
 
@@ -76,14 +76,14 @@ def _run_column(col: _Column, X0: np.ndarray, opts: dict) -> list[RunOutcome]:
     by_model: dict = {}
     for i, f in enumerate(col.files):
         c = modules[f].CONTRACT
-        w = col.P[i, list(c["parameters"]).index(c["forcing_frequency"])]
+        w = col.P[i][list(c["parameters"]).index(c["forcing_frequency"])]
         by_model.setdefault((f, float(w)), []).append(i)
     run_opts = {k: opts[k] for k in ("method", "rtol", "atol", "transient", "periods")}
     for (f, _), idx in by_model.items():
         module = modules[f]
         res = run_map(
             module,
-            col.P[idx],
+            np.array([col.P[i] for i in idx]),
             X0[idx],
             lyapunov_periods=opts["lyapunov_periods"],
             seed=opts["seed"],
@@ -248,7 +248,7 @@ def regime_map(
         if kind == "random":
             starts = [f"random-{k + 3}" for _ in cells for k in range(n_random)]
             files = [g.module.__file__ for g in cells for _ in range(n_random)]
-            P = np.array([g.p for g in cells for _ in range(n_random)])
+            P = tuple(g.p for g in cells for _ in range(n_random))
             X0 = np.array(
                 [
                     _random_state(seed, ix, iy, k + 3, box, states)
@@ -258,7 +258,7 @@ def regime_map(
             )
             return _Column(ix, kind, tuple(files), P, X0, tuple(starts))
         files = tuple(g.module.__file__ for g in cells)
-        return _Column(ix, kind, files, np.array([g.p for g in cells]), None, (kind,) * len(cells))
+        return _Column(ix, kind, files, tuple(g.p for g in cells), None, (kind,) * len(cells))
 
     tasks = []
     chains = {"forward": range(len(xv)), "backward": range(len(xv) - 1, -1, -1)}

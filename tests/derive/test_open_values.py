@@ -1,0 +1,113 @@
+"""Open values (derive/open_values.py): each carried through the derivation consistently.
+
+References: closed forms of the reduced torsional model -- the coupling between two meshes
+on one gear goes through that gear's inertia alone, so kappa_uv omega_n^2 I_g is the same
+for every flywheel; E = transmission-error amplitude / half backlash; the layout phase
+2 pi delta with delta the fractional number of teeth spanned (the study's definition).
+"""
+
+import math
+
+import numpy as np
+import pytest
+from gearsym.derive import InputError, derive_model, load_target, resolve_target
+from gearsym.derive.open_values import is_open_value, with_open_values
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return load_target(resolve_target("reference-light"))
+
+
+def _model(scene, **values):
+    model = derive_model(with_open_values(scene, **values))
+    return model, dict(zip(model.parameter_names, model.defaults, strict=True))
+
+
+def test_flywheel_changes_the_couplings_together_as_the_closed_form_says(scene):
+    rows = []
+    for J in (2.0, 10.0, 40.0):
+        variant = with_open_values(scene, flywheel_inertia_kg_m2=J)
+        gear = variant.topology.gear("g")
+        assert gear.inertia == pytest.approx(gear.gear_inertia + J)
+        model, p = _model(scene, flywheel_inertia_kg_m2=J)
+        wn = model.scales["omega_n_rad_per_s"]
+        # the coupling goes through gear g alone: kappa_uv omega_n^2 I_g does not depend
+        # on I_g; with each mesh's damping on its own mass (c_v = 2 zeta sqrt(k_v / W_vv))
+        # and equal meshes, xi_uv = zeta W_uv / W_vv = zeta kappa_uv
+        zeta = scene.parameters["damping_ratio"]
+        assert p["xi_u_v"] == pytest.approx(zeta * p["kappa_u_v"], rel=1e-9)
+        assert p["xi_v_u"] == pytest.approx(zeta * p["kappa_v_u"], rel=1e-9)
+        rows.append(
+            (p, p["kappa_u_v"] * wn**2 * gear.inertia, p["kappa_v_u"] * wn**2 * gear.inertia)
+        )
+    for row in rows[1:]:
+        assert row[1:] == pytest.approx(rows[0][1:], rel=1e-9)
+    # a heavier flywheel weakens every coupling term
+    kuv = [r[0]["kappa_u_v"] for r in rows]
+    xuv = [r[0]["xi_u_v"] for r in rows]
+    assert kuv[0] > kuv[1] > kuv[2] and xuv[0] > xuv[1] > xuv[2]
+
+
+def test_transmission_error_amplitude_becomes_e_over_the_half_backlash(scene):
+    _, p = _model(scene, te_amplitude_um=12.5)
+    half_backlash_um = 50.0  # scenes/topologies/diso.toml
+    assert p["E_u_1"] == pytest.approx(12.5 / half_backlash_um, rel=1e-12)
+    assert p["E_v_1"] == pytest.approx(12.5 / half_backlash_um, rel=1e-12)
+    _, p = _model(scene, te_amplitude_um_qg=2.5, te_phase_deg_qg=30.0)
+    assert p["E_u_1"] == pytest.approx(5.0 / half_backlash_um)  # the scene's own 5 um
+    assert p["E_v_1"] == pytest.approx(2.5 / half_backlash_um)
+    assert p["psi_v_1"] == pytest.approx(math.radians(30.0))
+
+
+@pytest.mark.parametrize("angle", [90.0, 100.0, 120.0])
+def test_layout_angle_gives_the_study_phase(scene, angle):
+    _, p = _model(scene, layout_angle_deg=angle)
+    spanned = 100 * angle / 360.0  # teeth of g between the two pinions
+    delta = spanned - math.floor(spanned)
+    expected = 2 * math.pi * delta
+    got = p["phi_v"] % (2 * math.pi)
+    assert min(abs(got - expected), 2 * math.pi - abs(got - expected)) < 1e-9
+
+
+def test_stiffness_harmonic_scale_scales_every_harmonic_and_keeps_the_mean(scene):
+    _, ref = _model(scene)
+    _, p = _model(scene, stiffness_harmonic_scale=0.5)
+    for key in ref:
+        if key.startswith(("kc_", "ks_")):
+            assert p[key] == pytest.approx(0.5 * ref[key], rel=1e-12, abs=1e-15)
+    assert p["kappa_u_u"] == ref["kappa_u_u"] and p["kappa_u_v"] == ref["kappa_u_v"]
+
+
+def test_the_scene_open_table_equals_the_keyword(tmp_path, root):
+    text = (root / "scenes" / "reference-light.toml").read_text()
+    topo = (root / "scenes" / "topologies" / "diso.toml").as_posix()
+    text = text.replace('topology = "topologies/diso.toml"', f'topology = "{topo}"')
+    path = tmp_path / "open.toml"
+    path.write_text(text + "\n[open]\nte_amplitude_um = 8.0\nflywheel_inertia_kg_m2 = 3.0\n")
+    from_file = derive_model(load_target(path))
+    scene = load_target(resolve_target("reference-light"))
+    keyword = derive_model(with_open_values(scene, te_amplitude_um=8.0, flywheel_inertia_kg_m2=3.0))
+    assert np.allclose(from_file.defaults, keyword.defaults, rtol=1e-12)
+
+
+def test_open_value_names():
+    assert is_open_value("te_amplitude_um") and is_open_value("te_amplitude_um_qg")
+    assert is_open_value("flywheel_inertia_kg_m2") and is_open_value("attached_inertia_kg_m2_g")
+    assert not is_open_value("lambda") and not is_open_value("attached_inertia_kg_m2")
+
+
+@pytest.mark.parametrize(
+    ("values", "message"),
+    [
+        ({"te_amplitude_um": -1.0}, "te_amplitude_um: must be in [0, 10000] um"),
+        ({"te_amplitude_um_xx": 1.0}, "te_amplitude_um_xx: names no mesh"),
+        ({"attached_inertia_kg_m2_q": float("nan")}, "must be in"),
+        ({"attached_inertia_kg_m2_z": 1.0}, "names no gear"),
+        ({"layout_angle_deg": 400.0}, "must be in [-360, 360] deg"),
+    ],
+)
+def test_bad_open_values_are_one_clear_line(scene, values, message):
+    with pytest.raises(InputError, match=None) as err:
+        with_open_values(scene, **values)
+    assert message in str(err.value) and "\n" not in str(err.value)
