@@ -21,7 +21,7 @@ import time
 
 import numpy as np
 
-__all__ = ["map_speed", "map_section"]
+__all__ = ["cli_sweep_speed", "floors_section", "map_section", "map_speed"]
 
 
 def _grid(quick: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -99,6 +99,57 @@ def map_section(r: dict) -> list[str]:
         "",
         f"Motion of v over the grid (dominant attractor): {r.get('motion_v', {})}; grid "
         f"points with more than one outcome: {r.get('several_outcomes', 0)} of {nx * ny}.",
+        "",
+    ]
+
+
+def cli_sweep_speed(quick: bool = False, repeats: int = 3) -> dict:
+    """Median wall time of the user-facing ``gearsym sweep`` of 400 independent points
+    (Poincare points and verdicts, no exponent), as a user runs it: a new process each
+    time, start-up, the store, sweep.json and the figure included."""
+    times = []
+    points = 100 if quick else 400
+    for _ in range(repeats):
+        with tempfile.TemporaryDirectory() as tmp:
+            cmd = [
+                sys.executable,
+                "-m",
+                "gearsym",
+                "sweep",
+                "reference-light",
+                "--param=lambda",
+                f"--range=0:1:{points}",
+                "--independent",
+                "--lyapunov-periods=0",
+                "--quiet",
+                f"--out={tmp}/sweep",
+            ]
+            started = time.perf_counter()
+            subprocess.run(cmd, check=True, capture_output=True, env=os.environ.copy())
+            times.append(time.perf_counter() - started)
+    return {"points": points, "median_s": statistics.median(times), "runs_s": times}
+
+
+def floors_section(baseline_s_per_point: float, sweep: dict, maps: dict) -> list[str]:
+    """The two speed floors of issue 12, measured in one run of ``gearsym bench``."""
+    n = sweep["points"]
+    baseline = baseline_s_per_point * n
+    ratio = baseline / sweep["median_s"]
+    w = maps["with_exponent"]["median_s"]
+    nx, ny = maps["grid"]
+    return [
+        "## Speed floors of the regime-map work (issue 12), measured side by side",
+        "",
+        "| floor | required | measured in this run |",
+        "|---|---|---|",
+        f"| `gearsym sweep reference-light --param lambda --range 0:1:{n} --independent "
+        f"--lyapunov-periods 0` (new process, start-up, store, sweep.json and figure "
+        f"included; median of {len(sweep['runs_s'])}) against `solve_ivp(RK45)` with a "
+        f"plain Python right-hand side ({baseline_s_per_point:.2f} s per point, headline "
+        f"above, × {n} = {baseline:.0f} s) | ≥ 500× | **{sweep['median_s']:.2f} s: "
+        f"{ratio:.0f}×** |",
+        f"| `gearsym map`, {nx} × {ny} grid × {maps['initial_states']} initial states, "
+        f"300 + 100 periods, exponent over 200 (median) | ≤ 60 s | **{w:.1f} s** |",
         "",
     ]
 
