@@ -11,7 +11,14 @@ from pathlib import Path
 from .._json import dumps
 from .points import SweepPoint
 
-__all__ = ["STORE_FORMAT", "SweepStoreError", "open_store", "store_point"]
+__all__ = [
+    "STORE_FORMAT",
+    "SweepStoreError",
+    "open_store",
+    "point_text",
+    "store_point",
+    "write_atomic",
+]
 
 STORE_FORMAT = 1
 
@@ -20,18 +27,41 @@ class SweepStoreError(ValueError):
     """A sweep folder that cannot be resumed (another model, or another sweep)."""
 
 
-def store_point(store: Path, index: int, point: SweepPoint) -> None:
-    """Write one finished point atomically."""
-    folder = Path(store) / "points"
-    folder.mkdir(parents=True, exist_ok=True)
-    path = folder / f"{index:05d}.json"
-    tmp = folder / f".{index:05d}.json.{os.getpid()}.tmp"
-    tmp.write_text(dumps(point.to_dict()), encoding="utf-8")
-    os.replace(tmp, path)
+def write_atomic(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` through a temporary file and a rename."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
 
 
-def open_store(store: Path, manifest: dict) -> dict[int, SweepPoint]:
-    """Create the store, or check that it holds this very sweep; return its points."""
+def point_text(point: SweepPoint) -> str:
+    """``dumps(point.to_dict())``: the point's JSON, with NaN written as null."""
+    d = point.to_dict()
+    try:
+        # A point's dict is plain Python but for NumPy floats (floats to json) and the odd
+        # NaN; the cleaning walk (a third of the time) is needed only then.
+        return json.dumps(d, allow_nan=False)
+    except (TypeError, ValueError):
+        return dumps(d)
+
+
+def store_point(store: Path, index: int, point: SweepPoint) -> str:
+    """Write one finished point atomically; return its text."""
+    text = point_text(point)
+    write_atomic(Path(store) / "points" / f"{index:05d}.json", text)
+    return text
+
+
+def open_store(
+    store: Path, manifest: dict, texts: dict[int, str] | None = None
+) -> dict[int, SweepPoint]:
+    """Create the store, or check that it holds this very sweep; return its points (and
+    put their texts into ``texts``)."""
     store = Path(store)
     store.mkdir(parents=True, exist_ok=True)
     path = store / "manifest.json"
@@ -50,18 +80,19 @@ def open_store(store: Path, manifest: dict) -> dict[int, SweepPoint]:
                 "output folder or delete it"
             )
     else:
-        tmp = store / ".manifest.json.tmp"
-        tmp.write_text(dumps(manifest, indent=1), encoding="utf-8")
-        os.replace(tmp, path)
+        write_atomic(path, dumps(manifest, indent=1))
     done = {}
     for f in sorted((store / "points").glob("[0-9]*.json")):
         try:
-            data = json.loads(f.read_text(encoding="utf-8"))
+            text = f.read_text(encoding="utf-8")
+            data = json.loads(text)
         except (ValueError, OSError):
             f.unlink(missing_ok=True)  # a torn file cannot exist (atomic writes); be safe
             continue
         try:
             done[int(f.stem)] = SweepPoint.from_dict(data)
+            if texts is not None:
+                texts[int(f.stem)] = text
         except (KeyError, TypeError, ValueError):
             raise SweepStoreError(
                 f"{f} is not a sweep point this version reads; choose another output folder "

@@ -1,0 +1,198 @@
+"""The work units of a sweep: chains of points, planned here and run in a worker.
+
+A chain is a continuation chain (each point from the previous point's end state), one
+independent point, or -- with a compiled method -- a chunk of independent points that
+run as one call of the lockstep engine (``simulate_many``: every point of the chunk
+integrated together in C, then analysed as :func:`analyse_point` analyses a trajectory,
+so a sweep point does not depend on the path it took, within the integrator's
+tolerance).  Workers rebuild the system from the generated module's name, so nothing
+unpicklable crosses processes; each finished point is written to the store at once.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..analysis.point import analyse_point, analyse_trajectory
+from ..integrate import SimulationError
+from ..integrate.methods import get_method
+from ..integrate.simulate import fastest_method, simulate_many
+from ..system import System
+from .points import SweepPoint
+from .store import store_point
+
+__all__ = ["Chain", "ChainDone", "checked_values", "module_ref", "plan", "run_chain"]
+
+# Points of one lockstep chunk: the engine's group size (``run_batch(group=64)``).
+CHUNK = 64
+SPREAD = 4
+_FAILURES = (SimulationError, ValueError, FloatingPointError)
+_SIMULATE = ("method", "rtol", "atol", "transient", "periods", "samples_per_period",
+             "steps_per_period", "on_invalid")  # fmt: skip
+_ANALYSE = ("rtol", "atol", "lyapunov_periods", "steps_per_period", "on_invalid",
+            "dimension_points")  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Chain:
+    """One worker task: a continuation chain, one independent point, or a lockstep chunk
+    of independent points (``batch``).
+
+    ``indices`` are the points' positions in the sweep's order; with a ``store`` each
+    finished point is written there at once (atomically), so nothing computed is lost.
+    """
+
+    module: str
+    base_values: dict
+    parameter: str
+    values: list
+    x0: list | None
+    settings: dict
+    continuation: bool
+    indices: list = field(default_factory=list)
+    store: str | None = None
+    batch: bool = False
+
+
+@dataclass(frozen=True)
+class ChainDone:
+    """A chain's points in its order, with each point's stored JSON text (None without a
+    store), so that the sweep's file is assembled without encoding the points again."""
+
+    points: list
+    texts: list
+
+
+def module_ref(system: System) -> str:
+    """How a worker process finds the model: its module name, or its file."""
+    name = system.module.__name__
+    if name.startswith("gearsym.generated."):
+        return name.rsplit(".", 1)[-1]
+    return system.module.__file__
+
+
+def checked_values(system: System, parameter: str, values) -> np.ndarray:
+    """The sweep values as an array, after checking them and the parameter's name."""
+    values = np.asarray(values, dtype=float)
+    if values.ndim != 1 or values.size == 0 or not np.all(np.isfinite(values)):
+        raise ValueError("sweep values must be a non-empty list of finite numbers")
+    try:
+        system.with_values(**{parameter: float(values[0])})  # an unknown name fails here
+    except KeyError as err:
+        raise ValueError(err.args[0]) from None
+    return values
+
+
+def _one(system: System, parameter: str, value: float, state, settings: dict) -> SweepPoint:
+    """One point by :func:`analyse_point`; a failure is tried once more, then recorded."""
+    for attempt in (1, 2):
+        try:
+            result = analyse_point(system.with_values(**{parameter: value}), state, **settings)
+            return SweepPoint.from_result(result, value)
+        except _FAILURES as err:
+            point = SweepPoint.failed(system, value, err, attempt)
+    return point
+
+
+def _batch(chain: Chain, system: System):
+    """The points of a chunk, integrated together (None: the engine refused the chunk,
+    then the points run one by one); each is analysed as the worker goes, and a point
+    whose analysis fails goes the per-point way, like any failed point."""
+    systems = [system.with_values(**{chain.parameter: v}) for v in chain.values]
+    state = None if chain.x0 is None else np.asarray(chain.x0, dtype=float)
+    sim = {k: v for k, v in chain.settings.items() if k in _SIMULATE}
+    rest = {k: v for k, v in chain.settings.items() if k in _ANALYSE}
+    try:
+        trajectories = simulate_many(
+            systems, None if state is None else [state] * len(systems), **sim
+        )
+    except _FAILURES:
+        return None
+
+    def analysed(value, tr):
+        try:
+            return SweepPoint.from_result(analyse_trajectory(tr, **rest), value)
+        except _FAILURES:
+            return _one(system, chain.parameter, value, state, chain.settings)
+
+    return map(analysed, chain.values, trajectories)
+
+
+def _points(chain: Chain, system: System):
+    if chain.batch:
+        points = _batch(chain, system)
+        if points is not None:
+            yield from points
+            return
+    state = None if chain.x0 is None else np.asarray(chain.x0, dtype=float)
+    for value in chain.values:
+        point = _one(system, chain.parameter, value, state, chain.settings)
+        if chain.continuation and point.ok:
+            state = np.asarray(point.x_final)
+        yield point
+
+
+def run_chain(chain: Chain, on_point=None) -> ChainDone:
+    """Run one chain (in a worker): its points, each stored as soon as it is done."""
+    system = System.load(chain.module, **chain.base_values)
+    points, texts = [], []
+    for k, point in enumerate(_points(chain, system)):
+        text = None
+        if chain.store is not None:
+            text = store_point(Path(chain.store), chain.indices[k], point)
+        points.append(point)
+        texts.append(text)
+        if on_point is not None:
+            on_point(point)
+    return ChainDone(points, texts)
+
+
+def plan(
+    system: System,
+    parameter: str,
+    values,
+    *,
+    continuation: bool,
+    backward: bool,
+    x0,
+    settings: dict,
+    done: dict[int, SweepPoint] | None = None,
+    store: Path | None = None,
+) -> list[Chain]:
+    """The chains of a sweep, without the points already ``done`` (from the store)."""
+    values = checked_values(system, parameter, values)
+    order = [float(v) for v in (values[::-1] if backward else values)]
+    x0 = None if x0 is None else [float(v) for v in x0]
+    done = done or {}
+    base = (module_ref(system), dict(system.values), parameter)
+    where = None if store is None else str(store)
+    if continuation:
+        # Resume after the last finished point, from the last state that was reached.
+        k = 0
+        while k in done:
+            k += 1
+        for j in range(k - 1, -1, -1):
+            if done[j].ok:
+                x0 = [float(v) for v in done[j].x_final]
+                break
+        if k == len(order):
+            return []
+        return [Chain(*base, order[k:], x0, settings, True, list(range(k, len(order))), where)]
+    todo = [i for i in range(len(order)) if i not in done]
+    method = settings.get("method") or fastest_method(settings.get("rtol", 1e-8))
+    if get_method(method).family != "native" or len(todo) < 2:
+        return [Chain(*base, [order[i]], x0, settings, False, [i], where) for i in todo]
+    # Compiled methods: lockstep chunks of up to CHUNK points, as many as a multiple of
+    # SPREAD so that 2 or 4 workers share the work evenly.  The chunks depend on the
+    # number of points only (not on the executor or the machine), so that a sweep's
+    # results are the same bits whichever way it runs.
+    count = -(-max(1, -(-len(todo) // CHUNK)) // SPREAD) * SPREAD
+    chunks = np.array_split(np.asarray(todo), min(count, len(todo)))
+    return [
+        Chain(*base, [order[i] for i in c], x0, settings, False, c.tolist(), where, True)
+        for c in chunks
+        if c.size
+    ]

@@ -1,0 +1,129 @@
+"""The result of a sweep: one :class:`~.points.SweepPoint` per value, in order.
+
+``save`` writes JSON, CSV or MATLAB files (``solver/export.py``).  A sweep that ran with a
+store already holds every point's JSON text (written once, in the worker that computed
+the point); ``sweep.json`` is then assembled from those texts instead of encoding the
+4 MB of Poincare points a second time.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .._json import dumps
+from .points import SweepPoint
+from .store import write_atomic
+
+__all__ = ["SweepResult"]
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """Per-point summaries of a sweep (in the order of ``values``)."""
+
+    model: str
+    model_hash: str
+    parameter: str
+    values: np.ndarray
+    direction: str  # "forward", "backward" or "independent"
+    base_values: dict
+    settings: dict
+    points: list = field(default_factory=list)  # SweepPoint, in the order of values
+    scales: dict = field(default_factory=dict)  # omega_n and half backlash: back to SI
+    # Each point's JSON text, dumps(point.to_dict()), when the store already wrote it.
+    texts: list | None = field(default=None, compare=False, repr=False)
+
+    def poincare(self, state: str) -> list[np.ndarray]:
+        return [np.asarray(p.poincare[state]) for p in self.points]
+
+    def motion(self, coordinate: str) -> list[str]:
+        return [p.motion(coordinate) for p in self.points]
+
+    def maxima(self, state: str) -> np.ndarray:
+        """Max of ``state`` at every point (NaN where a point failed)."""
+        return np.array([p.max(state) for p in self.points])
+
+    def minima(self, state: str) -> np.ndarray:
+        """Min of ``state`` at every point (NaN where a point failed)."""
+        return np.array([p.min(state) for p in self.points])
+
+    def _head(self) -> dict:
+        """Everything of :meth:`to_dict` but the points."""
+        return {
+            "model": self.model,
+            "model_hash": self.model_hash,
+            "parameter": self.parameter,
+            "values": self.values.tolist(),
+            "direction": self.direction,
+            "base_values": self.base_values,
+            "settings": self.settings,
+            "scales": self.scales,
+        }
+
+    def to_dict(self) -> dict:
+        return {**self._head(), "points": [p.to_dict() for p in self.points]}
+
+    def to_table(self) -> tuple[list, list]:
+        """One row per point: the value, status, motion of each coordinate, max and min of
+        each state, and the largest Lyapunov exponent."""
+        if not self.points:
+            return [self.parameter, "status"], []
+        coords = list(self.points[0].classification)
+        states = list(self.points[0].extremes)
+        columns = [
+            self.parameter,
+            "status",
+            *(f"motion_{c}" for c in coords),
+            *(f"{k}_{s}" for s in states for k in ("max", "min")),
+            "lyapunov",
+        ]
+        rows = [
+            [
+                p.value,
+                p.status,
+                *(p.motion(c) for c in coords),
+                *(f(s) for s in states for f in (p.max, p.min)),
+                p.lyapunov_exponent,
+            ]
+            for p in self.points
+        ]
+        return columns, rows
+
+    def save(self, path: Path) -> Path:
+        """Write the sweep (parameter values, scales and model hash included): ``.json``,
+        ``.csv`` or ``.mat`` (see ``solver/export.py``)."""
+        path = Path(path)
+        if path.suffix.lower() == ".json" and self.texts is not None:
+            write_atomic(path, self.to_json())
+            return path
+        from ..export import save
+
+        return save(self, path)
+
+    def to_json(self) -> str:
+        """``dumps(self.to_dict())``, made from the points' stored texts when there are."""
+        if self.texts is None or len(self.texts) != len(self.points):
+            return dumps(self.to_dict())
+        # "points" is the last key and json.dumps nests without indentation: the document
+        # is the head with the texts spliced into its empty list.
+        head = dumps({**self._head(), "points": []})
+        return head[: -len("]}")] + ", ".join(self.texts) + "]}"
+
+    @classmethod
+    def load(cls, path: Path) -> SweepResult:
+        d = json.loads(Path(path).read_text(encoding="utf-8"))
+        return cls(
+            d["model"],
+            d["model_hash"],
+            d["parameter"],
+            np.asarray(d["values"]),
+            d["direction"],
+            d["base_values"],
+            d["settings"],
+            [SweepPoint.from_dict(p) for p in d["points"]],
+            d.get("scales", {}),
+        )

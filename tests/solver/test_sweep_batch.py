@@ -1,0 +1,135 @@
+"""Independent sweep points integrated together (compiled lockstep chunks) against the same
+points one at a time.
+
+Reference: the per-point path -- ``analyse_point``, each point integrated on its own by the
+compiled DOP853 (``simulate``), which the batched path must reproduce within the
+integrator's tolerance (rtol 1e-8 on states of order 1: 1e-6 allowed), verdicts included.
+"""
+
+import json
+
+import numpy as np
+import pytest
+from gearsym.cli import main
+from gearsym.solver._json import dumps
+from gearsym.solver.analysis import analyse_point
+from gearsym.solver.integrate.simulate import simulate, simulate_many
+from gearsym.solver.sweep import SweepResult, sweep
+from gearsym.solver.sweep.chains import plan
+from gearsym.solver.system import System
+
+# Eight values put two points in each of the four lockstep chunks; 0.0476 is a period-3
+# point and 0.1303 a period-12 point of the reference model at the default settings.
+VALUES = [0.0, 0.047619047619047616, 0.1, 0.13032581453634084, 0.35, 0.5, 0.8, 1.0]
+
+
+@pytest.fixture(scope="module")
+def light():
+    return System.load("reference_light")
+
+
+@pytest.fixture(scope="module")
+def batched(light):
+    return sweep(light, "lambda", VALUES, continuation=False, lyapunov_periods=0)
+
+
+def test_the_points_run_in_lockstep_chunks(light):
+    chains = plan(light, "lambda", VALUES, continuation=False, backward=False, x0=None, settings={})
+    assert all(c.batch for c in chains) and [len(c.values) for c in chains] == [2, 2, 2, 2]
+    assert sorted(i for c in chains for i in c.indices) == list(range(len(VALUES)))
+    # not compiled: one point per chain, as before
+    chains = plan(
+        light,
+        "lambda",
+        VALUES,
+        continuation=False,
+        backward=False,
+        x0=None,
+        settings={"method": "cvodes"},
+    )
+    assert not any(c.batch for c in chains) and len(chains) == len(VALUES)
+
+
+def test_simulate_many_matches_simulate(light):
+    systems = [light.with_values(**{"lambda": v}) for v in (0.0, 0.35, 0.8)]
+    many = simulate_many(systems, transient=100, periods=20, samples_per_period=16)
+    for s, tr in zip(systems, many, strict=True):
+        one = simulate(s, transient=100, periods=20, samples_per_period=16)
+        assert tr.status == one.status == "ok"
+        assert np.max(np.abs(tr.x - one.x)) < 1e-6  # rtol 1e-8 on O(1) states
+        assert tr.t_final == one.t_final and tr.x.shape == one.x.shape
+
+
+def test_batched_sweep_equals_point_by_point(light, batched):
+    # Verdicts equal; Poincare points, Max/Min and meshing shares within the tolerance.
+    for v, point in zip(VALUES, batched.points, strict=True):
+        ref = analyse_point(light.with_values(**{"lambda": v}), lyapunov_periods=0)
+        tr = ref.trajectory
+        assert point.ok and tr.status == "ok"
+        for c in light.coordinates:
+            assert point.motion(c) == ref.classification[c].motion
+        for k, s in enumerate(light.states):
+            assert point.max(s) == pytest.approx(tr.x[k].max(), abs=1e-6)
+            assert point.min(s) == pytest.approx(tr.x[k].min(), abs=1e-6)
+            assert np.allclose(point.poincare[s], tr.poincare[k], rtol=0, atol=1e-6)
+        assert point.lyapunov is None
+    assert [p.motion("u") for p in batched.points][1:4] == ["period-3", "period-1", "period-12"]
+
+
+def test_serial_and_parallel_batched_sweeps_are_bit_identical(light, batched):
+    # The chunks depend on the number of points only, not on the executor.
+    other = sweep(
+        light, "lambda", VALUES, continuation=False, lyapunov_periods=0, executor="processes"
+    )
+    strip = [json.loads(dumps(p.to_dict())) for p in (*batched.points, *other.points)]
+    for d in strip:
+        d["integration"].pop("wall_time_s", None)
+    assert strip[: len(VALUES)] == strip[len(VALUES) :]
+
+
+def test_sweep_json_from_the_stored_texts_is_the_plain_encoding(light, tmp_path):
+    # The file assembled from the store's per-point texts equals dumps(to_dict()), also
+    # for a backward sweep and after a resume (texts read back from the store).
+    settings = dict(transient=20, periods=6, lyapunov_periods=0)
+    for backward in (False, True):
+        store = tmp_path / f"store{backward}"
+        result = sweep(light, "lambda", VALUES, continuation=False, store=store, **settings)
+        assert result.texts is not None
+        assert result.to_json() == dumps(result.to_dict())
+        (store / "points" / "00003.json").unlink()
+        again = sweep(light, "lambda", VALUES, continuation=False, store=store, **settings)
+        assert again.to_json() == dumps(again.to_dict())
+        path = again.save(tmp_path / "sweep.json")
+        assert SweepResult.load(path).motion("u") == result.motion("u")
+    assert sweep(light, "lambda", VALUES[:3], **settings).texts is None  # nothing stored
+
+
+def test_cli_sweep_of_independent_points(tmp_path, capsys):
+    out = tmp_path / "sw"
+    args = ["sweep", "reference-light", "--param", "lambda", "--range", "0:1:8"]
+    args += ["--independent", "--lyapunov-periods", "0", "--quiet", "--out", str(out)]
+    assert main(args) == 0
+    data = json.loads((out / "sweep.json").read_text())
+    assert data["direction"] == "independent" and len(data["points"]) == 8
+    assert all(p["status"] == "ok" and p["lyapunov"] is None for p in data["points"])
+    assert (out / "bifurcation.png").stat().st_size > 0
+    assert "u: period-1 on [0, 1]" in capsys.readouterr().out
+
+
+def test_cli_sweep_errors_are_one_line(tmp_path, capsys):
+    base = ["sweep", "reference-light", "--param", "lambda", "--independent", "--quiet"]
+    base += ["--lyapunov-periods", "0", "--transient", "20", "--periods", "6"]
+    assert main([*base, "--range", "0:1:8", "--out", str(tmp_path / "a")]) == 0
+    capsys.readouterr()
+    # the same folder, another sweep: refused in one line, nothing overwritten
+    assert main([*base, "--range", "0:1:9", "--out", str(tmp_path / "a")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("gearsym: error: sweep: ")
+    assert "holds another sweep" in err[0]
+
+
+def test_simulate_many_checks_its_input(light):
+    with pytest.raises(ValueError, match="2 systems but 1 initial states"):
+        simulate_many([light, light], [np.zeros(4)])
+    with pytest.raises(TypeError, match="unknown option"):
+        simulate_many([light], periodz=3)
