@@ -54,7 +54,8 @@ def register(sub) -> None:
     sw.add_argument(
         "--independent",
         action="store_true",
-        help="no continuation: every point from the same initial state",
+        help="no continuation: every point from the same initial state (with a compiled "
+        "method the points are integrated together, in chunks, on every core)",
     )
     sw.add_argument(
         "--executor",
@@ -68,6 +69,11 @@ def register(sub) -> None:
     )
     sw.add_argument("--out", metavar="DIR")
     sw.add_argument("--quiet", action="store_true", help="no progress bar")
+    sw.add_argument(
+        "--no-figure",
+        action="store_true",
+        help="write the data only (sweep.json), not bifurcation.png",
+    )
     analysis_options(sw)
     sw.set_defaults(func=_cmd_sweep)
 
@@ -143,15 +149,25 @@ def _cmd_simulate(args) -> int:
 
 
 def _cmd_sweep(args) -> int:
-    from gearsym.solver import plots
     from gearsym.solver.integrate import SimulationError
     from gearsym.solver.sweep import Progress, sweep
     from gearsym.studies.report import runs_text
 
+    figure = not args.no_figure
+
+    class _Bar(Progress):
+        """The progress line.  Its first step loads the figure code (matplotlib, a third of
+        a second) while the workers are still integrating, not after them."""
+
+        def step(self, note: str = "") -> None:
+            if self.done == 0 and figure:
+                import gearsym.solver.plots  # noqa: F401
+            super().step(note)
+
     values = parse_range(args.range)
     system = system_of(args.scene, parse_set(args.set))
     out = Path(args.out or f"sweep_{system.name}_{args.param}")
-    bar = Progress(len(values), f"{args.param}", enabled=not args.quiet)
+    bar = _Bar(len(values), f"{args.param}", enabled=not args.quiet)
     stored = len(list((out / "store" / "points").glob("[0-9]*.json")))
     try:
         result = sweep(
@@ -172,13 +188,18 @@ def _cmd_sweep(args) -> int:
     if stored:
         print(f"resumed: {stored} of {len(values)} points came from {out / 'store'}")
     path = result.save(out / "sweep.json")
-    fig = plots.bifurcation_diagram(
-        [result],
-        list(system.coordinates),
-        out / "bifurcation.png",
-        title=f"{system.name}: {args.param} sweep",
-    )
-    print(f"wrote {path} and {fig}")
+    if figure:
+        from gearsym.solver import plots
+
+        fig = plots.bifurcation_diagram(
+            [result],
+            list(system.coordinates),
+            out / "bifurcation.png",
+            title=f"{system.name}: {args.param} sweep",
+        )
+        print(f"wrote {path} and {fig}")
+    else:
+        print(f"wrote {path}")
     for c in system.coordinates:
         print(f"  {c}: {runs_text(values, result.motion(c))}")
     if failed:

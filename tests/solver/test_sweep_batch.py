@@ -7,6 +7,8 @@ integrator's tolerance (rtol 1e-8 on states of order 1: 1e-6 allowed), verdicts 
 """
 
 import json
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -133,3 +135,18 @@ def test_simulate_many_checks_its_input(light):
         simulate_many([light, light], [np.zeros(4)])
     with pytest.raises(TypeError, match="unknown option"):
         simulate_many([light], periodz=3)
+
+
+def test_a_sweep_without_a_figure_loads_neither_matplotlib_sympy_nor_casadi(tmp_path):
+    # A fresh process, as a user runs it: the data-only sweep needs none of the three.
+    code = (
+        "import sys; from gearsym.cli import main; "
+        f"rc = main(['sweep', 'reference-light', '--param', 'lambda', '--range', '0:1:8', "
+        f"'--independent', '--lyapunov-periods', '0', '--transient', '20', '--periods', '6', "
+        f"'--quiet', '--no-figure', '--out', r'{tmp_path / 'sw'}']); "
+        "print(rc, sorted(m for m in ('matplotlib', 'sympy', 'casadi') if m in sys.modules))"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.stdout.strip().splitlines()[-1] == "0 []", done.stderr
+    assert (tmp_path / "sw" / "sweep.json").exists()
+    assert not (tmp_path / "sw" / "bifurcation.png").exists()
