@@ -121,10 +121,20 @@ def reproduce(
         (out / "data" / f"continuation_{case}.json").write_text(
             dumps([b.describe() for b in branches[case]]), encoding="utf-8"
         )
+    from .report_sensitivity import sensitivity_section
+    from .sensitivity import SCENES, physical_scales, run_sensitivity
+
+    rows = run_sensitivity(
+        out, res, settings, quick=quick, executor=executor, workers=workers, progress=progress
+    )
+    scales = physical_scales(SCENES["light"][0])
+    section = sensitivity_section(rows, scales, {c: f1 for c, (_, f1) in SCENES.items()}, points)
     elapsed = time.perf_counter() - started
     text = report(
         res, lam, by_case, points, maps, map_lam, elapsed, quick, systems, branches, method
     )
+    head, sep, tail = text.partition("## Figures")
+    text = head + section + "\n" + sep + tail
     path = out / "report.md"
     path.write_text(text, encoding="utf-8")
     return path

@@ -1,0 +1,169 @@
+"""Where the study's findings live in the values it leaves open (issue 12, point 6).
+
+For each open value the derive layer offers (``gearsym.derive.open_values``), a regime map
+over lambda by that value, at both loads, from at least two initial states so that
+coexisting attractors show.  Each value is a new derivation (cached); the built-in scenes
+keep their stated values, which are always among the values tried.  Nothing is tuned: the
+values tried are a fixed spread round the stated one, chosen before any run.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["OPEN_SPREAD", "FINDINGS", "Sensitivity", "run_sensitivity", "physical_scales"]
+
+# key -> (values tried, stated value of the built-in scenes, unit)
+OPEN_SPREAD = {
+    "te_amplitude_um": ((0.0, 5.0, 20.0, 50.0), 5.0, "µm"),
+    "flywheel_inertia_kg_m2": ((1.0, 10.0, 100.0), 10.0, "kg m²"),
+    "layout_angle_deg": ((0.0, 60.0, 120.0, 180.0), 120.0, "°"),
+    "stiffness_harmonic_scale": ((0.0, 1.0, 2.0), 1.0, "×"),
+}
+QUICK_SPREAD = {"te_amplitude_um": ((5.0, 50.0), 5.0, "µm")}
+
+# Findings per load, each a test on the set of attractors (motion of u / v) at each lambda.
+# (case, name, coordinate, motion test, lambda range where the study reports it)
+FINDINGS = {
+    "light": (
+        ("u quasi-periodic at low λ", "u", "quasi", (0.0, 0.57)),
+        ("v chaotic at low λ", "v", "chaotic", (0.0, 0.3)),
+    ),
+    "heavy": (
+        ("u quasi-periodic at low λ", "u", "quasi", (0.0, 0.13)),
+        ("v chaotic at low λ", "v", "chaotic", (0.0, 0.3)),
+        ("u period-3 at high λ", "u", "period-3", (0.13, 1.0)),
+    ),
+}
+SCENES = {"light": ("reference-light", 0.1), "heavy": ("reference-heavy", 0.5)}
+
+
+@dataclass
+class Sensitivity:
+    case: str
+    key: str
+    values: tuple
+    stated: float
+    unit: str
+    motions: dict  # value -> sorted motion types (u and v) over every lambda and attractor
+    critical: dict  # value -> critical lambda of v (nan: none, 0: periodic everywhere)
+    reproduced: dict  # finding -> list of values that reproduce it
+    failed: int  # attractor records whose runs failed (e.g. left the valid range)
+    figures: list
+
+
+def _matches(motion: str, test: str) -> bool:
+    return motion.startswith(test) if test != "period-3" else motion == "period-3"
+
+
+def _resolver(scene: str, key: str):
+    from gearsym.resolve import load
+
+    memo: dict = {}
+
+    def resolve(values: dict):
+        v = values[key]
+        if v not in memo:
+            memo[v] = load(scene, **{key: v})
+        return memo[v].with_values(**{k: x for k, x in values.items() if k != key})
+
+    return resolve
+
+
+def _critical(records, lam_values, value, key) -> float:
+    """Smallest lambda past which every attractor of v is periodic (nan: never); runs
+    that failed (left the polynomial's valid range) are not attractors and not counted."""
+    ok = []
+    for lam in lam_values:
+        here = [r for r in records
+                if r["lambda"] == lam and r[key] == value and r["status"] == "ok"]  # fmt: skip
+        ok.append(bool(here) and all(r["motion"]["v"].startswith("period-") for r in here))
+    for k in range(len(ok)):
+        if all(ok[k:]):
+            return float(lam_values[k])
+    return float("nan")
+
+
+def run_sensitivity(out: Path, res, settings: dict, *, quick, executor, workers, progress):
+    """Regime maps over lambda by each open value at both loads; figures and data under
+    ``out``; a list of :class:`Sensitivity` rows."""
+    from gearsym.resolve import load
+    from gearsym.solver.plots_maps import map_figures
+    from gearsym.solver.sweep.atlas import regime_map
+
+    spread = QUICK_SPREAD if quick else OPEN_SPREAD
+    lam = np.round(np.linspace(0.0, 1.0, 6 if quick else 11), 10)
+    folder = out / "sensitivity"
+    folder.mkdir(parents=True, exist_ok=True)
+    rows = []
+    for case, (scene, _f1) in SCENES.items():
+        base = load(scene)
+        for key, (values, stated, unit) in spread.items():
+            if progress:
+                import sys
+
+                print(f"sensitivity: {case} load, {key} = {list(values)}", file=sys.stderr)
+            m = regime_map(
+                base,
+                ("lambda", lam),
+                (key, np.array(values, float)),
+                initial_states=3,
+                seed=0,
+                transient=res.transient,
+                periods=res.periods,
+                lyapunov_periods=min(res.lyapunov_periods, res.transient + res.periods),
+                method=settings["method"],
+                rtol=settings["rtol"],
+                atol=settings["atol"],
+                executor=executor,
+                workers=workers,
+                store=out / "store" / f"sensitivity_{case}_{key}",
+                progress=progress,
+                resolve=_resolver(scene, key),
+            )
+            m.save(out / "data" / f"sensitivity_{case}_{key}.json")
+            figs = map_figures(m, folder, f"{case}-{key}")
+            records = m.records()
+            motions, critical = {}, {}
+            for v in values:
+                here = [r for r in records if r[key] == v and r["status"] == "ok"]
+                motions[v] = sorted({r["motion"][c] for r in here for c in ("u", "v")})
+                critical[v] = _critical(records, lam, v, key)
+            reproduced = {}
+            for name, coord, test, (lo, hi) in FINDINGS[case]:
+                inside = [r for r in records if lo <= r["lambda"] <= hi]
+                shows = [r[key] for r in inside if _matches(r["motion"][coord], test)]
+                reproduced[name] = [v for v in values if v in shows]
+            rows.append(
+                Sensitivity(
+                    case,
+                    key,
+                    values,
+                    stated,
+                    unit,
+                    motions,
+                    critical,
+                    reproduced,
+                    sum(r["status"] != "ok" for r in records),
+                    figs,
+                )
+            )
+    return rows
+
+
+def physical_scales(scene: str) -> dict:
+    """Force and length scales of a scene's model (application layer: it derives).
+    The non-dimensional mesh force times ``force_N`` is newtons; u times ``b_um`` is the
+    dynamic transmission error in µm."""
+    from gearsym.derive import derive_model, load_target, resolve_target
+
+    model = derive_model(load_target(resolve_target(scene)))
+    s = model.scales
+    out = {}
+    for c, b in s["half_backlash_m"].items():
+        km = s["mean_stiffness_N_per_m"][c]
+        out[c] = {"k_m_N_per_m": km, "b_um": b * 1e6, "force_N": km * b}
+    return out

@@ -1,0 +1,77 @@
+"""The reproduce report's sensitivity section (issue 12, point 6)."""
+
+import math
+
+import numpy as np
+import pytest
+from gearsym.studies.report_sensitivity import sensitivity_section
+from gearsym.studies.sensitivity import OPEN_SPREAD, Sensitivity, _critical, _matches
+
+
+def _rec(lam, value, v, status="ok"):
+    return {"lambda": lam, "k": value, "status": status, "motion": {"u": "period-1", "v": v}}
+
+
+def test_critical_lambda_is_where_every_attractor_of_v_stays_periodic():
+    lam = np.array([0.0, 0.5, 1.0])
+    records = [
+        _rec(0.0, 1, "chaotic"),
+        _rec(0.5, 1, "period-1"),
+        _rec(0.5, 1, "quasi-periodic"),  # a coexisting non-periodic attractor
+        _rec(1.0, 1, "period-1"),
+        _rec(0.0, 2, "period-1"),
+        _rec(0.5, 2, "period-1"),
+        _rec(1.0, 2, "period-3"),
+        _rec(1.0, 2, "undetermined", status="left the valid range"),  # not an attractor
+        _rec(1.0, 3, "chaotic"),
+    ]
+    assert _critical(records, lam, 1, "k") == 1.0
+    assert _critical(records, lam, 2, "k") == 0.0
+    assert math.isnan(_critical(records, lam, 3, "k"))
+
+
+def test_period_3_means_the_minimal_period_three():
+    assert _matches("period-3", "period-3")
+    assert not _matches("period-30", "period-3")
+    assert _matches("quasi-periodic", "quasi")
+
+
+def test_stated_values_are_among_those_tried():
+    for values, stated, _ in OPEN_SPREAD.values():
+        assert stated in values
+
+
+def test_section_states_every_finding_and_marks_the_stated_value():
+    row = Sensitivity(
+        case="heavy",
+        key="te_amplitude_um",
+        values=(5.0, 50.0),
+        stated=5.0,
+        unit="µm",
+        motions={5.0: ["period-1"], 50.0: ["period-1", "period-2"]},
+        critical={5.0: 0.0, 50.0: float("nan")},
+        reproduced={"u period-3 at high λ": [], "v chaotic at low λ": [50.0]},
+        failed=2,
+        figures=[],
+    )
+    scales = {"u": {"k_m_N_per_m": 1e9, "b_um": 50.0, "force_N": 5e4}}
+    text = sensitivity_section([row], scales, {"heavy": 0.5}, {})
+    assert "| heavy (f1 = 0.5) | `te_amplitude_um` (µm) | 5*, 50 |" in text
+    assert "5: 0; 50: none" in text
+    assert "*u period-3 at high λ*: **no value tried reproduces it.**" in text
+    assert "*v chaotic at low λ*: reproduced with `te_amplitude_um` = 50." in text
+    assert "2 runs failed" in text
+    assert "| u | 1e+09 | 50 | 5e+04 | 1000 | 2.5e+04 |" in text
+    assert "multiples of ω̄/3" in text
+
+
+@pytest.mark.slow
+def test_reproduce_quick_has_the_sensitivity_table(tmp_path):
+    from gearsym.cli import main
+
+    assert main(["reproduce", "--quick", "--out", str(tmp_path), "--quiet"]) == 0
+    report = (tmp_path / "report.md").read_text()
+    assert "## Sensitivity to the values the study leaves open" in report
+    assert "| light (f1 = 0.1) | `te_amplitude_um` (µm) |" in report
+    assert "### Physical scales" in report
+    assert (tmp_path / "sensitivity" / "heavy-te_amplitude_um-motion.png").stat().st_size > 1000
