@@ -65,7 +65,7 @@ class SweepPoint:
     @classmethod
     def from_result(cls, result, value: float) -> SweepPoint:
         """The summary of a :class:`~gearsym.solver.analysis.point.PointResult`."""
-        d = result.describe(poincare=True)
+        d = result.describe(poincare=False)  # the arrays are copied below
         tr = result.trajectory
         return cls(
             value=float(value),
