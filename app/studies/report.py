@@ -293,6 +293,13 @@ def report(
         "- `map_f1_lambda.png`: Max(u), Min(v) and the motion of v over (f1, λ).",
         "- `continuation_<case>.png`: continued branches (stable solid, unstable dashed, "
         "bifurcations marked) over the brute-force Poincaré points.",
+        "- `meshing_lyapunov_<case>.png`: share of time each mesh spends in forward contact, "
+        "separated and in backward contact, and the largest Lyapunov exponent with its "
+        "uncertainty, against λ, both sweeps.",
+        "- `backlash.png`: the model's polynomial g(x) against the exact dead zone, contact "
+        "edges ±1 and the fit's valid range marked.",
+        "- `stiffness.png`: k(τ)/k_m of both meshes over two mesh periods, with their phase lag.",
+        "- `sensitivity/<load>-<open value>-*.png`: regime maps over λ by each open value.",
         "",
         "Data (parameter values, scales and model hash with every point) are in `data/`.",
         "",

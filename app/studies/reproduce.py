@@ -74,6 +74,22 @@ def reproduce(
 
     from gearsym.solver import plots
 
+    from .figures import backlash_figure, stiffness_figure, sweep_state_figure
+
+    start = "start: each mesh pressed into contact by its load, at rest; then each point from"
+    for case, _, f1 in CASES:
+        sweep_state_figure(
+            by_case[case],
+            out / f"meshing_lyapunov_{case}.png",
+            f"{case} load, f1 = {f1}: meshing state and largest Lyapunov exponent",
+            f"{systems[case].name}, scene values (no overrides); {start} the previous one's "
+            f"end state; {res.transient} + {res.periods} periods, {method} "
+            f"rtol {TOLERANCES['rtol']:g}",
+        )
+    plain = f"{systems['light'].name}, scene values (no overrides)"
+    backlash_figure(systems["light"], out / "backlash.png", plain)
+    stiffness_figure(systems["light"], out / "stiffness.png", plain)
+
     points = {}
     for case, _, f1 in CASES:
         plots.bifurcation_diagram(
