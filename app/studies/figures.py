@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["backlash_figure", "stiffness_figure", "sweep_state_figure"]
+__all__ = ["backlash_figure", "floquet_figure", "stiffness_figure", "sweep_state_figure"]
 
 
 def _plt():
@@ -111,6 +111,36 @@ def stiffness_figure(system, path: Path, caption: str) -> Path:
     ax.set_ylabel("k(τ) / k_m")
     ax.set_title("mesh stiffness of both meshes over their mean")
     ax.legend(fontsize=8)
+    _caption(fig, caption)
+    fig.tight_layout(rect=(0, 0.04, 1, 1))
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def floquet_figure(branches, path: Path, title: str, caption: str) -> Path:
+    """Moduli of the Floquet multipliers along each continued branch against lambda (the
+    orbit is stable while all lie inside the unit circle), and the bifurcations found."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for k, br in enumerate(branches):
+        if not br.multipliers:
+            continue
+        lam = np.array(br.values, float)
+        mods = np.sort(np.abs(np.array([np.asarray(m) for m in br.multipliers])), axis=1)
+        col = colors[k % len(colors)]
+        for j in range(mods.shape[1]):
+            label = f"branch {k + 1} (period-{br.n}), all multipliers" if j == 0 else None
+            ax.plot(lam, mods[:, j], ".", ms=2.5, color=col, label=label)
+        for b in br.bifurcations:
+            ax.axvline(float(b.value), color=col, ls=":", lw=0.8)
+    ax.axhline(1.0, color="k", lw=1, label="|μ| = 1 (unit circle)")
+    ax.set_yscale("log")
+    ax.set_xlabel("lambda")
+    ax.set_ylabel("|Floquet multiplier|")
+    ax.set_title(title + "; dotted: bifurcations located")
+    ax.legend(fontsize=7)
     _caption(fig, caption)
     fig.tight_layout(rect=(0, 0.04, 1, 1))
     fig.savefig(path, dpi=110)

@@ -298,6 +298,8 @@ def report(
         "uncertainty, against λ, both sweeps.",
         "- `backlash.png`: the model's polynomial g(x) against the exact dead zone, contact "
         "edges ±1 and the fit's valid range marked.",
+        "- `floquet_<case>.png`: moduli of the Floquet multipliers along each continued "
+        "branch against λ, the unit circle and the bifurcations located marked.",
         "- `stiffness.png`: k(τ)/k_m of both meshes over two mesh periods, with their phase lag.",
         "- `sensitivity/<load>-<open value>-*.png`: regime maps over λ by each open value.",
         "",

@@ -74,7 +74,7 @@ def reproduce(
 
     from gearsym.solver import plots
 
-    from .figures import backlash_figure, stiffness_figure, sweep_state_figure
+    from .figures import backlash_figure, floquet_figure, stiffness_figure, sweep_state_figure
 
     start = "start: each mesh pressed into contact by its load, at rest; then each point from"
     for case, _, f1 in CASES:
@@ -133,6 +133,13 @@ def reproduce(
             "u",
             sweeps=by_case[case],
             title=f"{case} load, f1 = {f1}: period-1 branch over the sweeps",
+        )
+        floquet_figure(
+            branches[case],
+            out / f"floquet_{case}.png",
+            f"{case} load, f1 = {f1}",
+            f"{systems[case].name}, scene values (no overrides); branches continued both ways "
+            "from the periodic points of the forward sweep",
         )
         (out / "data" / f"continuation_{case}.json").write_text(
             dumps([b.describe() for b in branches[case]]), encoding="utf-8"
