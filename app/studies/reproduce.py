@@ -11,6 +11,7 @@ the study leaves open are those of the shipped scenes, stated in their files.
 
 from __future__ import annotations
 
+import sys
 import time
 from pathlib import Path
 
@@ -39,6 +40,11 @@ def reproduce(
     """Run everything, write figures, data and ``report.md`` under ``out``; return the
     report's path."""
     res = RESOLUTIONS["quick" if quick else "full"]
+
+    def stage(text: str) -> None:
+        if progress:
+            print(f"reproduce: {text} ({time.perf_counter() - started:.0f} s)", file=sys.stderr)
+
     out = Path(out)
     (out / "data").mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
@@ -74,6 +80,7 @@ def reproduce(
 
     from gearsym.solver import plots
 
+    stage("sweeps done; figures")
     from .figures import backlash_figure, floquet_figure, stiffness_figure, sweep_state_figure
 
     start = "start: each mesh pressed into contact by its load, at rest; then each point from"
@@ -90,6 +97,7 @@ def reproduce(
     backlash_figure(systems["light"], out / "backlash.png", plain)
     stiffness_figure(systems["light"], out / "stiffness.png", plain)
 
+    stage("operating points lambda = 0.1, 0.8")
     points = {}
     for case, _, f1 in CASES:
         plots.bifurcation_diagram(
@@ -125,6 +133,7 @@ def reproduce(
         title="light-load scene with f1 varied",
         names=("f1", "lambda", "u", "v"),
     )
+    stage("continuation of the periodic branches")
     branches = _continue_cases(systems, by_case, quick, executor, workers)
     for case, _, f1 in CASES:
         plots.branch_figure(
@@ -147,6 +156,7 @@ def reproduce(
     from .report_sensitivity import sensitivity_section
     from .sensitivity import SCENES, physical_scales, run_sensitivity
 
+    stage("sensitivity to the open values (regime maps; store under out/store)")
     rows = run_sensitivity(
         out, res, settings, quick=quick, executor=executor, workers=workers, progress=progress
     )
