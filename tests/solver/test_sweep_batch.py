@@ -15,10 +15,13 @@ import pytest
 from gearsym.cli import main
 from gearsym.solver._json import dumps
 from gearsym.solver.analysis import analyse_point
+from gearsym.solver.integrate import native
 from gearsym.solver.integrate.simulate import simulate, simulate_many
 from gearsym.solver.sweep import SweepResult, sweep
 from gearsym.solver.sweep.chains import plan
 from gearsym.solver.system import System
+
+pytestmark = pytest.mark.skipif(native.compiler() is None, reason="no C compiler")
 
 # Eight values put two points in each of the four lockstep chunks; 0.0476 is a period-3
 # point and 0.1303 a period-12 point of the reference model at the default settings.
