@@ -18,7 +18,8 @@ __all__ = ["OPEN_SPREAD", "FINDINGS", "Sensitivity", "run_sensitivity", "physica
 
 # key -> (values tried, stated value of the built-in scenes, unit)
 OPEN_SPREAD = {
-    "te_amplitude_um": ((0.0, 5.0, 20.0, 50.0), 5.0, "µm"),
+    # a uniform 2.5 um grid up to four times the stated 5 um, and 50 um (one half backlash)
+    "te_amplitude_um": ((0.0, 2.5, 5.0, 7.5, 10.0, 12.5, 15.0, 20.0, 50.0), 5.0, "µm"),
     "flywheel_inertia_kg_m2": ((1.0, 10.0, 100.0), 10.0, "kg m²"),
     "layout_angle_deg": ((0.0, 60.0, 120.0, 180.0), 120.0, "°"),
     "stiffness_harmonic_scale": ((0.0, 1.0, 2.0), 1.0, "×"),
