@@ -151,6 +151,7 @@ def _cmd_simulate(args) -> int:
 def _cmd_sweep(args) -> int:
     from gearsym.solver.integrate import SimulationError
     from gearsym.solver.sweep import Progress, sweep
+    from gearsym.solver.sweep.store import stored_count
     from gearsym.studies.report import runs_text
 
     figure = not args.no_figure
@@ -168,7 +169,7 @@ def _cmd_sweep(args) -> int:
     system = system_of(args.scene, parse_set(args.set))
     out = Path(args.out or f"sweep_{system.name}_{args.param}")
     bar = _Bar(len(values), f"{args.param}", enabled=not args.quiet)
-    stored = len(list((out / "store" / "points").glob("[0-9]*.json")))
+    stored = stored_count(out / "store")
     try:
         result = sweep(
             system,

@@ -22,7 +22,7 @@ from ..integrate.methods import get_method
 from ..integrate.simulate import fastest_method, simulate_many
 from ..system import System
 from .points import SweepPoint
-from .store import store_point
+from .store import point_text, store_chunk, store_point
 
 __all__ = ["Chain", "ChainDone", "checked_values", "module_ref", "plan", "run_chain"]
 
@@ -136,17 +136,22 @@ def _points(chain: Chain, system: System):
 
 
 def run_chain(chain: Chain, on_point=None) -> ChainDone:
-    """Run one chain (in a worker): its points, each stored as soon as it is done."""
+    """Run one chain (in a worker): its points, each stored as soon as it is done (a
+    lockstep chunk, whose points finish together, as one file)."""
     system = System.load(chain.module, **chain.base_values)
     points, texts = [], []
     for k, point in enumerate(_points(chain, system)):
         text = None
-        if chain.store is not None:
+        if chain.store is not None and chain.batch:
+            text = point_text(point)
+        elif chain.store is not None:
             text = store_point(Path(chain.store), chain.indices[k], point)
         points.append(point)
         texts.append(text)
         if on_point is not None:
             on_point(point)
+    if chain.store is not None and chain.batch:
+        store_chunk(Path(chain.store), chain.indices, texts)
     return ChainDone(points, texts)
 
 
@@ -183,14 +188,16 @@ def plan(
         return [Chain(*base, order[k:], x0, settings, True, list(range(k, len(order))), where)]
     todo = [i for i in range(len(order)) if i not in done]
     method = settings.get("method") or fastest_method(settings.get("rtol", 1e-8))
-    if get_method(method).family != "native" or len(todo) < 2:
+    if get_method(method).family != "native" or len(order) < 2:
         return [Chain(*base, [order[i]], x0, settings, False, [i], where) for i in todo]
     # Compiled methods: lockstep chunks of up to CHUNK points, as many as a multiple of
-    # SPREAD so that 2 or 4 workers share the work evenly.  The chunks depend on the
-    # number of points only (not on the executor or the machine), so that a sweep's
-    # results are the same bits whichever way it runs.
-    count = -(-max(1, -(-len(todo) // CHUNK)) // SPREAD) * SPREAD
-    chunks = np.array_split(np.asarray(todo), min(count, len(todo)))
+    # SPREAD so that 2 or 4 workers share the work evenly.  The chunks follow from the
+    # number of points alone (not from the executor, the machine or what a resumed store
+    # holds), so that a sweep's results are the same bits whichever way it runs; a
+    # resumed sweep runs the chunks that are not done.
+    count = -(-max(1, -(-len(order) // CHUNK)) // SPREAD) * SPREAD
+    chunks = np.array_split(np.arange(len(order)), min(count, len(order)))
+    chunks = [c for c in chunks if c.size and any(int(i) not in done for i in c)]
     return [
         Chain(*base, [order[i] for i in c], x0, settings, False, c.tolist(), where, True)
         for c in chunks

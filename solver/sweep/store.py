@@ -1,6 +1,13 @@
-"""The resumable sweep store: a manifest and one file per finished point, each written
+"""The resumable sweep store: a manifest and the finished points, every file written
 atomically (temporary file, then rename), so that nothing computed is lost and a torn
-file cannot exist."""
+file cannot exist.
+
+A point of a continuation chain, or an independent point run on its own, is one file
+(``points/00012.json``) written as soon as it is done.  A lockstep chunk of independent
+points (integrated together, so finished together) is one file
+(``points/chunk-00048-50.json``: first index, number of points) holding the indices and
+the points: creating 400 small files took 0.2 s of a 400-point sweep's CPU time.
+"""
 
 from __future__ import annotations
 
@@ -16,7 +23,9 @@ __all__ = [
     "SweepStoreError",
     "open_store",
     "point_text",
+    "store_chunk",
     "store_point",
+    "stored_count",
     "write_atomic",
 ]
 
@@ -57,6 +66,26 @@ def store_point(store: Path, index: int, point: SweepPoint) -> str:
     return text
 
 
+def store_chunk(store: Path, indices: list[int], texts: list[str]) -> None:
+    """Write the points of a chunk (their texts from :func:`point_text`) as one file."""
+    body = f'{{"indices": {json.dumps([int(i) for i in indices])}, "points": ['
+    body += ", ".join(texts) + "]}"
+    write_atomic(Path(store) / "points" / f"chunk-{indices[0]:05d}-{len(indices)}.json", body)
+
+
+def stored_count(store: Path) -> int:
+    """How many points a store holds (without reading them)."""
+    folder = Path(store) / "points"
+    single = len(list(folder.glob("[0-9]*.json")))
+    return single + sum(int(f.stem.rsplit("-", 1)[1]) for f in folder.glob("chunk-*-*.json"))
+
+
+def _refused(f: Path) -> SweepStoreError:
+    return SweepStoreError(
+        f"{f} is not a sweep point this version reads; choose another output folder or delete it"
+    )
+
+
 def open_store(
     store: Path, manifest: dict, texts: dict[int, str] | None = None
 ) -> dict[int, SweepPoint]:
@@ -81,8 +110,10 @@ def open_store(
             )
     else:
         write_atomic(path, dumps(manifest, indent=1))
-    done = {}
-    for f in sorted((store / "points").glob("[0-9]*.json")):
+    done: dict[int, SweepPoint] = {}
+    folder = store / "points"
+    files = sorted(folder.glob("chunk-*-*.json")) + sorted(folder.glob("[0-9]*.json"))
+    for f in files:
         try:
             text = f.read_text(encoding="utf-8")
             data = json.loads(text)
@@ -90,12 +121,16 @@ def open_store(
             f.unlink(missing_ok=True)  # a torn file cannot exist (atomic writes); be safe
             continue
         try:
-            done[int(f.stem)] = SweepPoint.from_dict(data)
-            if texts is not None:
-                texts[int(f.stem)] = text
+            if f.name.startswith("chunk-"):
+                found = {int(i): SweepPoint.from_dict(d) for i, d in
+                         zip(data["indices"], data["points"], strict=True)}  # fmt: skip
+                chunk_texts = {i: point_text(p) for i, p in found.items()}
+            else:
+                found = {int(f.stem): SweepPoint.from_dict(data)}
+                chunk_texts = {int(f.stem): text}
         except (KeyError, TypeError, ValueError):
-            raise SweepStoreError(
-                f"{f} is not a sweep point this version reads; choose another output folder "
-                "or delete it"
-            ) from None
+            raise _refused(f) from None
+        done.update(found)
+        if texts is not None:
+            texts.update(chunk_texts)
     return done

@@ -19,6 +19,7 @@ from gearsym.solver.integrate import native
 from gearsym.solver.integrate.simulate import simulate, simulate_many
 from gearsym.solver.sweep import SweepResult, sweep
 from gearsym.solver.sweep.chains import plan
+from gearsym.solver.sweep.store import stored_count
 from gearsym.solver.system import System
 
 pytestmark = pytest.mark.skipif(native.compiler() is None, reason="no C compiler")
@@ -26,6 +27,13 @@ pytestmark = pytest.mark.skipif(native.compiler() is None, reason="no C compiler
 # Eight values put two points in each of the four lockstep chunks; 0.0476 is a period-3
 # point and 0.1303 a period-12 point of the reference model at the default settings.
 VALUES = [0.0, 0.047619047619047616, 0.1, 0.13032581453634084, 0.35, 0.5, 0.8, 1.0]
+
+
+def _plain(point) -> dict:
+    """A point as stored, without its wall-clock time (the one field that may differ)."""
+    d = json.loads(dumps(point.to_dict()))
+    d["integration"].pop("wall_time_s", None)
+    return d
 
 
 @pytest.fixture(scope="module")
@@ -86,23 +94,27 @@ def test_serial_and_parallel_batched_sweeps_are_bit_identical(light, batched):
     other = sweep(
         light, "lambda", VALUES, continuation=False, lyapunov_periods=0, executor="processes"
     )
-    strip = [json.loads(dumps(p.to_dict())) for p in (*batched.points, *other.points)]
-    for d in strip:
-        d["integration"].pop("wall_time_s", None)
-    assert strip[: len(VALUES)] == strip[len(VALUES) :]
+    assert [_plain(p) for p in batched.points] == [_plain(p) for p in other.points]
 
 
 def test_sweep_json_from_the_stored_texts_is_the_plain_encoding(light, tmp_path):
     # The file assembled from the store's per-point texts equals dumps(to_dict()), also
-    # for a backward sweep and after a resume (texts read back from the store).
+    # for a backward sweep and after a resume (texts read back from the store); the
+    # resumed sweep recomputes the chunk that was lost and equals the uninterrupted one.
     settings = dict(transient=20, periods=6, lyapunov_periods=0)
     for backward in (False, True):
         store = tmp_path / f"store{backward}"
         result = sweep(light, "lambda", VALUES, continuation=False, store=store, **settings)
         assert result.texts is not None
         assert result.to_json() == dumps(result.to_dict())
-        (store / "points" / "00003.json").unlink()
+        # a lockstep chunk is one file: first index and number of points in its name
+        files = sorted(f.name for f in (store / "points").iterdir())
+        assert files == [f"chunk-{i:05d}-2.json" for i in (0, 2, 4, 6)]
+        assert stored_count(store) == len(VALUES)
+        (store / "points" / "chunk-00002-2.json").unlink()  # as if killed before it
+        assert stored_count(store) == len(VALUES) - 2
         again = sweep(light, "lambda", VALUES, continuation=False, store=store, **settings)
+        assert [_plain(p) for p in again.points] == [_plain(p) for p in result.points]
         assert again.to_json() == dumps(again.to_dict())
         path = again.save(tmp_path / "sweep.json")
         assert SweepResult.load(path).motion("u") == result.motion("u")
