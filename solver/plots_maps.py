@@ -55,12 +55,28 @@ def motion_class(motion: str, status: str = "ok") -> str:
     return motion if motion in known else "undetermined"
 
 
+def _uneven(v) -> bool:
+    """Values whose steps differ by more than a factor two: drawn at equal spacing."""
+    steps = np.diff(np.asarray(v, float))
+    return steps.size > 1 and np.max(np.abs(steps)) > 2 * np.min(np.abs(steps))
+
+
 def _edges(v) -> np.ndarray:
     v = np.asarray(v, float)
+    if _uneven(v):
+        return np.arange(v.size + 1) - 0.5
     if v.size == 1:
         return np.array([v[0] - 0.5, v[0] + 0.5])
     mid = (v[1:] + v[:-1]) / 2
     return np.concatenate([[2 * v[0] - mid[0]], mid, [2 * v[-1] - mid[-1]]])
+
+
+def _label(ax, m: RegimeMap) -> None:
+    """Axis names; an unevenly spaced axis gets one tick per value (cells of equal size)."""
+    for values, name, axis in ((m.x_values, m.x, ax.xaxis), (m.y_values, m.y, ax.yaxis)):
+        axis.set_label_text(name + (" (unevenly spaced values)" if _uneven(values) else ""))
+        if _uneven(values):
+            axis.set_ticks(np.arange(len(values)), [f"{v:g}" for v in values])
 
 
 def _caption(m: RegimeMap) -> str:
@@ -89,8 +105,7 @@ def _categorical(ax, fig, m: RegimeMap, labels, classes, title: str) -> None:
         fontsize=8,
         frameon=False,
     )
-    ax.set_xlabel(m.x)
-    ax.set_ylabel(m.y)
+    _label(ax, m)
     ax.set_title(title)
 
 
@@ -125,8 +140,7 @@ def map_figures(m: RegimeMap, folder, prefix: str = "map") -> list[Path]:
     lim = np.nanmax(np.abs(lam)) if np.any(np.isfinite(lam)) else 1.0
     im = ax.pcolormesh(xe, ye, lam, cmap="RdBu_r", vmin=-lim, vmax=lim)
     fig.colorbar(im, ax=ax, label="largest Lyapunov exponent (per unit τ)")
-    ax.set_xlabel(m.x)
-    ax.set_ylabel(m.y)
+    _label(ax, m)
     ax.set_title("largest Lyapunov exponent (> 0: chaos); blank: no estimate")
     out.append(_save(fig, folder / f"{prefix}-lyapunov.png", caption))
 
@@ -136,8 +150,7 @@ def map_figures(m: RegimeMap, folder, prefix: str = "map") -> list[Path]:
     cmap = plt.get_cmap("viridis", top + 1)
     im = ax.pcolormesh(xe, ye, count, cmap=cmap, vmin=-0.5, vmax=top + 0.5)
     fig.colorbar(im, ax=ax, ticks=range(0, top + 1), label="attractors found")
-    ax.set_xlabel(m.x)
-    ax.set_ylabel(m.y)
+    _label(ax, m)
     ax.set_title(
         f"attractors found from {m.settings['initial_states']} initial states\n"
         "(runs that diverged or left the valid range are not counted)"
@@ -150,8 +163,7 @@ def map_figures(m: RegimeMap, folder, prefix: str = "map") -> list[Path]:
             ax = axes[row][k]
             im = ax.pcolormesh(xe, ye, m.grid(field, c), cmap="viridis")
             fig.colorbar(im, ax=ax, label=f"{field.capitalize()}({c}) / half backlash")
-            ax.set_xlabel(m.x)
-            ax.set_ylabel(m.y)
+            _label(ax, m)
             ax.set_title(f"{field.capitalize()}({c}) over the sampled window")
     out.append(_save(fig, folder / f"{prefix}-extremes.png", caption))
 
