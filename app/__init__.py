@@ -26,13 +26,14 @@ _EXPORTS = {
     "save": "gearsym.solver.export",
     "load": "gearsym.resolve",
     "analyse": ("gearsym.solver", "analyse_point"),
+    "sweep": ("gearsym.solver.sweep", "sweep"),
     **{
         name: "gearsym.solver"
         for name in (
             "METHODS", "Branch", "Contract", "FlowMap", "Orbit", "PointResult",
             "ShootingError", "SimulationError", "StroboscopicMap", "SweepPoint",
             "SweepResult", "System", "Trajectory", "continue_orbit", "shoot", "simulate",
-            "sweep", "switch_period_doubling",
+            "switch_period_doubling",
         )
     },
 }  # fmt: skip

@@ -11,21 +11,46 @@ and its functions; it never imports ``gearsym.derive``.  Rooms:
 * ``plots.py`` -- figures from result objects.
 """
 
-from .analysis import PointResult, analyse_point
-from .contract import Contract, load_generated
-from .integrate import METHODS, SimulationError, Trajectory, simulate
-from .periodic import (
-    Branch,
-    FlowMap,
-    Orbit,
-    ShootingError,
-    StroboscopicMap,
-    continue_orbit,
-    shoot,
-    switch_period_doubling,
-)
-from .sweep import SweepPoint, SweepResult, sweep
-from .system import System
+import importlib as _importlib
+
+# Names resolve on first use (PEP 562): a sweep does not load the periodic-orbit code and
+# SciPy's linear algebra that it never calls.  ``gearsym.solver.sweep`` is the sub-package;
+# the function is ``gearsym.solver.sweep.sweep`` (and ``gearsym.sweep``).
+_EXPORTS = {
+    "PointResult": "analysis",
+    "analyse_point": "analysis",
+    "Contract": "contract",
+    "load_generated": "contract",
+    "METHODS": "integrate",
+    "SimulationError": "integrate",
+    "Trajectory": "integrate",
+    "simulate": "integrate",
+    "Branch": "periodic",
+    "FlowMap": "periodic",
+    "Orbit": "periodic",
+    "ShootingError": "periodic",
+    "StroboscopicMap": "periodic",
+    "continue_orbit": "periodic",
+    "shoot": "periodic",
+    "switch_period_doubling": "periodic",
+    "SweepPoint": "sweep",
+    "SweepResult": "sweep",
+    "System": "system",
+}
+
+
+def __getattr__(name: str):
+    if name not in _EXPORTS:
+        raise AttributeError(f"module 'gearsym.solver' has no attribute {name!r}")
+    module = _importlib.import_module(f".{_EXPORTS[name]}", __name__)
+    value = getattr(module, name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_EXPORTS))
+
 
 __all__ = [
     "METHODS",
@@ -46,6 +71,5 @@ __all__ = [
     "load_generated",
     "shoot",
     "simulate",
-    "sweep",
     "switch_period_doubling",
 ]
