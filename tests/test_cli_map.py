@@ -64,3 +64,19 @@ def test_map_refuses_an_unwritable_folder(capsys, tmp_path):
     argv = ["map", "reference-light", "--x=lambda=0:1:2", "--y=f1=0.1:0.3:2"]
     code, out, err = run(capsys, *argv, f"--out={blocker}/map")
     assert code == 2 and "cannot write there" in err
+
+
+def test_a_sweep_over_an_open_value_points_to_the_map(capsys, tmp_path):
+    argv = ["sweep", "reference-light", "--param", "te_amplitude_um", "--range", "0:20:3"]
+    code, out, err = run(capsys, *argv, f"--out={tmp_path}/s")
+    assert code == 2 and "an open value" in err and "gearsym map" in err
+
+
+def test_a_map_over_an_open_value_derives_one_model_per_value(capsys, tmp_path, monkeypatch):
+    monkeypatch.setenv("GEARSYM_CACHE", str(tmp_path / "cache"))
+    argv = ["map", "reference-light", "--x=lambda=0:1:2", "--y=te_amplitude_um=0:10:2"]
+    code, out, err = run(capsys, *argv, *SMALL, "--json", "--executor=serial", f"--out={tmp_path}")
+    assert code == 0, err
+    records = [json.loads(line) for line in out.splitlines()]
+    assert {r["te_amplitude_um"] for r in records} == {0.0, 10.0}
+    assert len(list((tmp_path / "cache" / "models").glob("reference_light_open_*.py"))) == 2

@@ -166,6 +166,14 @@ def _cmd_sweep(args) -> int:
             super().step(note)
 
     values = parse_range(args.range)
+    from gearsym.derive.open_values import is_open_value
+
+    if is_open_value(args.param):
+        raise Fail(
+            f"--param {args.param}: an open value (each value derives its own model); sweep "
+            f"it with `gearsym map {args.scene} --x {args.param}=START:STOP:NUM --y "
+            "lambda=...`, or set one value with --set"
+        )
     system = system_of(args.scene, parse_set(args.set))
     out = Path(args.out or f"sweep_{system.name}_{args.param}")
     bar = _Bar(len(values), f"{args.param}", enabled=not args.quiet)
