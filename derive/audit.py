@@ -16,6 +16,8 @@ import sympy as sp
 from ._paths import display_path
 from .backlash import fit_dead_zone
 from .model import Model
+from .nondim import DAMPING_TEXT
+from .readings import reading_section
 
 __all__ = ["audit_page", "index_page"]
 
@@ -178,9 +180,9 @@ def audit_page(model: Model, command: str) -> str:
     w("## 6. Scales\n")
     w(
         "Each mesh is scaled by its half backlash, $u_i = x_i/b_i$; time by the natural "
-        "frequency of the reference mesh (the first), $\\tau = \\omega_n t$; the damping "
-        "coefficient of each mesh follows from one damping ratio $\\zeta$ on the mesh's own "
-        "equivalent mass $1/W_{jj}$:\n"
+        "frequency of the reference mesh (the first), $\\tau = \\omega_n t$; "
+        + DAMPING_TEXT[nd.damping]
+        + ":\n"
     )
     w(
         _math(
@@ -263,6 +265,9 @@ def audit_page(model: Model, command: str) -> str:
             )
             + " (the torque form above converts torques to loads).\n"
         )
+    section = reading_section(model)
+    if section:
+        w(section)
     w("Parameter values of the emitted model, in the order of the generated code:\n")
     w("| # | name | symbol | value | meaning |")
     w("|---|---|---|---|---|")

@@ -50,10 +50,16 @@ class Built:
 def build_files(
     paths: list[Path], *, index: bool = False, overrides: dict[str, float] | None = None
 ) -> Built:
-    """Derive every target in ``paths``; return the models and the files' text."""
+    """Derive every target in ``paths``; return the models and the files' text.
+    ``overrides`` set scene parameters, or open values (``derive.open_values``), which
+    give each target's variant."""
+    from .open_values import is_open_value, with_open_values
+
     models, files = [], {}
+    opened = {k: v for k, v in (overrides or {}).items() if is_open_value(k)}
+    rest = {k: v for k, v in (overrides or {}).items() if k not in opened}
     for path in paths:
-        scene = load_target(path, overrides)
+        scene = with_open_values(load_target(path, rest or None), **opened)
         model = derive_model(scene)
         command = f"gearsym derive {display_path(path)}"
         files[f"generated/{model.name}.py"] = emit_module(model, command)

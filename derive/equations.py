@@ -4,21 +4,24 @@ For ``n`` gears joined by ``m = n - 1`` meshes (a tree), with ``theta_k`` the ro
 gear ``k`` counted positive in its operating direction:
 
 * Newton:      ``I_k theta_k'' = T_k - sum_i cos(beta_b,i) A_ik F_i``
-* deflection:  ``x_i = cos(beta_b,i) sum_k A_ik theta_k + e_i(t)``, along the normal line of
-  action, with ``A_ik = +r_b,k`` for the driver and ``-r_b,k`` for the driven gear of
-  mesh ``i`` (0 otherwise) and ``e_i`` the composite transmission error (positive = excess
-  material, which presses the flanks together);
+* deflection:  ``x_i = cos(beta_b,i) sum_k A_ik theta_k + s_i e_i(t)``, along the normal
+  line of action, with ``A_ik = +s_i r_b,k`` for the driver and ``-s_i r_b,k`` for the driven
+  gear of mesh ``i`` (0 otherwise), ``s_i = +1`` for a coordinate measured forward (driver
+  flank loaded = positive) and ``-1`` for one measured the other way (``derive.readings``),
+  and ``e_i`` the composite transmission error (positive = excess material, which presses
+  the flanks together);
 * mesh force:  ``F_i = k_i(t) b_i g(x_i / b_i) + c_i x_i'`` along the normal line of action;
   its transverse component ``F_i cos(beta_b,i)`` acts at the base radius.
 
 Differentiating ``x_i`` twice and substituting ``theta''`` from Newton's law gives, with
 ``C = diag(cos beta_b)`` and ``I = diag(I_k)``,
 
-    ``x'' + W F = C A I^-1 T + e''``,   ``W = C A I^-1 A^T C``  (m x m, symmetric),
+    ``x'' + W F = C A I^-1 T + S e''``,   ``W = C A I^-1 A^T C``  (m x m, symmetric),
 
 in which no ``theta`` remains: the rigid-body rotation has dropped out.  ``W_ij`` is the
 inverse equivalent mass coupling meshes ``i`` and ``j``; it is non-zero only when they
-share a gear.  The derivation here is carried out on SymPy objects and checked term by
+share a gear, and its sign is ``s_i s_j`` times that of the forward-measured pair.  ``S =
+diag(s_i)``.  The derivation here is carried out on SymPy objects and checked term by
 term; ``I`` is diagonal, so no matrix is inverted symbolically.
 """
 
@@ -52,6 +55,7 @@ class Equations:
     te: tuple[sp.Expr, ...]
     force: tuple[sp.Symbol, ...]
     x: tuple[sp.Expr, ...]
+    orientation: tuple[int, ...]  # s_i: +1 forward, -1 reversed
     g: sp.FunctionClass
     incidence: sp.ImmutableMatrix
     newton: tuple[sp.Eq, ...]
@@ -83,10 +87,11 @@ def derive_equations(topology: Topology) -> Equations:
     g = sp.Function("g")
 
     col = {gid: j for j, gid in enumerate(gears)}
+    s = tuple(int(mesh.orientation) for mesh in topology.meshes)
     A = sp.zeros(len(meshes), len(gears))
     for i, mesh in enumerate(topology.meshes):
-        A[i, col[mesh.driver]] = radius[col[mesh.driver]]
-        A[i, col[mesh.driven]] = -radius[col[mesh.driven]]
+        A[i, col[mesh.driver]] = s[i] * radius[col[mesh.driver]]
+        A[i, col[mesh.driven]] = -s[i] * radius[col[mesh.driven]]
     A = sp.ImmutableMatrix(A)
     cb = [sp.cos(bb) for bb in beta_b]
 
@@ -100,7 +105,7 @@ def derive_equations(topology: Topology) -> Equations:
     kinematic = [
         cb[i] * sum(A[i, kk] * theta[kk] for kk in range(len(gears))) for i in range(len(meshes))
     ]
-    deflection = tuple(sp.Eq(x[i], kinematic[i] + e[i]) for i in range(len(meshes)))
+    deflection = tuple(sp.Eq(x[i], kinematic[i] + s[i] * e[i]) for i in range(len(meshes)))
     force_law = tuple(
         sp.Eq(F[i], k[i] * b[i] * g(x[i] / b[i]) + c[i] * x[i].diff(t)) for i in range(len(meshes))
     )
@@ -125,7 +130,7 @@ def derive_equations(topology: Topology) -> Equations:
     load = []
     for i in range(len(meshes)):
         rest = substituted[i].rhs + sum(W[i, j] * F[j] for j in range(len(meshes)))
-        rest = sp.expand(rest - e[i].diff(t, 2))
+        rest = sp.expand(rest - s[i] * e[i].diff(t, 2))
         if sp.expand(W[i, :] - W_closed[i, :]) != sp.zeros(1, len(meshes)):
             raise AssertionError(f"compliance row {i} does not match C A I^-1 A^T C")
         if sp.expand(rest - load_closed[i]) != 0 or rest.has(*theta):
@@ -135,7 +140,7 @@ def derive_equations(topology: Topology) -> Equations:
     reduced = tuple(
         sp.Eq(
             x[i].diff(t, 2) + sum(W[i, j] * F[j] for j in range(len(meshes))),
-            load[i] + e[i].diff(t, 2),
+            load[i] + s[i] * e[i].diff(t, 2),
         )
         for i in range(len(meshes))
     )
@@ -155,6 +160,7 @@ def derive_equations(topology: Topology) -> Equations:
         te=e,
         force=F,
         x=x,
+        orientation=s,
         g=g,
         incidence=A,
         newton=newton,

@@ -141,7 +141,7 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
     topo = scene.topology
     feats = scene.features
     eq = derive_equations(topo)
-    nd = nondimensionalise(topo, scene.damping_ratio, eq)
+    nd = nondimensionalise(topo, scene.damping_ratio, eq, scene.damping_normalisation)
     meshes = topo.meshes
     m = len(meshes)
     coords = tuple(me.coordinate for me in meshes)
@@ -174,9 +174,17 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
         r"\bar\omega",
     )
     # Static loads.
+    signs = {c: 1 for c in coords}
+    if scene.load_reading is not None and scene.loads is not None:  # sizes; signs derived
+        from .readings import load_signs
+
+        for c, (_, slope, sigma) in load_signs(nd, topo, scene.load_reading, scene.source).items():
+            signs[c] = slope * sigma
     if scene.loads is not None:
-        f_values = [scene.loads[c] for c in coords]
+        f_values = [signs[c] * scene.loads[c] for c in coords]
         f_meaning = "static load (from the scene's [loads])"
+        if scene.load_reading is not None:
+            f_meaning = f"static load (size from [loads], sign from reading {scene.load_reading})"
     else:
         f_values = [nd.value(nd.load[i]) for i in range(m)]
         f_meaning = "static load (from the topology's torques)"
@@ -271,7 +279,8 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
         for j in range(m)
     ]
     ebar = tuple(
-        sum(
+        eq.orientation[j]
+        * sum(
             (
                 te_amp[j, h] * sp.cos(h * phase_arg[j] + te_phase[j, h])
                 for (jj, h) in te_amp
@@ -313,7 +322,8 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
     sources = {"omega": "s['omega']"}
     if scene.loads is not None:
         for c in coords:
-            sources[f"f_{c}"] = expression_source(scene.load_expressions[c])
+            source = expression_source(scene.load_expressions[c])
+            sources[f"f_{c}"] = source if signs[c] > 0 else f"-({source})"
     for i, j in xi:
         unit = nd.value(nd.xi[i, j].subs(nd.zeta, 1))
         sources[f"xi_{coords[i]}_{coords[j]}"] = f"{float(f'{unit:.15g}')!r} * s['damping_ratio']"

@@ -18,12 +18,19 @@ E = amplitude / half backlash; a layout angle becomes the stiffness phase phi.  
                                           that has one / one mesh
 ``stiffness_harmonic_scale`` /            factor on every stiffness harmonic k_j1, k_j2
 ``..._<mesh>``                            (the mean k_m kept)
+``load_reading``                          a ``[[reading]]`` of the topology (text):
+                                          ``q-braking`` or ``both-driving`` for the
+                                          reference stage (``derive/readings.py``)
+``damping_normalisation``                 ``mesh`` or ``modal`` (text,
+                                          ``derive/nondim.py``)
 ========================================  ============================================
 
 A scene file sets them in an ``[open]`` table; ``gearsym.load(scene, **values)`` and the
 CLI's ``--set`` accept them beside ordinary parameters and derive (once, into the
-derivation cache) the model they give.  The damping normalisation and the reading of the
-loads are not offered here yet.
+derivation cache) the model they give.  A value equal to the scene's own changes nothing
+and derives nothing.  :func:`is_open_value` (or the frozenset :data:`OPEN_VALUE_BASES`
+with the per-mesh/per-gear suffixes) tells a sweep or map whether a name needs a
+derivation.
 """
 
 from __future__ import annotations
@@ -34,7 +41,14 @@ from dataclasses import replace
 
 from ._input import InputError, nearest
 
-__all__ = ["OPEN_VALUES", "apply_open_values", "is_open_value", "with_open_values"]
+__all__ = [
+    "CHOICES",
+    "OPEN_VALUES",
+    "OPEN_VALUE_BASES",
+    "apply_open_values",
+    "is_open_value",
+    "with_open_values",
+]
 
 # key -> (unit, meaning, low, high)
 OPEN_VALUES = {
@@ -46,6 +60,14 @@ OPEN_VALUES = {
     "stiffness_harmonic_scale": ("1", "factor on the stiffness harmonics", 0.0, 1e3),
 }
 _PER_MESH = ("te_amplitude_um", "te_phase_deg", "layout_angle_deg", "stiffness_harmonic_scale")
+# key -> meaning; text values, which set the scene rather than the topology's data
+CHOICES = {
+    "load_reading": "the reading of the loads, a [[reading]] of the topology",
+    "damping_normalisation": "how the damping ratio sets the dampers: mesh or modal",
+}
+# Every open-value name is one of these, or one of the per-mesh / per-gear ones
+# (``<base>_<mesh id>``, ``attached_inertia_kg_m2_<gear id>``): use is_open_value().
+OPEN_VALUE_BASES = frozenset(OPEN_VALUES) | frozenset(CHOICES)
 
 
 def _split(name: str) -> tuple[str, str | None] | None:
@@ -61,7 +83,7 @@ def _split(name: str) -> tuple[str, str | None] | None:
 
 def is_open_value(name: str) -> bool:
     """Whether ``name`` is an open value (a key that needs a new derivation)."""
-    return _split(name) is not None
+    return name in CHOICES or _split(name) is not None
 
 
 def apply_open_values(data: dict, values: dict, where: str) -> dict:
@@ -75,9 +97,9 @@ def apply_open_values(data: dict, values: dict, where: str) -> dict:
     for name, value in values.items():
         split = _split(name)
         if split is None:
-            allowed = list(OPEN_VALUES) + [f"{k}_{m}" for k in _PER_MESH for m in mesh_ids]
+            allowed = [*OPEN_VALUES, *CHOICES] + [f"{k}_{m}" for k in _PER_MESH for m in mesh_ids]
             raise InputError(where, name, "is not an open value" + nearest(name, allowed)
-                             + f"; open values: {', '.join(OPEN_VALUES)}")  # fmt: skip
+                             + f"; open values: {', '.join([*OPEN_VALUES, *CHOICES])}")  # fmt: skip
         base, which = split
         unit, meaning, low, high = OPEN_VALUES[base]
         try:
@@ -132,26 +154,70 @@ def apply_open_values(data: dict, values: dict, where: str) -> dict:
     return data
 
 
+def check_damping(value: str, where: str) -> None:
+    """Raise :class:`InputError` unless ``value`` is a damping normalisation."""
+    from .nondim import DAMPING_NORMALISATIONS
+
+    if value not in DAMPING_NORMALISATIONS:
+        known = DAMPING_NORMALISATIONS
+        message = f"'{value}' is not one of {', '.join(known)}" + nearest(value, known)
+        raise InputError(where, "damping_normalisation", message)
+
+
 def with_open_values(scene, **values):
-    """``scene`` with open values set: its topology rebuilt from the edited data, the
-    values recorded (they enter the derivation's inputs hash), the name suffixed with a
-    short digest of them so that a variant never passes for its original."""
+    """``scene`` with open values set: its topology rebuilt from the edited data (the
+    scene's own ``[open]`` values kept beneath the new ones), the choices
+    (``load_reading``, ``damping_normalisation``) applied, the values recorded (they enter
+    the derivation's inputs hash) and the name suffixed with a short digest of them, so that
+    a variant never passes for its original.  Values equal to the scene's own are dropped;
+    with none left, ``scene`` itself is returned (nothing to derive)."""
     import hashlib
     import json
 
     from ._input import load_toml
     from .topology import parse_topology
 
-    if not values:
-        return scene
+    where = f"{scene.source} (open values)"
+    chosen = {k: v for k, v in values.items() if k in CHOICES}
+    numbers = {k: v for k, v in values.items() if k not in CHOICES}
+    for key, value in chosen.items():
+        if not isinstance(value, str):
+            raise InputError(where, key, f"must be text ({CHOICES[key]}), got {value!r}")
+    own = {"load_reading": scene.load_reading, "damping_normalisation": scene.damping_normalisation}
+    chosen = {k: v for k, v in chosen.items() if v != own[k]}
     source = scene.topology.source
-    data = apply_open_values(load_toml(source), values, f"{scene.source} (open values)")
-    topology = parse_topology(data, source)
-    given = {k: float(v) for k, v in sorted(values.items())}
-    tag = hashlib.sha256(json.dumps(given).encode()).hexdigest()[:8]
+    before = dict(scene.variations.get("open_values", {}))
+    if scene.kind == "scene":
+        opened = load_toml(scene.source).get("open", {})
+        before = {k: v for k, v in opened.items() if k not in CHOICES} | before
+    before = {k: v for k, v in before.items() if k not in CHOICES}
+    data = load_toml(source)
+    old = apply_open_values(data, before, where)
+    new = apply_open_values(data, before | numbers, where)
+    if new == old:
+        numbers = {}
+    numbers = {k: float(v) for k, v in numbers.items() if before.get(k) != float(v)}
+    if not numbers and not chosen:
+        return scene
+    reading = chosen.get("load_reading", scene.load_reading)
+    damping = chosen.get("damping_normalisation", scene.damping_normalisation)
+    if "damping_normalisation" in chosen:
+        check_damping(damping, where)
+    topology = parse_topology(new, source)  # afresh: a reading replaced leaves no trace
+    if reading is not None:
+        from .readings import apply_reading
+
+        topology = apply_reading(topology, reading, where)
+    given = {k: v for k, v in sorted((before | numbers | chosen).items())}
+    recorded = dict(scene.variations.get("open_values", {}))
+    recorded = recorded | {k: float(v) for k, v in numbers.items()} | chosen
+    tag = hashlib.sha256(json.dumps(given, sort_keys=True).encode()).hexdigest()[:8]
+    base = scene.name.split("-open-")[0]
     return replace(
         scene,
-        name=f"{scene.name}-open-{tag}",
+        name=f"{base}-open-{tag}",
         topology=topology,
-        variations=scene.variations | {"open_values": given},
+        variations=scene.variations | {"open_values": dict(sorted(recorded.items()))},
+        load_reading=reading,
+        damping_normalisation=damping,
     )

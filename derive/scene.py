@@ -11,9 +11,14 @@ A scene names the features the model must carry; the derivation emits only their
 ``[parameters]`` holds named numbers: ``omega`` (the non-dimensional excitation
 frequency of the reference mesh, required), ``damping_ratio`` (required) and any others
 that ``[loads]`` uses.  ``[loads]`` gives the non-dimensional static load ``f_i`` of each
-mesh coordinate as a number or an arithmetic expression of the parameters (for the
-reference study ``u = "f1"`` and ``v = "-lambda*f1"``).  Without ``[loads]`` the loads
-come from the topology's torques.
+mesh coordinate as a number or an arithmetic expression of the parameters (``u = "f1"``,
+``v = "-lambda*f1"``); with a ``load_reading`` (``[open]``, ``derive/readings.py``) it gives
+the size of each load and the derivation gives its sign (the reference scenes:
+``v = "lambda*f1"``).  Without ``[loads]`` the loads come from the topology's torques.
+
+``[open]`` sets the values the reference study leaves open (``derive/open_values.py``):
+numbers such as ``te_amplitude_um`` and the choices ``load_reading`` and
+``damping_normalisation`` (``"mesh"`` or ``"modal"``, ``derive/nondim.py``).
 
 A topology file may be derived on its own: it then stands for a default scene with every
 feature on, 3 harmonics, the reference study's backlash polynomial, and ``omega`` and the
@@ -97,6 +102,10 @@ class Scene:
     source: str
     kind: str = "scene"  # "scene" or "topology" (a topology derived with default features)
     variations: dict = field(default_factory=dict)  # [features] changed by variant()
+    # The study's open choices (derive/open_values.py, derive/readings.py): the reading of
+    # the loads (None: [loads] carry their own signs) and the damping normalisation.
+    load_reading: str | None = None
+    damping_normalisation: str = "mesh"
 
     @property
     def omega(self) -> float | None:
@@ -232,16 +241,30 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
             )
         topo_path = builtin
     open_t = top.table("open", None)
+    choices: dict[str, str] = {}
     if open_t is None:
         topology = load_topology(topo_path)
     else:
         # the study's open values, set in the scene (derive/open_values.py)
-        from .open_values import apply_open_values
+        from .open_values import CHOICES, apply_open_values
 
-        values = {key: open_t.number(key) for key in open_t.data}
+        for key in CHOICES:
+            if open_t.has(key):
+                choices[key] = open_t.string(key)
+        values = {key: open_t.number(key) for key in open_t.data if key not in CHOICES}
         open_t.finish()
         data = apply_open_values(load_toml(topo_path), values, f"{source} [open]")
         topology = parse_topology(data, str(topo_path))
+    reading = choices.get("load_reading")
+    if reading is not None:
+        from .readings import apply_reading
+
+        topology = apply_reading(topology, reading, f"{source} [open]")
+    damping = choices.get("damping_normalisation", "mesh")
+    if damping != "mesh":
+        from .open_values import check_damping
+
+        check_damping(damping, f"{source} [open]")
     features = _features(top.table("features", None))
 
     pt = top.table("parameters")
@@ -280,6 +303,12 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
             raw = lt.raw(c)
             loads[c] = parse_expression(raw, parameters, source=source, key=lt.key(c))
             expressions[c] = raw if isinstance(raw, str) else float(raw)
+            if reading is not None and loads[c] < 0:
+                raise lt.error(
+                    c,
+                    f"'{raw}' = {loads[c]:g} < 0: with a load_reading the load is a size and "
+                    "its sign comes from the reading; drop the sign",
+                )
         lt.finish()
     elif not topology.torques:
         raise InputError(
@@ -288,8 +317,21 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
             "is missing and the topology has no [[torque]]; "
             "give the non-dimensional load of every coordinate",
         )
+    elif reading is not None:
+        raise InputError(source, "loads", "a load_reading needs [loads]: the size of each load")
     top.finish()
-    return Scene(name, description, topology, features, parameters, loads, expressions, source)
+    return Scene(
+        name,
+        description,
+        topology,
+        features,
+        parameters,
+        loads,
+        expressions,
+        source,
+        load_reading=reading,
+        damping_normalisation=damping,
+    )
 
 
 def _check_parameters(t: Table, parameters: dict[str, float]) -> None:

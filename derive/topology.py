@@ -23,6 +23,7 @@ from pathlib import Path
 from ._input import Table, load_toml, nearest
 from .geometry import GearGeometry, PairGeometry, gear_geometry, pair_geometry
 from .pem import pem_stiffness
+from .readings import ORIENTATIONS, parse_readings
 from .stiffness import MeshStiffness, contact_line_stiffness
 
 __all__ = [
@@ -97,7 +98,8 @@ class TransmissionError:
 @dataclass(frozen=True)
 class Mesh:
     """One gear pair.  ``driver`` pushes ``driven``; the coordinate is positive when the
-    driver's working flanks are loaded (forward meshing)."""
+    driver's working flanks are loaded (forward meshing), or, with ``orientation = -1``
+    (``orientation = "reversed"``, see ``derive.readings``), measured the other way."""
 
     id: str
     driver: str
@@ -109,6 +111,7 @@ class Mesh:
     phase: float  # stiffness/TE phase lag relative to the reference mesh, rad
     phase_source: str
     pair: PairGeometry
+    orientation: int = 1  # +1: coordinate positive on the driver's flank; -1: reversed
 
 
 @dataclass(frozen=True)
@@ -127,6 +130,7 @@ class Topology:
     torques: dict[str, float] = field(default_factory=dict)  # N m, on gears
     operating: Operating | None = None
     source: str = ""
+    readings: dict = field(default_factory=dict)  # id -> derive.readings.Reading
 
     def gear(self, gear_id: str) -> Gear:
         return next(g for g in self.gears if g.id == gear_id)
@@ -488,6 +492,7 @@ def parse_topology(data: dict, source: str) -> Topology:
         stiffness = _stiffness(mt.table("stiffness"), pair, (g1, g2))
         te = _transmission_error(mt.table("transmission_error", None))
         phase, phase_source = _phase(mt, meshes, ends, by_id)
+        orientation = mt.string("orientation", "forward", choices=ORIENTATIONS)
         mt.finish()
         for other in meshes:
             if other.id == mid:
@@ -510,6 +515,7 @@ def parse_topology(data: dict, source: str) -> Topology:
                 phase,
                 phase_source,
                 pair,
+                ORIENTATIONS[orientation],
             )
         )
 
@@ -544,8 +550,11 @@ def parse_topology(data: dict, source: str) -> Topology:
             ot.number("damping_ratio", low=0.0, high=1.0),
         )
         ot.finish()
+    readings = parse_readings(top, list(by_id), [m.id for m in meshes])
     top.finish()
-    return Topology(name, description, tuple(gears), tuple(meshes), torques, operating, source)
+    return Topology(
+        name, description, tuple(gears), tuple(meshes), torques, operating, source, readings
+    )
 
 
 def _check_tree(top: Table, gears: list[Gear], meshes: list[Mesh]) -> None:

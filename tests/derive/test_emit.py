@@ -11,6 +11,8 @@ NAMES = [
     "reference_dead_zone",
     "reference_light",
     "reference_heavy",
+    "reference_light_both_driving",
+    "reference_heavy_both_driving",
     "reference_linear",
     "diso",
     "siso",

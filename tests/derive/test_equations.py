@@ -3,7 +3,8 @@
 Reference: Newton's second law written out by hand below for three rigid gears in
 NumPy (no SymPy), with the mesh deflection x = cos(beta_b)(r_p theta_p - r_g theta_g) + e
 and force F = k(t) b g(x/b) + c x'.  The generated right-hand side must give the same
-non-dimensional acceleration u'' = x'' / (b omega_n^2) at the matching state.
+non-dimensional acceleration u'' = x'' / (b omega_n^2) at the matching state.  In the
+both-driving reading the q-g coordinate is measured the other way: v = -x_qg / b by hand.
 """
 
 import math
@@ -52,10 +53,17 @@ def test_mean_coefficients_against_hand_formulas(diso_model):
     assert diso_model.scales["omega_n_rad_per_s"] == pytest.approx(math.sqrt(wn2), rel=1e-13)
 
 
-@pytest.mark.parametrize("name", ["diso", "reference_light"])
-def test_generated_rhs_equals_hand_newton(name, diso_model, light_model):
-    model = {"diso": diso_model, "reference_light": light_model}[name]
+@pytest.mark.parametrize("name", ["diso", "reference_light", "reference_light_both_driving"])
+def test_generated_rhs_equals_hand_newton(name, diso_model, light_model, root):
+    if name == "reference_light_both_driving":
+        from gearsym.derive import derive_model, load_target
+
+        model = derive_model(load_target(root / "scenes" / "reference-light-both-driving.toml"))
+    else:
+        model = {"diso": diso_model, "reference_light": light_model}[name]
     mod = load_generated(name)
+    # s = +1: v measured forward (q's flank loaded); -1: measured the other way (g's flank)
+    s = -1.0 if name.endswith("both_driving") else 1.0
     topo = model.scene.topology
     p, q, g = (topo.gear(i) for i in "pqg")
     meshes = topo.meshes
@@ -93,9 +101,11 @@ def test_generated_rhs_equals_hand_newton(name, diso_model, light_model):
         torque = {gid: topo.torques.get(gid, 0.0) for gid in "pqg"}
         extra = [0.0, 0.0]
     else:
-        # The scene gives f directly: no torques, and f enters u'' as itself.
+        # The scene gives the size of f: no torques, and f enters u'' as itself.  Its sign
+        # by hand: p drives (its torque loads x_pg forward, +); q brakes (T_q < 0 unloads
+        # x_qg: -) or drives (T_q > 0 loads x_qg, +, but v = -x_qg / b: -) -- f_v < 0 both ways.
         torque = {"p": 0.0, "q": 0.0, "g": 0.0}
-        extra = [model.scene.loads["u"], model.scene.loads["v"]]
+        extra = [model.scene.loads["u"], -model.scene.loads["v"]]
 
     rng = np.random.default_rng(7)
     for _ in range(25):
@@ -119,8 +129,11 @@ def test_generated_rhs_equals_hand_newton(name, diso_model, light_model):
             cb[0] * (rp * ddp - rg * ddg) + e_of(0, t, 2),
             cb[1] * (rq * ddq - rg * ddg) + e_of(1, t, 2),
         ]
-        expected = [ddx[j] / (b[j] * wn**2) + extra[j] for j in range(2)]
-        state = np.array([x[0] / b[0], x[1] / b[1], dx[0] / (b[0] * wn), dx[1] / (b[1] * wn)])
+        sign = [1.0, s]
+        expected = [sign[j] * ddx[j] / (b[j] * wn**2) + extra[j] for j in range(2)]
+        state = np.array(
+            [x[0] / b[0], s * x[1] / b[1], dx[0] / (b[0] * wn), s * dx[1] / (b[1] * wn)]
+        )
         got = mod.rhs(wn * t, state, np.array(mod.DEFAULTS))
         assert got[0] == pytest.approx(state[2], rel=1e-14)
         assert got[2:] == pytest.approx(expected, rel=1e-9, abs=1e-12)

@@ -190,6 +190,24 @@ TOPOLOGY_CASES = [
         'gear = "z"\ntorque_Nm',
         "torque[1].gear: names unknown gear 'z'",
     ),
+    (
+        "reading names an unknown mesh",
+        'reversed = ["qg"]',
+        'reversed = ["qh"]',
+        "reading[1].reversed: names no mesh 'qh' (did you mean 'qg'?)",
+    ),
+    (
+        "gear both drives and brakes",
+        'braking = ["q"]',
+        'braking = ["q", "p"]',
+        "reading[0].braking: gear 'p' cannot both drive and brake",
+    ),
+    (
+        "orientation typo",
+        'coordinate = "v"',
+        'coordinate = "v"\norientation = "reverse"',
+        "mesh[1].orientation: 'reverse' is not one of 'forward', 'reversed' (did you mean",
+    ),
 ]
 
 
@@ -239,19 +257,19 @@ SCENE_CASES = [
     ("negative omega", "omega = 0.5 ", "omega = -0.5 ", "parameters.omega: must be > 0"),
     (
         "load uses unknown parameter",
-        'v = "-lambda*f1"',
+        'v = "lambda*f1"',
         'v = "-lamda*f1"',
         "loads.v: 'lamda' in '-lamda*f1' is not a scene parameter (did you mean 'lambda'?)",
     ),
     (
         "load expression with a call",
-        'v = "-lambda*f1"',
+        'v = "lambda*f1"',
         'v = "__import__(1)"',
         "loads.v: '__import__(1)' may use only numbers",
     ),
     (
         "load for unknown coordinate",
-        'v = "-lambda*f1"',
+        'v = "lambda*f1"',
         'v = "-lambda*f1"\nw = 1',
         "loads.w: is not a mesh coordinate of topology 'diso'",
     ),
@@ -276,25 +294,25 @@ SCENE_CASES = [
     ),
     (
         "load overflows",
-        'v = "-lambda*f1"',
+        'v = "lambda*f1"',
         'v = "10**10**10"',
         "loads.v: '10**10**10' overflows",
     ),
     (
         "load is complex",
-        'v = "-lambda*f1"',
+        'v = "lambda*f1"',
         'v = "(-1)**0.5"',
         "loads.v: '(-1)**0.5' is not a real number",
     ),
     (
         "load too long",
-        'v = "-lambda*f1"',
+        'v = "lambda*f1"',
         'v = "' + "-" * 5000 + '1"',
         "is not a plain arithmetic expression of at most 200 characters",
     ),
     (
         "mangled keyword smuggled in",
-        'v = "-lambda*f1"',
+        'v = "lambda*f1"',
         'v = "-lambda__kw*f1"',
         "is not a plain arithmetic expression",
     ),
@@ -303,6 +321,30 @@ SCENE_CASES = [
         "stiffness_harmonics = 3",
         "stiffness_harmonics = -1",
         "features.stiffness_harmonics: must be >= 0",
+    ),
+    (
+        "unknown load reading",
+        'load_reading = "q-braking"',
+        'load_reading = "q-brake"',
+        "load_reading: 'q-brake' is not a reading of topology 'diso' (did you mean 'q-braking'?)",
+    ),
+    (
+        "signed load under a reading",
+        'v = "lambda*f1"',
+        'v = "-lambda*f1"',
+        "loads.v: '-lambda*f1' = -0.01 < 0: with a load_reading the load is a size",
+    ),
+    (
+        "unknown damping normalisation",
+        'damping_normalisation = "mesh"',
+        'damping_normalisation = "modla"',
+        "damping_normalisation: 'modla' is not one of mesh, modal (did you mean 'modal'?)",
+    ),
+    (
+        "unknown open value",
+        'load_reading = "q-braking"',
+        'load_reading = "q-braking"\nflywheel_inertia = 3.0',
+        "flywheel_inertia: is not an open value (did you mean 'flywheel_inertia_kg_m2'?)",
     ),
 ]
 

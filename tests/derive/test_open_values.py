@@ -84,7 +84,9 @@ def test_the_scene_open_table_equals_the_keyword(tmp_path, root):
     topo = (root / "scenes" / "topologies" / "diso.toml").as_posix()
     text = text.replace('topology = "topologies/diso.toml"', f'topology = "{topo}"')
     path = tmp_path / "open.toml"
-    path.write_text(text + "\n[open]\nte_amplitude_um = 8.0\nflywheel_inertia_kg_m2 = 3.0\n")
+    assert "\n[open]\n" in text
+    extra = "te_amplitude_um = 8.0\nflywheel_inertia_kg_m2 = 3.0\n"
+    path.write_text(text.replace("\n[open]\n", "\n[open]\n" + extra))
     from_file = derive_model(load_target(path))
     scene = load_target(resolve_target("reference-light"))
     keyword = derive_model(with_open_values(scene, te_amplitude_um=8.0, flywheel_inertia_kg_m2=3.0))
@@ -109,5 +111,127 @@ def test_open_value_names():
 )
 def test_bad_open_values_are_one_clear_line(scene, values, message):
     with pytest.raises(InputError, match=None) as err:
+        with_open_values(scene, **values)
+    assert message in str(err.value) and "\n" not in str(err.value)
+
+
+def test_values_equal_to_the_scenes_own_derive_nothing(scene):
+    # diso.toml states 5 um, 10 kg m^2 and 120 deg; the scene q-braking and "mesh"
+    same = with_open_values(
+        scene,
+        te_amplitude_um=5.0,
+        flywheel_inertia_kg_m2=10,
+        layout_angle_deg=120.0,
+        load_reading="q-braking",
+        damping_normalisation="mesh",
+    )
+    assert same is scene
+    assert with_open_values(scene, te_amplitude_um=6.0) is not scene
+
+
+def test_a_variant_keeps_the_scenes_own_open_values(tmp_path, root):
+    text = (root / "scenes" / "reference-light.toml").read_text()
+    topo = (root / "scenes" / "topologies" / "diso.toml").as_posix()
+    text = text.replace('topology = "topologies/diso.toml"', f'topology = "{topo}"')
+    path = tmp_path / "open.toml"
+    path.write_text(text.replace("\n[open]\n", "\n[open]\nte_amplitude_um = 8.0\n"))
+    own = load_target(path)
+    _, p = _model(own, flywheel_inertia_kg_m2=3.0)
+    assert p["E_u_1"] == pytest.approx(8.0 / 50.0, rel=1e-12)  # the file's 8 um kept
+    assert with_open_values(own, te_amplitude_um=8.0) is own
+
+
+def test_flywheel_gives_the_reduced_mass_coupling_by_hand(scene):
+    # By hand for the reference stage (equal pinions p, q on gear g, equal meshes):
+    # W_uu = c^2 (r_p^2/I_p + r_g^2/I_g), W_uv = c^2 r_g^2/I_g, omega_n^2 = k_m W_uu, so
+    # kappa_uv = W_uv / W_uu = (r_g^2/I_g) / (r_p^2/I_p + r_g^2/I_g).
+    for J in (0.5, 25.0):
+        variant = with_open_values(scene, flywheel_inertia_kg_m2=J)
+        p_, g = variant.topology.gear("p"), variant.topology.gear("g")
+        a, c = p_.base_radius**2 / p_.inertia, g.base_radius**2 / g.inertia
+        _, values = _model(scene, flywheel_inertia_kg_m2=J)
+        assert values["kappa_u_v"] == pytest.approx(c / (a + c), rel=1e-10)
+        assert values["kappa_v_u"] == pytest.approx(c / (a + c), rel=1e-10)
+
+
+# The sign table of the two readings (SEED.md): f2 < 0 in both; the coupling terms
+# kappa_uv, kappa_vu, xi_uv, xi_vu positive with q braking, negative with both driving.
+@pytest.mark.parametrize("name", ["reference-light", "reference-heavy"])
+def test_the_two_readings_differ_in_the_coupling_signs_only(name):
+    base = load_target(resolve_target(name))
+    _, braking = _model(base)
+    _, driving = _model(base, load_reading="both-driving")
+    f1 = base.parameters["f1"]
+    lam = base.parameters["lambda"]
+    for p in (braking, driving):
+        assert p["f_u"] == pytest.approx(f1) and p["f_v"] == pytest.approx(-lam * f1)
+    for key in ("kappa_u_v", "kappa_v_u", "xi_u_v", "xi_v_u"):
+        assert braking[key] > 0 and driving[key] == pytest.approx(-braking[key], rel=1e-12)
+    for key in braking:
+        if key not in ("kappa_u_v", "kappa_v_u", "xi_u_v", "xi_v_u"):
+            assert driving[key] == pytest.approx(braking[key], rel=1e-12, abs=1e-15), key
+    # the shipped scene of the other reading is the same model
+    other = derive_model(load_target(resolve_target(f"{name}-both-driving")))
+    assert np.allclose(other.defaults, list(driving.values()), rtol=1e-12)
+
+
+def test_the_load_sign_follows_the_torque_sign():
+    # Pinion q driving while v is measured forward (no such built-in reading): f_v > 0,
+    # as T_q > 0 loads q's flank; the couplings stay positive.
+    from dataclasses import replace
+
+    from gearsym.derive.readings import Reading
+
+    base = load_target(resolve_target("reference-light"))
+    odd = Reading("q-driving-forward", "", ("p", "q"), (), ())
+    topo = replace(base.topology, readings=base.topology.readings | {odd.id: odd})
+    from gearsym.derive.readings import apply_reading
+
+    scene = replace(base, topology=apply_reading(topo, odd.id, "test"), load_reading=odd.id)
+    model = derive_model(scene)
+    p = dict(zip(model.parameter_names, model.defaults, strict=True))
+    assert p["f_v"] == pytest.approx(base.parameters["lambda"] * base.parameters["f1"])
+    assert p["kappa_u_v"] > 0
+    assert model.scene.topology.torques["q"] > 0
+
+
+def test_switching_the_reading_back_leaves_no_trace(scene):
+    driving = with_open_values(scene, load_reading="both-driving")
+    back = with_open_values(driving, load_reading="q-braking")
+    assert [m.orientation for m in back.topology.meshes] == [1, 1]
+    assert np.allclose(derive_model(back).defaults, derive_model(scene).defaults, rtol=1e-12)
+
+
+def test_modal_damping_gives_each_mode_the_damping_ratio(scene):
+    # Reference: for equal meshes kappa = [[1, a], [a, 1]] has modes (1, +-1) with
+    # frequencies sqrt(1 +- a); modal damping zeta on each gives xi = zeta sqrt(kappa):
+    # xi_uu = zeta (sqrt(1+a) + sqrt(1-a)) / 2, xi_uv = zeta (sqrt(1+a) - sqrt(1-a)) / 2.
+    _, p = _model(scene, damping_normalisation="modal")
+    zeta, a = scene.parameters["damping_ratio"], p["kappa_u_v"]
+    plus, minus = math.sqrt(1 + a), math.sqrt(1 - a)
+    assert p["xi_u_u"] == pytest.approx(zeta * (plus + minus) / 2, rel=1e-9)
+    assert p["xi_u_v"] == pytest.approx(zeta * (plus - minus) / 2, rel=1e-9)
+    assert p["xi_v_u"] == pytest.approx(p["xi_u_v"], rel=1e-9)
+    _, mesh = _model(scene)
+    assert p["xi_u_v"] == pytest.approx(mesh["xi_u_v"] / 2, rel=0.01)  # ~ half of "mesh"
+
+
+def test_choice_names_are_open_values():
+    assert is_open_value("load_reading") and is_open_value("damping_normalisation")
+    from gearsym.derive.open_values import OPEN_VALUE_BASES
+
+    assert {"load_reading", "te_amplitude_um", "flywheel_inertia_kg_m2"} <= OPEN_VALUE_BASES
+
+
+@pytest.mark.parametrize(
+    ("values", "message"),
+    [
+        ({"load_reading": "both-drivng"}, "'both-drivng' is not a reading of topology 'diso'"),
+        ({"load_reading": 1.0}, "load_reading: must be text"),
+        ({"damping_normalisation": "modl"}, "(did you mean 'modal'?)"),
+    ],
+)
+def test_bad_choices_are_one_clear_line(scene, values, message):
+    with pytest.raises(InputError) as err:
         with_open_values(scene, **values)
     assert message in str(err.value) and "\n" not in str(err.value)
