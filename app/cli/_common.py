@@ -24,12 +24,21 @@ class Fail(Exception):
     """A user-facing failure: one line, exit code 2."""
 
 
-def parse_set(items: list[str]) -> dict[str, float]:
+def parse_set(items: list[str]) -> dict[str, float | str]:
+    """``--set key=value`` items: numbers, except the open values that take text
+    (``load_reading``, ``damping_normalisation``: ``gearsym.derive.open_values.CHOICES``)."""
+    from gearsym.derive.open_values import CHOICES
+
     out = {}
     for item in items or []:
         key, sep, value = item.partition("=")
         if not sep or not key:
             raise Fail(f"--set {item}: expected key=value, for example --set lambda=0.5")
+        if key.strip() in CHOICES:
+            if not value.strip():
+                raise Fail(f"--set {item}: give a value ({CHOICES[key.strip()]})")
+            out[key.strip()] = value.strip()
+            continue
         try:
             number = float(value)
         except ValueError:
@@ -71,11 +80,11 @@ def system_of(scene_arg: str, sets: dict[str, float]):
         return System.load(module, **rest)
     except KeyError as err:
         from gearsym.derive._input import nearest
-        from gearsym.derive.open_values import OPEN_VALUES
+        from gearsym.derive.open_values import OPEN_VALUE_BASES
 
         unknown = [k for k in rest if k not in module.PARAMETERS]
-        hint = nearest(unknown[0], OPEN_VALUES) if unknown else ""
-        more = f"{hint}; open values (derived anew): {', '.join(OPEN_VALUES)}"
+        hint = nearest(unknown[0], OPEN_VALUE_BASES) if unknown else ""
+        more = f"{hint}; open values (derived anew): {', '.join(sorted(OPEN_VALUE_BASES))}"
         raise Fail(f"--set: {err.args[0]}{more}") from None
     except ValueError as err:
         raise Fail(f"--set: {err}") from None

@@ -140,7 +140,8 @@ def test_parameters_function_maps_scene_parameters():
     mod = load_generated("reference_light")
     idx = {n: k for k, n in enumerate(mod.PARAMETERS)}
     p = mod.parameters(**{"lambda": 0.8, "f1": 0.5, "damping_ratio": 0.06})
-    # The scene's [loads]: u = "f1", v = "-lambda*f1"; xi scales with the damping ratio.
+    # The scene's [loads]: u = "f1", v = "lambda*f1" (a size; q braking gives f_v = -lambda*f1);
+    # xi scales with the damping ratio.
     assert p[idx["f_u"]] == 0.5 and p[idx["f_v"]] == pytest.approx(-0.4)
     assert p[idx["xi_u_u"]] == pytest.approx(0.06)
     assert p[idx["xi_u_v"]] == pytest.approx(2 * mod.DEFAULTS[idx["xi_u_v"]])

@@ -235,3 +235,26 @@ def test_bad_choices_are_one_clear_line(scene, values, message):
     with pytest.raises(InputError) as err:
         with_open_values(scene, **values)
     assert message in str(err.value) and "\n" not in str(err.value)
+
+
+def test_cli_set_takes_open_values_with_text(capsys):
+    import json
+
+    from gearsym.cli import main
+
+    args = ["derive", "reference-light", "--dry-run", "--json"]
+    code = main(args + ["--set", "load_reading=both-driving", "--set", "te_amplitude_um=10"])
+    out = json.loads(capsys.readouterr().out)
+    (model,) = out.values()
+    assert code == 0 and model["kappa"]["uv"]["mean"] < 0 and model["f"]["v"] < 0
+    assert model["transmission_error"]["v"]["amplitude"] == [pytest.approx(10.0 / 50.0)]
+    code = main(args[:-1] + ["--set", "damping_normalisation=modl"])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "(did you mean 'modal'?)" in err
+
+
+def test_load_with_the_scenes_own_values_uses_the_shipped_module():
+    import gearsym
+
+    system = gearsym.load("reference-light", load_reading="q-braking", te_amplitude_um=5.0)
+    assert system.module.__name__ == "gearsym.generated.reference_light"
