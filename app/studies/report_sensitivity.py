@@ -69,8 +69,10 @@ def sensitivity_section(rows, scales: dict, loads: dict, points: dict) -> str:
         "random state in the regime map's default box (seed 0). The built-in scenes keep "
         "their stated values (marked *); the values "
         "tried are a fixed spread round them, set before any run. The load reading (q braking "
-        "against both driving) and the damping normalisation are not yet offered by the derive "
-        "layer, so they are not varied here: every row uses the scenes' reading, q braking.\n"
+        "against both driving) and the damping normalisation are open values too, but text, "
+        "not a map axis, and are not varied here yet: every row uses the scenes' reading, q "
+        "braking, and mesh damping (`gearsym map reference-light-both-driving ...` maps the "
+        "other reading).\n"
     )
     w.append(
         "Critical λ: the smallest λ past which every attractor of v is periodic "
