@@ -71,27 +71,33 @@ def _edges(v) -> np.ndarray:
     return np.concatenate([[2 * v[0] - mid[0]], mid, [2 * v[-1] - mid[-1]]])
 
 
-def _label(ax, m: RegimeMap) -> None:
-    """Axis names; an unevenly spaced axis gets one tick per value (cells of equal size)."""
+def _label(ax, m: RegimeMap, ticks: dict | None = None) -> None:
+    """Axis names; an unevenly spaced axis gets one tick per value (cells of equal size);
+    ``ticks`` names the values of an axis that stands for text (``{axis: [label, ...]}``)."""
+    ticks = ticks or {}
     for values, name, axis in ((m.x_values, m.x, ax.xaxis), (m.y_values, m.y, ax.yaxis)):
+        if name in ticks:
+            axis.set_label_text(name)
+            axis.set_ticks(np.asarray(values, float), list(ticks[name]))
+            continue
         axis.set_label_text(name + (" (unevenly spaced values)" if _uneven(values) else ""))
         if _uneven(values):
             axis.set_ticks(np.arange(len(values)), [f"{v:g}" for v in values])
 
 
-def _caption(m: RegimeMap) -> str:
+def _caption(m: RegimeMap, title: str | None = None) -> str:
     fixed = ", ".join(f"{k} = {v:g}" for k, v in m.values.items() if k not in (m.x, m.y))
     s = m.settings
     k = s["initial_states"]
     starts = ["forward", "backward"][: min(k, 2)] + ([f"{k - 2} random"] if k > 2 else [])
     return (
-        f"{m.model}{'; ' + fixed if fixed else ''}; {k} initial states per point "
+        f"{title or m.model}{'; ' + fixed if fixed else ''}; {k} initial states per point "
         f"({', '.join(starts)}; seed {s['seed']}); {s['transient']} + {s['periods']} periods, "
         f"{s['method']} rtol {s['rtol']:g}; dominant attractor shown"
     )
 
 
-def _categorical(ax, fig, m: RegimeMap, labels, classes, title: str) -> None:
+def _categorical(ax, fig, m: RegimeMap, labels, classes, title: str, ticks=None) -> None:
     names = [c for c, _ in classes]
     codes = np.vectorize(lambda s: names.index(s))(labels).astype(float)
     cmap = ListedColormap([c for _, c in classes])
@@ -105,7 +111,7 @@ def _categorical(ax, fig, m: RegimeMap, labels, classes, title: str) -> None:
         fontsize=8,
         frameon=False,
     )
-    _label(ax, m)
+    _label(ax, m, ticks)
     ax.set_title(title)
 
 
@@ -118,64 +124,90 @@ def _save(fig, path: Path, caption: str) -> Path:
     return path
 
 
-def map_figures(m: RegimeMap, folder, prefix: str = "map") -> list[Path]:
+FIGURES = ("motion", "lyapunov", "attractors", "extremes", "meshing")
+
+
+def map_figures(
+    m: RegimeMap,
+    folder,
+    prefix: str = "map",
+    ticks: dict | None = None,
+    title: str | None = None,
+    kinds: tuple = FIGURES,
+) -> list[Path]:
     """Write the figures of a map into ``folder`` (the meshing regime only for models
-    with contact edges); return their paths."""
+    with contact edges); return their paths.  ``ticks``: ``{axis: [label per value]}`` for
+    an axis whose values stand for text (a load reading, a backlash model); ``title``
+    opens the caption instead of the model's name (say what a derived variant is);
+    ``kinds``: which of :data:`FIGURES` to write."""
+    unknown = sorted(set(kinds) - set(FIGURES))
+    if unknown:
+        raise ValueError(f"kinds: {', '.join(unknown)} unknown; known: {', '.join(FIGURES)}")
     folder = Path(folder)
-    caption = _caption(m)
+    caption = _caption(m, title)
     out = []
     coords, nc = m.coordinates, len(m.coordinates)
     xe, ye = _edges(m.x_values), _edges(m.y_values)
     status = m.grid("status")
 
-    fig, axes = plt.subplots(1, nc, figsize=(5.2 * nc + 1.5, 4.2), squeeze=False)
-    for ax, c in zip(axes[0], coords, strict=True):
-        motion = m.grid("motion", c)
-        labels = np.vectorize(motion_class)(motion, status)
-        _categorical(ax, fig, m, labels, MOTION_CLASSES, f"motion of {c}")
-    out.append(_save(fig, folder / f"{prefix}-motion.png", caption))
+    if "motion" in kinds:
+        fig, axes = plt.subplots(1, nc, figsize=(5.2 * nc + 1.5, 4.2), squeeze=False)
+        for ax, c in zip(axes[0], coords, strict=True):
+            motion = m.grid("motion", c)
+            labels = np.vectorize(motion_class)(motion, status)
+            _categorical(ax, fig, m, labels, MOTION_CLASSES, f"motion of {c}", ticks)
+        out.append(_save(fig, folder / f"{prefix}-motion.png", caption))
 
-    fig, ax = plt.subplots(figsize=(6.5, 4.5))
-    lam = m.grid("lyapunov")
-    lim = np.nanmax(np.abs(lam)) if np.any(np.isfinite(lam)) else 1.0
-    im = ax.pcolormesh(xe, ye, lam, cmap="RdBu_r", vmin=-lim, vmax=lim)
-    fig.colorbar(im, ax=ax, label="largest Lyapunov exponent (per unit τ)")
-    _label(ax, m)
-    ax.set_title("largest Lyapunov exponent (> 0: chaos); blank: no estimate")
-    out.append(_save(fig, folder / f"{prefix}-lyapunov.png", caption))
+    if "lyapunov" in kinds:
+        fig, ax = plt.subplots(figsize=(6.5, 4.5))
+        lam = m.grid("lyapunov")
+        lim = np.nanmax(np.abs(lam)) if np.any(np.isfinite(lam)) else 1.0
+        im = ax.pcolormesh(xe, ye, lam, cmap="RdBu_r", vmin=-lim, vmax=lim)
+        fig.colorbar(im, ax=ax, label="largest Lyapunov exponent (per unit τ)")
+        _label(ax, m, ticks)
+        ax.set_title("largest Lyapunov exponent (> 0: chaos); blank: no estimate")
+        out.append(_save(fig, folder / f"{prefix}-lyapunov.png", caption))
 
-    fig, ax = plt.subplots(figsize=(6.5, 4.5))
-    count = m.grid("attractors")
-    top = max(int(np.nanmax(count)), 1)
-    cmap = plt.get_cmap("viridis", top + 1)
-    im = ax.pcolormesh(xe, ye, count, cmap=cmap, vmin=-0.5, vmax=top + 0.5)
-    fig.colorbar(im, ax=ax, ticks=range(0, top + 1), label="attractors found")
-    _label(ax, m)
-    ax.set_title(
-        f"attractors found from {m.settings['initial_states']} initial states\n"
-        "(runs that diverged or left the valid range are not counted)"
-    )
-    out.append(_save(fig, folder / f"{prefix}-attractors.png", caption))
+    if "attractors" in kinds:
+        fig, ax = plt.subplots(figsize=(6.5, 4.5))
+        count = m.grid("attractors")
+        top = max(int(np.nanmax(count)), 1)
+        cmap = plt.get_cmap("viridis", top + 1)
+        im = ax.pcolormesh(xe, ye, count, cmap=cmap, vmin=-0.5, vmax=top + 0.5)
+        fig.colorbar(im, ax=ax, ticks=range(0, top + 1), label="attractors found")
+        _label(ax, m, ticks)
+        ax.set_title(
+            f"attractors found from {m.settings['initial_states']} initial states\n"
+            "(runs that diverged or left the valid range are not counted)"
+        )
+        out.append(_save(fig, folder / f"{prefix}-attractors.png", caption))
 
-    fig, axes = plt.subplots(2, nc, figsize=(5.2 * nc, 8), squeeze=False)
-    for k, c in enumerate(coords):
-        for row, field in enumerate(("max", "min")):
-            ax = axes[row][k]
-            im = ax.pcolormesh(xe, ye, m.grid(field, c), cmap="viridis")
-            fig.colorbar(im, ax=ax, label=f"{field.capitalize()}({c}) / half backlash")
-            _label(ax, m)
-            ax.set_title(f"{field.capitalize()}({c}) over the sampled window")
-    out.append(_save(fig, folder / f"{prefix}-extremes.png", caption))
+    if "extremes" in kinds:
+        fig, axes = plt.subplots(2, nc, figsize=(5.2 * nc, 8), squeeze=False)
+        for k, c in enumerate(coords):
+            for row, field in enumerate(("max", "min")):
+                ax = axes[row][k]
+                im = ax.pcolormesh(xe, ye, m.grid(field, c), cmap="viridis")
+                fig.colorbar(im, ax=ax, label=f"{field.capitalize()}({c}) / half backlash")
+                _label(ax, m, ticks)
+                ax.set_title(f"{field.capitalize()}({c}) over the sampled window")
+        out.append(_save(fig, folder / f"{prefix}-extremes.png", caption))
 
     meshes = m.meshes
-    if not meshes:
+    if not meshes or "meshing" not in kinds:
         return out
     fig, axes = plt.subplots(1, len(meshes), figsize=(5.2 * len(meshes) + 2, 4.2), squeeze=False)
     for ax, c in zip(axes[0], meshes, strict=True):
         regime = m.grid("meshing", c)
         labels = np.vectorize(lambda r: r if r else "undetermined")(regime)
         _categorical(
-            ax, fig, m, labels, MESHING_CLASSES, f"meshing regime of {c} (Kahraman & Singh)"
+            ax,
+            fig,
+            m,
+            labels,
+            MESHING_CLASSES,
+            f"meshing regime of {c} (Kahraman & Singh)",
+            ticks,
         )
     out.append(_save(fig, folder / f"{prefix}-meshing.png", caption))
     return out

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 from gearsym.studies.report_sensitivity import sensitivity_section
-from gearsym.studies.sensitivity import OPEN_SPREAD, Sensitivity, _critical, _matches
+from gearsym.studies.sensitivity import OPEN_SPREAD, Sensitivity, _critical, _matches, _named
 
 
 def _rec(lam, value, v, status="ok"):
@@ -56,13 +56,37 @@ def test_section_states_every_finding_and_marks_the_stated_value():
     )
     scales = {"u": {"k_m_N_per_m": 1e9, "b_um": 50.0, "force_N": 5e4}}
     text = sensitivity_section([row], scales, {"heavy": 0.5}, {})
-    assert "| heavy (f1 = 0.5) | `te_amplitude_um` (µm) | 5*, 50 |" in text
+    assert "| heavy (f1 = 0.5) | q braking | `te_amplitude_um` (µm) | 5*, 50 |" in text
     assert "5: 0; 50: none" in text
     assert "*u period-3 at high λ*: **no value tried reproduces it.**" in text
-    assert "*v chaotic at low λ*: reproduced with `te_amplitude_um` = 50." in text
+    assert "*v chaotic at low λ*: reproduced with `te_amplitude_um` = 50 (q braking)." in text
     assert "2 runs failed" in text
     assert "| u | 1e+09 | 50 | 5e+04 | 1000 | 2.5e+04 |" in text
     assert "multiples of ω̄/3" in text
+
+
+def test_text_values_are_named_in_records_and_table():
+    values = ("mesh", "modal")
+    records = [{"lambda": 0.0, "damping_normalisation": 1.0, "status": "ok"}]
+    assert _named(records, "damping_normalisation", values)[0]["damping_normalisation"] == "modal"
+    assert _named(records, "k", (1.0, 2.0)) is records  # numeric axes are left alone
+    row = Sensitivity(
+        case="light",
+        key="damping_normalisation",
+        values=values,
+        stated="mesh",
+        unit="text",
+        motions={"mesh": ["period-1"], "modal": ["chaotic"]},
+        critical={"mesh": 0.0, "modal": 0.4},
+        reproduced={"v chaotic at low λ": ["modal"]},
+        failed=0,
+        figures=[],
+        reading="both-driving",
+    )
+    text = sensitivity_section([row], {}, {"light": 0.1}, {})
+    assert "| light (f1 = 0.1) | both driving | `damping_normalisation` | mesh*, modal |" in text
+    assert "mesh: 0; modal: 0.4" in text
+    assert "reproduced with `damping_normalisation` = modal (both driving)." in text
 
 
 @pytest.mark.slow
@@ -72,6 +96,8 @@ def test_reproduce_quick_has_the_sensitivity_table(tmp_path):
     assert main(["reproduce", "--quick", "--out", str(tmp_path), "--quiet"]) == 0
     report = (tmp_path / "report.md").read_text()
     assert "## Sensitivity to the values the study leaves open" in report
-    assert "| light (f1 = 0.1) | `te_amplitude_um` (µm) |" in report
+    assert "| light (f1 = 0.1) | q braking | `te_amplitude_um` (µm) |" in report
+    assert "| heavy (f1 = 0.5) | both driving | `te_amplitude_um` (µm) |" in report
     assert "### Physical scales" in report
-    assert (tmp_path / "sensitivity" / "heavy-te_amplitude_um-motion.png").stat().st_size > 1000
+    figure = tmp_path / "sensitivity" / "heavy-both-driving-te_amplitude_um-motion.png"
+    assert figure.stat().st_size > 1000

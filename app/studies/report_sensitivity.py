@@ -46,7 +46,21 @@ def _failed(r) -> str:
 
 
 def _num(v) -> str:
-    return f"{v:g}"
+    return v if isinstance(v, str) else f"{v:g}"
+
+
+def _motion_order(motion: str):
+    """period-1, period-2, ..., period-12, then the rest in alphabetical order."""
+    if motion.startswith("period-") and motion[7:].isdigit():
+        return (0, int(motion[7:]), "")
+    return (1, 0, motion)
+
+
+def _unit(r) -> str:
+    return {"text": "", "model": " (model, stated)"}.get(r.unit, f" ({r.unit})")
+
+
+READING_NAMES = {"q-braking": "q braking", "both-driving": "both driving"}
 
 
 def _critical(c: dict) -> str:
@@ -68,11 +82,13 @@ def sensitivity_section(rows, scales: dict, loads: dict, points: dict) -> str:
         "from the previous λ's end state, the first from the loaded rest state) and one "
         "random state in the regime map's default box (seed 0). The built-in scenes keep "
         "their stated values (marked *); the values "
-        "tried are a fixed spread round them, set before any run. The load reading (q braking "
-        "against both driving) and the damping normalisation are open values too, but text, "
-        "not a map axis, and are not varied here yet: every row uses the scenes' reading, q "
-        "braking, and mesh damping (`gearsym map reference-light-both-driving ...` maps the "
-        "other reading).\n"
+        "tried are a fixed spread round them, set before any run. Every row is mapped in both "
+        "readings of the loads the study allows (`load_reading`): pinion q braking (the "
+        "built-in scenes') and both pinions driving with the q-g coordinate measured the "
+        "other way. Text values (the damping normalisation) are mapped over their index and "
+        "labelled by name. The backlash row is not an open value (the study states its "
+        "7th-order fit) but sets the fit beside the exact dead zone it approximates "
+        "(scene `reference-dead-zone`), which has no valid range to leave.\n"
     )
     w.append(
         "Critical λ: the smallest λ past which every attractor of v is periodic "
@@ -83,12 +99,13 @@ def sensitivity_section(rows, scales: dict, loads: dict, points: dict) -> str:
         "λ ≥ 0.13 (heavy only; n/a at light load).\n"
     )
     names = list(dict.fromkeys(n for r in rows for n in r.reproduced))
-    w.append("| load | open value | values tried | motion types found | critical λ of v | "
+    w.append("| load | reading | open value | values tried | motion types found | "
+             "critical λ of v | "
              + " | ".join(f"reproduces: {n}" for n in names) + " |")  # fmt: skip
-    w.append("|---|---|---|---|---|" + "---|" * len(names))
+    w.append("|---|---|---|---|---|---|" + "---|" * len(names))
     for r in rows:
         tried = ", ".join(_num(v) + ("*" if v == r.stated else "") for v in r.values)
-        types = sorted({m for ms in r.motions.values() for m in ms})
+        types = sorted({m for ms in r.motions.values() for m in ms}, key=_motion_order)
         cells = []
         for n in names:
             if n not in r.reproduced:
@@ -98,7 +115,8 @@ def sensitivity_section(rows, scales: dict, loads: dict, points: dict) -> str:
             else:
                 cells.append("no")
         w.append(
-            f"| {r.case} (f1 = {loads[r.case]}) | `{r.key}` ({r.unit}) | {tried} | "
+            f"| {r.case} (f1 = {loads[r.case]}) | {READING_NAMES.get(r.reading, r.reading)} | "
+            f"`{r.key}`{_unit(r)} | {tried} | "
             f"{', '.join(types) or '—'}{_failed(r)} | {_critical(r.critical)} | "
             + " | ".join(cells)
             + " |"
@@ -107,7 +125,8 @@ def sensitivity_section(rows, scales: dict, loads: dict, points: dict) -> str:
     for case in dict.fromkeys(r.case for r in rows):
         here = [r for r in rows if r.case == case]
         for n in here[0].reproduced:
-            found = [f"`{r.key}` = {', '.join(_num(v) for v in r.reproduced[n])}"
+            found = [f"`{r.key}` = {', '.join(_num(v) for v in r.reproduced[n])} "
+                     f"({READING_NAMES.get(r.reading, r.reading)})"
                      for r in here if r.reproduced[n]]  # fmt: skip
             if found:
                 w.append(f"- {case} load, *{n}*: reproduced with {'; '.join(found)}.")
@@ -134,7 +153,8 @@ def sensitivity_section(rows, scales: dict, loads: dict, points: dict) -> str:
         )
     w.append("")
     w.append(
-        "Figures: `sensitivity/<load>-<open value>-*.png`, the regime maps (motion of u and "
+        "Figures: `sensitivity/<load>-<reading>-<open value>-*.png`, the regime maps (motion "
+        "of u and "
         "v, largest Lyapunov exponent, attractor count, meshing) over λ by each value.\n"
     )
     return "\n".join(w)

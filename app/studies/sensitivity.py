@@ -1,10 +1,11 @@
 """Where the study's findings live in the values it leaves open (issue 12, point 6).
 
 For each open value the derive layer offers (``gearsym.derive.open_values``), a regime map
-over lambda by that value, at both loads, from at least two initial states so that
-coexisting attractors show.  Each value is a new derivation (cached); the built-in scenes
-keep their stated values, which are always among the values tried.  Nothing is tuned: the
-values tried are a fixed spread round the stated one, chosen before any run.
+over lambda by that value, at both loads and in both readings of the loads, from three
+initial states so that coexisting attractors show.  Each value is a new derivation
+(cached); the built-in scenes keep their stated values, which are always among the values
+tried.  Nothing is tuned: the values tried are a fixed spread round the stated one, chosen
+before any run.
 """
 
 from __future__ import annotations
@@ -16,15 +17,27 @@ import numpy as np
 
 __all__ = ["OPEN_SPREAD", "FINDINGS", "Sensitivity", "run_sensitivity", "physical_scales"]
 
-# key -> (values tried, stated value of the built-in scenes, unit)
+# key -> (values tried, stated value of the built-in scenes, unit); text values (a damping
+# normalisation, a backlash model) are mapped over their index and labelled by name
 OPEN_SPREAD = {
     # a uniform 2.5 um grid up to four times the stated 5 um, and 50 um (one half backlash)
     "te_amplitude_um": ((0.0, 2.5, 5.0, 7.5, 10.0, 12.5, 15.0, 20.0, 50.0), 5.0, "µm"),
+    # the q-g mesh's error against the p-g mesh's, a quarter turn apart
+    "te_phase_deg_qg": ((0.0, 90.0, 180.0, 270.0), 0.0, "°"),
     "flywheel_inertia_kg_m2": ((1.0, 10.0, 100.0), 10.0, "kg m²"),
     "layout_angle_deg": ((0.0, 60.0, 120.0, 180.0), 120.0, "°"),
     "stiffness_harmonic_scale": ((0.0, 1.0, 2.0), 1.0, "×"),
+    "damping_normalisation": (("mesh", "modal"), "mesh", "text"),
+    # not open (the study states its 7th-order fit), but the fit's error is a modelling
+    # choice a reader will ask about: the exact dead zone it approximates beside it
+    "backlash": (("polynomial", "dead-zone"), "polynomial", "model"),
 }
 QUICK_SPREAD = {"te_amplitude_um": ((5.0, 50.0), 5.0, "µm")}
+# the two readings of the loads (topologies/diso.toml [[reading]]); every row is mapped in
+# both, the built-in scenes' reading first
+READINGS = ("q-braking", "both-driving")
+# the scene that models each backlash choice (same values otherwise; f1 set per load)
+BACKLASH_SCENES = {"polynomial": None, "dead-zone": "reference-dead-zone"}
 
 # Findings per load, each a test on the set of attractors (motion of u / v) at each lambda.
 # (case, name, coordinate, motion test, lambda range where the study reports it)
@@ -54,22 +67,35 @@ class Sensitivity:
     reproduced: dict  # finding -> list of values that reproduce it
     failed: int  # attractor records whose runs failed (e.g. left the valid range)
     figures: list
+    reading: str = "q-braking"
 
 
 def _matches(motion: str, test: str) -> bool:
     return motion.startswith(test) if test != "period-3" else motion == "period-3"
 
 
-def _resolver(scene: str, key: str):
+def is_text(values) -> bool:
+    return any(isinstance(v, str) for v in values)
+
+
+def _resolver(scene: str, f1: float, reading: str, key: str, values: tuple):
+    """The System of one map point: one derivation per value of ``key`` (cached), in
+    ``reading``; a text value arrives as its index in ``values``."""
     from gearsym.resolve import load
 
     memo: dict = {}
+    text = is_text(values)
 
-    def resolve(values: dict):
-        v = values[key]
+    def resolve(point: dict):
+        v = point[key]
         if v not in memo:
-            memo[v] = load(scene, **{key: v})
-        return memo[v].with_values(**{k: x for k, x in values.items() if k != key})
+            value = values[int(round(v))] if text else v
+            if key == "backlash":
+                target = BACKLASH_SCENES[value] or scene
+                memo[v] = load(target, load_reading=reading, f1=f1)
+            else:
+                memo[v] = load(scene, load_reading=reading, **{key: value})
+        return memo[v].with_values(**{k: x for k, x in point.items() if k != key})
 
     return resolve
 
@@ -88,9 +114,16 @@ def _critical(records, lam_values, value, key) -> float:
     return float("nan")
 
 
+def _named(records, key, values):
+    """Records with a text axis's index replaced by the text it stands for."""
+    if not is_text(values):
+        return records
+    return [{**r, key: values[int(round(r[key]))]} for r in records]
+
+
 def run_sensitivity(out: Path, res, settings: dict, *, quick, executor, workers, progress):
-    """Regime maps over lambda by each open value at both loads; figures and data under
-    ``out``; a list of :class:`Sensitivity` rows."""
+    """Regime maps over lambda by each open value at both loads, in both load readings;
+    figures and data under ``out``; a list of :class:`Sensitivity` rows."""
     from gearsym.resolve import load
     from gearsym.solver.plots_maps import map_figures
     from gearsym.solver.sweep.atlas import regime_map
@@ -100,58 +133,74 @@ def run_sensitivity(out: Path, res, settings: dict, *, quick, executor, workers,
     folder = out / "sensitivity"
     folder.mkdir(parents=True, exist_ok=True)
     rows = []
-    for case, (scene, _f1) in SCENES.items():
-        base = load(scene)
-        for key, (values, stated, unit) in spread.items():
-            if progress:
-                import sys
+    for case, (scene, f1) in SCENES.items():
+        for reading in READINGS:
+            base = load(scene, load_reading=reading)
+            for key, (values, stated, unit) in spread.items():
+                if progress:
+                    import sys
 
-                print(f"sensitivity: {case} load, {key} = {list(values)}", file=sys.stderr)
-            m = regime_map(
-                base,
-                ("lambda", lam),
-                (key, np.array(values, float)),
-                initial_states=3,
-                seed=0,
-                transient=res.transient,
-                periods=res.periods,
-                lyapunov_periods=min(res.lyapunov_periods, res.transient + res.periods),
-                method=settings["method"],
-                rtol=settings["rtol"],
-                atol=settings["atol"],
-                executor=executor,
-                workers=workers,
-                store=out / "store" / f"sensitivity_{case}_{key}",
-                progress=progress,
-                resolve=_resolver(scene, key),
-            )
-            m.save(out / "data" / f"sensitivity_{case}_{key}.json")
-            figs = map_figures(m, folder, f"{case}-{key}")
-            records = m.records()
-            motions, critical = {}, {}
-            for v in values:
-                here = [r for r in records if r[key] == v and r["status"] == "ok"]
-                motions[v] = sorted({r["motion"][c] for r in here for c in ("u", "v")})
-                critical[v] = _critical(records, lam, v, key)
-            reproduced = {}
-            for name, coord, test, (lo, hi) in FINDINGS[case]:
-                inside = [r for r in records if lo <= r["lambda"] <= hi]
-                shows = [r[key] for r in inside if _matches(r["motion"][coord], test)]
-                reproduced[name] = [v for v in values if v in shows]
-            rows.append(
-                Sensitivity(
-                    case,
-                    key,
-                    values,
-                    stated,
-                    unit,
-                    motions,
-                    critical,
-                    reproduced,
-                    sum(r["status"] != "ok" for r in records),
-                    figs,
+                    print(
+                        f"sensitivity: {case} load, {reading}, {key} = {list(values)}",
+                        file=sys.stderr,
+                    )
+                text = is_text(values)
+                axis = np.arange(len(values), dtype=float) if text else np.array(values, float)
+                name = f"{case}_{reading}_{key}"
+                m = regime_map(
+                    base,
+                    ("lambda", lam),
+                    (key, axis),
+                    initial_states=3,
+                    seed=0,
+                    transient=res.transient,
+                    periods=res.periods,
+                    lyapunov_periods=min(res.lyapunov_periods, res.transient + res.periods),
+                    method=settings["method"],
+                    rtol=settings["rtol"],
+                    atol=settings["atol"],
+                    executor=executor,
+                    workers=workers,
+                    store=out / "store" / f"sensitivity_{name}",
+                    progress=progress,
+                    resolve=_resolver(scene, f1, reading, key, values),
                 )
-            )
+                m.save(out / "data" / f"sensitivity_{name}.json")
+                figs = map_figures(
+                    m,
+                    folder,
+                    f"{case}-{reading}-{key}",
+                    ticks={key: list(values)} if text else None,
+                    title=f"{scene} (f1 = {f1}), load reading {reading}, {key} as on the "
+                    "y axis, all else as stated",
+                    kinds=("motion", "lyapunov", "attractors", "meshing"),
+                )
+                records = _named(m.records(), key, values)
+                motions, critical = {}, {}
+                for v in values:
+                    here = [r for r in records if r[key] == v and r["status"] == "ok"]
+                    motions[v] = sorted({r["motion"][c] for r in here for c in ("u", "v")})
+                    critical[v] = _critical(records, lam, v, key)
+                reproduced = {}
+                for finding, coord, test, (lo, hi) in FINDINGS[case]:
+                    inside = [r for r in records if lo <= r["lambda"] <= hi]
+                    shows = [r[key] for r in inside if _matches(r["motion"][coord], test)]
+                    reproduced[finding] = [v for v in values if v in shows]
+                rows.append(
+                    Sensitivity(
+                        case,
+                        key,
+                        values,
+                        stated,
+                        unit,
+                        motions,
+                        critical,
+                        reproduced,
+                        sum(r["status"] != "ok" for r in records),
+                        figs,
+                        reading,
+                    )
+                )
     return rows
 
 

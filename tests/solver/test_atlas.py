@@ -177,3 +177,27 @@ def test_map_records_round_trip(duffing, tmp_path):
     back = RegimeMap.load(m.save(tmp_path / "map.json"))
     assert back.records() == json.loads(json.dumps(m.to_dict()))["records"]
     assert (tmp_path / m.save(tmp_path / "map.csv").name).exists()
+
+
+def test_map_figures_label_a_text_axis_and_write_only_the_kinds_asked(duffing, tmp_path):
+    from gearsym.solver.plots_maps import map_figures
+
+    s = duffing.with_values(a=1.0, c=0.1, k=0.1, B=0.3, omega=1.2)
+    m = regime_map(
+        s, ("omega", [1.1, 1.2]), ("B", [0.0, 1.0]), initial_states=1, lyapunov_periods=0,
+        transient=50, periods=32, executor="serial",
+    )  # fmt: skip
+    paths = map_figures(
+        m, tmp_path, "t", ticks={"B": ["low", "high"]}, title="a title", kinds=("motion",)
+    )
+    assert [p.name for p in paths] == ["t-motion.png"]
+    assert sorted(f.name for f in tmp_path.iterdir()) == ["t-motion.png"]
+    with pytest.raises(ValueError, match="kinds: spectrum unknown"):
+        map_figures(m, tmp_path, "t", kinds=("spectrum",))
+    import matplotlib.pyplot as plt
+    from gearsym.solver.plots_maps import _label
+
+    fig, ax = plt.subplots()
+    _label(ax, m, {"B": ["low", "high"]})
+    assert [t.get_text() for t in ax.get_yticklabels()] == ["low", "high"]
+    plt.close(fig)
