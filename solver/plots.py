@@ -40,9 +40,18 @@ def bifurcation_diagram(
         len(states), 1, figsize=(7, 2.8 * len(states)), sharex=True, squeeze=False
     )
     for ax, state in zip(axes[:, 0], states, strict=True):
+        finite = [p[np.isfinite(p)] for sw in sweeps for p in sw.poincare(state)]
+        finite = np.concatenate(finite) if finite else np.zeros(0)
+        lo = finite.min() if finite.size else 0.0
+        cell = max(float(np.ptp(finite)) if finite.size else 0.0, 1e-12) * 1e-4
         for sw in sweeps:
             xs, ys = [], []
             for value, pts in zip(sw.values, sw.poincare(state), strict=True):
+                # a periodic orbit's points repeat: draw each place once (points closer
+                # than 1e-4 of the panel's height, far below a pixel, are one place)
+                pts = pts[np.isfinite(pts)]
+                _, first = np.unique(np.round((pts - lo) / cell), return_index=True)
+                pts = pts[np.sort(first)]
                 xs.append(np.full(pts.size, value))
                 ys.append(pts)
             ax.plot(
@@ -50,7 +59,7 @@ def bifurcation_diagram(
                 np.concatenate(ys),
                 ".",
                 markersize=1.5,
-                alpha=0.8,
+                alpha=1.0,
                 color=_COLOURS[sw.direction],
                 label=f"{sw.direction} sweep",
             )

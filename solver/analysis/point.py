@@ -32,6 +32,9 @@ class PointResult:
     trajectory: Trajectory
     lyapunov: LyapunovEstimate | None
     classification: dict[str, Classification]
+    # the spectra the verdicts were drawn from, per coordinate (kept so that describe()
+    # does not compute them again); None: computed on demand
+    spectra: dict | None = None
 
     def describe(self, poincare: bool = True) -> dict:
         tr = self.trajectory
@@ -41,12 +44,16 @@ class PointResult:
             "classification": {c: k.describe() for c, k in self.classification.items()},
             "extremes": extremes(tr),
             "meshing_states": meshing_states(tr),
-            "spectra": {c: spectrum(tr, c).describe() for c in tr.system.coordinates},
+            "spectra": {c: self._spectrum(c).describe() for c in tr.system.coordinates},
             "lyapunov": None if self.lyapunov is None else self.lyapunov.describe(),
         }
         if poincare:
             out["poincare"] = {s: tr.poincare[k].tolist() for k, s in enumerate(tr.system.states)}
         return out
+
+    def _spectrum(self, c: str):
+        known = (self.spectra or {}).get(c)
+        return known if known is not None else spectrum(self.trajectory, c)
 
     def to_dict(self, samples: bool = True) -> dict:
         """Everything of :meth:`describe`, with the time series when ``samples``."""
@@ -153,6 +160,7 @@ def analyse_trajectory(
         return PointResult(
             tr, None, {c: Classification("undetermined", None, why) for c in system.coordinates}
         )
+    spectra = {c: spectrum(tr, c) for c in system.coordinates} if tr.status == "ok" else None
     for c in system.coordinates:
         i, j = system.index(c), system.velocity_index(c)
         points = tr.poincare[[i, j]]
@@ -162,7 +170,7 @@ def analyse_trajectory(
             lyapunov=lyap,
             divergent=tr.status == "divergent",
             period=system.period,
-            spectrum_peaks=spectrum(tr, c).peaks() if tr.status == "ok" else None,
+            spectrum_peaks=spectra[c].peaks() if spectra else None,
         )
     unsettled = [c for c, k in verdicts.items() if k.period is None and k.motion != "divergent"]
     more = dimension_points - tr.poincare.shape[1]
@@ -193,4 +201,4 @@ def analyse_trajectory(
                 )
                 k.evidence["extended_from"] = int(tr.poincare.shape[1])
                 verdicts[c] = k
-    return PointResult(tr, lyap, verdicts)
+    return PointResult(tr, lyap, verdicts, spectra)

@@ -7,6 +7,7 @@ each peak is also given as a multiple of the excitation frequency omega.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -67,6 +68,15 @@ class Spectrum:
     to_dict = describe
 
 
+@functools.lru_cache(maxsize=8)
+def _hann(n: int) -> tuple[np.ndarray, float]:
+    """The periodic Hann window of ``n`` samples (exact on bins) and its sum; a sweep's
+    points share one length."""
+    w = 0.5 - 0.5 * np.cos(2 * np.pi * np.arange(n) / n)
+    w.setflags(write=False)
+    return w, float(w.sum())
+
+
 def spectrum(tr: Trajectory, state: str) -> Spectrum:
     """Hann-windowed FFT of ``state`` over the sampled window (mean removed); non-finite
     samples (a divergent run) give an empty spectrum."""
@@ -76,8 +86,8 @@ def spectrum(tr: Trajectory, state: str) -> Spectrum:
         empty = np.zeros(0)
         return Spectrum(empty, empty, tr.system.omega, "hann", 0, y.size * dt)
     n = y.size
-    w = 0.5 - 0.5 * np.cos(2 * np.pi * np.arange(n) / n)  # periodic Hann: exact on bins
-    amp = 2.0 * np.abs(np.fft.rfft((y - y.mean()) * w)) / w.sum()
+    w, w_sum = _hann(n)
+    amp = 2.0 * np.abs(np.fft.rfft((y - y.mean()) * w)) / w_sum
     freq = 2 * np.pi * np.fft.rfftfreq(n, dt)
     return Spectrum(freq, amp, tr.system.omega, "hann", n, n * dt)
 

@@ -106,6 +106,23 @@ def __getattr__(name: str):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
+@functools.cache
+def dop853_dense():
+    """DOP853's dense output (Hairer, Norsett and Wanner, II.6; SciPy's coefficient
+    arrays): three extra stages (rows ``A`` and nodes ``C`` over the 16 stages of the
+    extended step) and the matrix ``D`` (4 x 16) of the seventh-order interpolant."""
+    from scipy.integrate._ivp import dop853_coefficients as d
+
+    s = d.N_STAGES + 1
+    return {"A": d.A[s:], "C": d.C[s:], "D": d.D, "power": d.INTERPOLATOR_POWER}
+
+
+def dop853_dense_tables(arr) -> list[str]:
+    dense = dop853_dense()
+    return [arr("GS_DOP853_AX", dense["A"]), arr("GS_DOP853_CX", dense["C"]),
+            arr("GS_DOP853_D", dense["D"])]  # fmt: skip
+
+
 def c_tables() -> str:
     """The tableaux of the compiled integrators as C arrays (no transcription by hand)."""
 
@@ -127,5 +144,6 @@ def c_tables() -> str:
             arr("GS_DOP853_C", DOP853.c),
             arr("GS_DOP853_E3", DOP853.errors["E3"]),
             arr("GS_DOP853_E5", DOP853.errors["E5"]),
+            *dop853_dense_tables(arr),
         ]
     )

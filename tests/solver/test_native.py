@@ -79,6 +79,32 @@ def test_lockstep_batch_agrees_with_point_by_point():
     np.testing.assert_allclose(many.x, one.x, atol=1e-7)
 
 
+def test_lockstep_dense_output_equals_scipy_dop853_dense_output():
+    # Reference: SciPy's DOP853 with dense_output=True (an independent implementation of
+    # the same method, step control and interpolant).  Two identical points make the
+    # lockstep group take exactly one point's steps, unshortened up to the window's end,
+    # so the interpolated samples agree to rounding; the step-shortening path (dense=False)
+    # lands on each sample and agrees only to the tolerance.
+    from scipy.integrate import solve_ivp
+
+    system = System.load("reference_light", **{"lambda": 0.3})
+    x0 = default_initial_state(system)
+    P = np.array([system.p, system.p])
+    X0 = np.array([x0, x0])
+    kw = dict(method="dop853", rtol=1e-8, atol=1e-10, transient=5, periods=3)
+    dense = native.run_batch(system.module, P, X0, samples_per_period=16, **kw)
+    ref = solve_ivp(system.rhs, (0.0, dense.t[-1]), x0, method="DOP853", rtol=1e-8,
+                    atol=1e-10, dense_output=True)  # fmt: skip
+    assert dense.status == ("ok", "ok")
+    assert dense.nsteps[0] == ref.t.size - 1  # the same steps
+    np.testing.assert_allclose(dense.x[0], ref.sol(dense.t).T, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(dense.x[0], dense.x[1])
+    assert dense.t.size == 3 * 16 + 1
+    clipped = native.run_batch(system.module, P, X0, samples_per_period=16, dense=False, **kw)
+    assert clipped.nsteps[0] > dense.nsteps[0]
+    np.testing.assert_allclose(dense.x, clipped.x, rtol=0, atol=1e-7)
+
+
 def test_a_diverging_point_does_not_spoil_its_group():
     module = System.load("reference_light").module
     good = module.parameters(**{"lambda": 0.8})

@@ -332,12 +332,66 @@ static void gs_extremes(const double *Y, int n, int g0, const int *alive, const 
     }
 }
 
+/* DOP853's dense output over the accepted step [t, t + hh] of a group (SciPy's
+ * Dop853DenseOutput): the three extra stages into K rows 13..15, the seven interpolant
+ * coefficients into F (7 x S), then y(t + x hh) = Y + a Horner-like sum in x and 1 - x. */
+#define GS_KROWS 16
+static void gs_dense_coefficients(double t, double hh, int n, const double *Y, const double *YN,
+                                  double *K, double *YT, const double *Pg, const double *Qg,
+                                  double *F)
+{
+    const long S = (long)GS_NX * n;
+    for (int x = 0; x < 3; ++x) {
+        const int row = 13 + x;
+        for (long e = 0; e < S; ++e) {
+            double acc = 0.0;
+            for (int r = 0; r < row; ++r) acc += GS_DOP853_AX[x * GS_KROWS + r] * K[r * S + e];
+            YT[e] = Y[e] + hh * acc;
+        }
+        gs_rhs_batch(t + GS_DOP853_CX[x] * hh, n, YT, Pg, Qg, K + row * S);
+    }
+    for (long e = 0; e < S; ++e) {
+        const double dy = YN[e] - Y[e], f0 = K[e], f1 = K[12 * S + e];
+        F[e] = dy;
+        F[S + e] = hh * f0 - dy;
+        F[2 * S + e] = 2.0 * dy - hh * (f1 + f0);
+        for (int i = 0; i < 4; ++i) {
+            double acc = 0.0;
+            for (int r = 0; r < GS_KROWS; ++r) acc += GS_DOP853_D[i * GS_KROWS + r] * K[r * S + e];
+            F[(3 + i) * S + e] = hh * acc;
+        }
+    }
+}
+
+static double gs_dense_value(const double *F, long S, long e, double x, double y0)
+{
+    double y = 0.0;
+    for (int i = 0; i < 7; ++i) {
+        y += F[(6 - i) * S + e];
+        y *= (i % 2 == 0) ? x : 1.0 - x;
+    }
+    return y + y0;
+}
+
+/* Write sample k of the group's points (alive: from V, structure of arrays; else NaN). */
+static void gs_write_sample(double *OUT, int n_out, int g0, int n, int k, const double *V,
+                            const int *alive, int ok)
+{
+    for (int j = 0; j < n; ++j) {
+        double *out = OUT + ((long)(g0 + j) * n_out + k) * GS_NX;
+        for (int i = 0; i < GS_NX; ++i) out[i] = ok && alive[j] ? V[(long)i * n + j] : NAN;
+    }
+}
+
 static int gs_lockstep(int method, int npts, int group, const double *P, const double *X0,
-                       double t0, double period, int first, int n_stops, int spp, double rtol,
-                       double atol, double bound, long long max_steps, double *OUT,
+                       double t0, double period, int first, int n_stops, int spp, int dense,
+                       double rtol, double atol, double bound, long long max_steps, double *OUT,
                        long long *NFEV, long long *NSTEP, int *STATUS, double *TFAIL,
                        const gs_extras *m)
 {
+    /* dense: plain sampled DOP853 runs take their natural steps and interpolate the
+     * samples (the 7th-order dense output) instead of shortening steps to land on them */
+    const int use_dense = dense && !m && OUT && method != 0;
     const gs_tableau *T = method == 0 ? &GS_RK45 : &GS_DOP853;
     const int ns = T->ns;
     const double exponent = -1.0 / (T->error_order + 1);
@@ -348,11 +402,14 @@ static int gs_lockstep(int method, int npts, int group, const double *P, const d
     double *Pg = malloc(sizeof(double) * GS_NP * G), *Qg = malloc(sizeof(double) * GS_NQ * G);
     double *Y = malloc(sizeof(double) * GS_NX * G), *YT = malloc(sizeof(double) * GS_NX * G);
     double *YN = malloc(sizeof(double) * GS_NX * G);
-    double *K = malloc(sizeof(double) * (GS_MAXS + 1) * GS_NX * G);
+    double *K = malloc(sizeof(double) * GS_KROWS * GS_NX * G);
+    double *F = use_dense ? malloc(sizeof(double) * 7 * GS_NX * G) : 0;
     int *alive = malloc(sizeof(int) * G);
     double *E5s = malloc(sizeof(double) * G), *E3s = malloc(sizeof(double) * G);
     double *growth = malloc(sizeof(double) * G);
-    if (!Pg || !Qg || !Y || !YT || !YN || !K || !alive || !E5s || !E3s || !growth) return -1;
+    if (!Pg || !Qg || !Y || !YT || !YN || !K || !alive || !E5s || !E3s || !growth ||
+        (use_dense && !F))
+        return -1;
     for (int g0 = 0; g0 < npts; g0 += G) {
         const int n = npts - g0 < G ? npts - g0 : G;
         long long nfev = 0, nsteps = 0;
@@ -394,13 +451,22 @@ static int gs_lockstep(int method, int npts, int group, const double *P, const d
         nfev = nfev / (n > 0 ? n : 1) + 1;
         gs_rhs_batch(t0, n, Y, Pg, Qg, K); /* K[0] = f(t0, y0) */
         int group_status = GS_OK;
-        for (int ko = 0; ko < n_stops; ++ko) {
-            const double target = t0 + (double)(first + ko) * period / (double)spp;
+        int next_out = 0; /* dense: the next sample to write */
+        const double t_last = t0 + (double)(first + n_stops - 1) * period / (double)spp;
+        if (use_dense) {
+            while (next_out < n_stops &&
+                   t0 + (double)(first + next_out) * period / (double)spp <= t)
+                gs_write_sample(OUT, n_stops, g0, n, next_out++, Y, alive, 1);
+        }
+        for (int ko = 0; ko < (use_dense ? 1 : n_stops); ++ko) {
+            const double target =
+                use_dense ? t_last : t0 + (double)(first + ko) * period / (double)spp;
             const int in_window = m && ko > m->first_kept;
             while (t < target && group_status == GS_OK) {
                 const double min_step = 10.0 * fabs(nextafter(t, INFINITY) - t);
                 double h = h_abs < min_step ? min_step : h_abs;
                 int rejected = 0;
+                const int step_first = next_out; /* dense: samples written by this step */
                 for (;;) {
                     if (h < min_step) {
                         group_status = GS_STEP_TOO_SMALL;
@@ -480,6 +546,33 @@ static int gs_lockstep(int method, int npts, int group, const double *P, const d
                         if (rejected && factor > 1.0) factor = 1.0;
                         const double next = hh * factor;
                         h_abs = clipped && !rejected && h > next ? h : next;
+                        if (use_dense) {
+                            int have_f = 0;
+                            for (;;) {
+                                if (next_out >= n_stops) break;
+                                const double ts =
+                                    t0 + (double)(first + next_out) * period / (double)spp;
+                                if (ts > t_new) break;
+                                if (ts == t_new) {
+                                    gs_write_sample(OUT, n_stops, g0, n, next_out++, YN, alive, 1);
+                                    continue;
+                                }
+                                if (!have_f) {
+                                    gs_dense_coefficients(t, hh, n, Y, YN, K, YT, Pg, Qg, F);
+                                    nfev += 3;
+                                    have_f = 1;
+                                }
+                                const double x = (ts - t) / hh;
+                                for (int j = 0; j < n; ++j) {
+                                    double *out = OUT + ((long)(g0 + j) * n_stops + next_out) * GS_NX;
+                                    for (int i = 0; i < GS_NX; ++i) {
+                                        const long e = (long)i * n + j;
+                                        out[i] = alive[j] ? gs_dense_value(F, S, e, x, Y[e]) : NAN;
+                                    }
+                                }
+                                next_out++;
+                            }
+                        }
                         t = t_new;
                         memcpy(Y, YN, sizeof(double) * S);
                         memcpy(K, K + ns * S, sizeof(double) * S); /* FSAL */
@@ -502,12 +595,22 @@ static int gs_lockstep(int method, int npts, int group, const double *P, const d
                         TFAIL[g0 + j] = t;
                         for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = 0.0;
                         dead = 1;
+                        /* as without dense output: no samples from the failing step */
+                        for (int k = step_first; use_dense && k < next_out; ++k)
+                            for (int i = 0; i < GS_NX; ++i)
+                                OUT[((long)(g0 + j) * n_stops + k) * GS_NX + i] = NAN;
                     }
                 }
                 if (dead) gs_rhs_batch(t, n, Y, Pg, Qg, K); /* refresh FSAL stage */
                 if (in_window) gs_extremes(Y, n, g0, alive, m);
             }
             const int group_ok = group_status == GS_OK;
+            if (use_dense) {
+                /* a failed group leaves the samples it did not reach undefined */
+                while (next_out < n_stops)
+                    gs_write_sample(OUT, n_stops, g0, n, next_out++, Y, alive, 0);
+                continue;
+            }
             if (OUT) {
                 const int n_out = n_stops;
                 for (int j = 0; j < n; ++j) {
@@ -564,19 +667,19 @@ static int gs_lockstep(int method, int npts, int group, const double *P, const d
         }
     }
     free(Pg); free(Qg); free(Y); free(YT); free(YN); free(K); free(alive); free(E5s); free(E3s);
-    free(growth);
+    free(growth); free(F);
     return 0;
 }
 
 /* Sampled runs: OUT npts x (n_sample spp + 1) x GS_NX at t0 + (n_transient + k / spp) T. */
 int gs_run_lockstep(int method, int npts, int group, const double *P, const double *X0,
-                    double t0, double period, int n_transient, int n_sample, int spp,
+                    double t0, double period, int n_transient, int n_sample, int spp, int dense,
                     double rtol, double atol, double bound, long long max_steps, double *OUT,
                     long long *NFEV, long long *NSTEP, int *STATUS, double *TFAIL)
 {
     return gs_lockstep(method, npts, group, P, X0, t0, period, n_transient * spp,
-                       n_sample * spp + 1, spp, rtol, atol, bound, max_steps, OUT, NFEV, NSTEP,
-                       STATUS, TFAIL, 0);
+                       n_sample * spp + 1, spp, dense, rtol, atol, bound, max_steps, OUT, NFEV,
+                       NSTEP, STATUS, TFAIL, 0);
 }
 
 /* Maps: stops at every period t0 + k T, k = 0 .. n_transient + n_sample.  Keeps the
@@ -595,7 +698,7 @@ int gs_map_lockstep(int method, int npts, int group, const double *P, const doub
     if (tangent && (n_lyap < 1 || n_lyap > n_stops - 1)) return -2;
     gs_extras m = {tangent ? GS_NX / 2 : GS_NX, tangent, n_transient,
                    tangent ? n_stops - 1 - n_lyap : 0, RANGE, POINC, XMIN, XMAX, LYAP};
-    return gs_lockstep(method, npts, group, P, X0, t0, period, 0, n_stops, 1, rtol, atol,
+    return gs_lockstep(method, npts, group, P, X0, t0, period, 0, n_stops, 1, 0, rtol, atol,
                        bound, max_steps, 0, NFEV, NSTEP, STATUS, TFAIL, &m);
 }
 

@@ -65,6 +65,7 @@ def run_batch(
     group: int = 64,
     workers: int = 1,
     fallback: bool = True,
+    dense: bool = True,
 ) -> BatchResult:
     """Integrate every column set ``P[i]`` (parameters) from ``X0[i]`` of ``module``.
 
@@ -77,6 +78,11 @@ def run_batch(
     ``lockstep``: groups of ``group`` points share time and step size (the excitation is
     computed once per stage for the group and the arithmetic vectorises); otherwise each
     point takes its own steps.  RK4 always runs point by point.
+
+    ``dense``: lockstep DOP853 takes its natural steps and interpolates the samples with
+    its seventh-order dense output (three more stages in a step that holds a sample)
+    instead of shortening steps to land on them; False shortens the steps (as RK45 and
+    the per-point engine always do).
     """
     if method not in NATIVE_METHODS:
         raise ValueError(f"unknown native method '{method}'; methods: {', '.join(NATIVE_METHODS)}")
@@ -126,6 +132,7 @@ def run_batch(
         lockstep=lockstep,
         group=group,
         fallback=fallback,
+        dense=dense,
     )
     if workers > 1 and P.shape[0] > 1:
         return _parallel(module, P, X0, workers, started, opts)
@@ -156,6 +163,7 @@ def run_batch(
             int(transient),
             int(periods),
             spp,
+            int(dense),
             float(rtol),
             float(atol),
             float(bound),

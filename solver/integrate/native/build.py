@@ -185,7 +185,7 @@ def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
     lib.gs_run_lockstep.argtypes = [
         i, i, i,
         ptr(np.float64, flags="C"), ptr(np.float64, flags="C"),
-        d, d, i, i, i, d, d, d, ll,
+        d, d, i, i, i, i, d, d, d, ll,
         ptr(np.float64, flags="C"), ptr(np.int64, flags="C"), ptr(np.int64, flags="C"),
         ptr(np.int32, flags="C"), ptr(np.float64, flags="C"),
     ]  # fmt: skip
