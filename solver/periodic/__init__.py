@@ -7,12 +7,21 @@
 * ``floquet.py`` -- multipliers, stability, Liouville's check, bifurcation test functions;
 * ``continuation.py`` -- pseudo-arclength continuation with folds, period doublings and
   Neimark-Sacker points located;
-* ``switching.py`` -- branch switching at a period doubling.
+* ``switching.py`` -- branch switching at a period doubling;
+* ``harmonic_balance.py`` -- harmonic balance by alternating frequency-time with the
+  generated Jacobian, and Hill's stability.
 """
 
 from .continuation import Bifurcation, Branch, continue_orbit
 from .floquet import Floquet, bifurcation_tests, floquet
 from .flow import MONODROMY_METHODS, FlowMap, StroboscopicMap, monodromy_agreement
+from .harmonic_balance import (
+    HarmonicBalance,
+    HarmonicBalanceError,
+    HBSolution,
+    harmonic_balance,
+    hill,
+)
 from .newton import NewtonError, NewtonResult, newton
 from .shooting import Orbit, OrbitSearch, ShootingError, residual, search, shoot
 from .switching import switch_period_doubling
@@ -23,6 +32,9 @@ __all__ = [
     "Branch",
     "Floquet",
     "FlowMap",
+    "HBSolution",
+    "HarmonicBalance",
+    "HarmonicBalanceError",
     "NewtonError",
     "NewtonResult",
     "Orbit",
@@ -32,6 +44,8 @@ __all__ = [
     "bifurcation_tests",
     "continue_orbit",
     "floquet",
+    "harmonic_balance",
+    "hill",
     "monodromy_agreement",
     "newton",
     "residual",

@@ -1,0 +1,153 @@
+"""Harmonic balance (AFT) and Hill's stability against closed forms and shooting."""
+
+import numpy as np
+import pytest
+from gearsym.solver.periodic import shoot
+from gearsym.solver.periodic.harmonic_balance import (
+    HarmonicBalance,
+    HarmonicBalanceError,
+    harmonic_balance,
+)
+from gearsym.solver.system import System
+from scipy.linalg import expm
+
+from .conftest import HERE
+from .test_simulate import closed_form_steady_state
+
+DUFFING = HERE / "duffing_model.py"
+
+
+def test_linear_limit_equals_the_closed_form_steady_state(linear_system):
+    # Reference: the complex-amplitude steady state of the forced damped linear system
+    # (tests/solver/test_simulate.py); harmonic balance is exact on it with H >= 1, and
+    # Hill's multipliers are exp(eig(A) T) (constant coefficients).
+    sol = harmonic_balance(linear_system, harmonics=3)
+    tau = np.linspace(0.0, linear_system.period, 37)
+    np.testing.assert_allclose(
+        sol.at(tau), closed_form_steady_state(linear_system, tau), rtol=0, atol=1e-8
+    )
+    A = linear_system.jacobian(0.0, np.zeros(linear_system.n))
+    expected = np.sort_complex(np.linalg.eigvals(expm(A * linear_system.period)))
+    np.testing.assert_allclose(np.sort_complex(sol.floquet.multipliers), expected, atol=1e-8)
+    assert sol.floquet.stable and sol.tail_share() < 1e-10
+
+
+@pytest.mark.parametrize(("omega", "B"), [(0.8, 0.2), (1.5, 0.3), (2.0, 0.01)])
+def test_one_harmonic_duffing_against_its_closed_form(omega, B):
+    # Reference: the one-term harmonic balance of x'' + a x + c x^3 = B cos(w t) (undamped),
+    # x = A cos(w t) with (a - w^2) A + 3/4 c A^3 = B (Nayfeh and Mook 1979, "Nonlinear
+    # Oscillations", 4.1); at B -> 0 it is the backbone w^2 = a + 3/4 c A^2.
+    a, c = 1.0, 0.5
+    system = System.load(DUFFING, a=a, c=c, k=0.0, B=B, omega=omega)
+    sol = harmonic_balance(
+        system, np.array([[0.0, B / (a - omega**2), 0.0], [0.0] * 3]), harmonics=1, stability=False
+    )
+    A = sol.coefficients[0, 1]
+    roots = np.roots([0.75 * c, 0.0, a - omega**2, -B])
+    exact = roots[np.argmin(np.abs(roots - A))]
+    assert abs(exact.imag) < 1e-12 and abs(A - exact.real) < 1e-10 * max(1.0, abs(A))
+    assert abs(sol.coefficients[0, 2]) < 1e-12  # no sine part without damping
+
+
+def test_backbone_is_a_solution_of_the_unforced_one_harmonic_balance():
+    a, c, A = 1.0, 0.5, 1.3
+    omega = np.sqrt(a + 0.75 * c * A**2)
+    system = System.load(DUFFING, a=a, c=c, k=0.0, B=0.0, omega=omega)
+    problem = HarmonicBalance(system, 1)
+    X = np.array([[0.0, A, 0.0], [0.0, 0.0, -omega * A]])
+    R, _ = problem.residual(X, system.p)
+    assert np.max(np.abs(R)) < 1e-12
+
+
+def test_jacobian_is_the_derivative_of_the_residual():
+    # Reference: central finite differences of the residual (an independent route).
+    system = System.load(DUFFING, a=1.0, c=0.5, k=0.1, B=0.4, omega=1.3)
+    problem = HarmonicBalance(system, 4)
+    X = np.random.default_rng(2).normal(size=(2, 9)) * 0.3
+    _, Jac = problem.residual(X, system.p)
+    h = 1e-6
+    fd = np.empty_like(Jac)
+    for j in range(X.size):
+        e = np.zeros(X.size)
+        e[j] = h
+        up = problem.residual(X + e.reshape(X.shape), system.p, jacobian=False)[0]
+        dn = problem.residual(X - e.reshape(X.shape), system.p, jacobian=False)[0]
+        fd[:, j] = (up - dn).ravel() / (2 * h)
+    np.testing.assert_allclose(Jac, fd, rtol=0, atol=1e-8)
+
+
+def _hardening(omega, k=0.1, B=0.3):
+    return System.load(DUFFING, a=1.0, c=0.1, k=k, B=B, omega=omega)
+
+
+def _one_harmonic_branches(a, c, k, B, w):
+    """The damped one-term balance of x'' + k x' + a x + c x^3 = B cos(w t), x = p cos +
+    q sin: [(a - w^2 + 3/4 c A^2)^2 + (k w)^2] A^2 = B^2, a cubic in A^2 (Nayfeh and Mook
+    1979, 4.1.4); each real root gives (p, q) by a 2 x 2 solve.  Lowest amplitude first."""
+    e, g = a - w**2, 0.75 * c
+    roots = np.roots([g**2, 2 * e * g, e**2 + (k * w) ** 2, -(B**2)])
+    out = []
+    for A2 in np.sort(roots[np.abs(roots.imag) < 1e-12].real):
+        al = e + g * A2
+        p, q = np.linalg.solve([[al, k * w], [-k * w, al]], [B, 0.0])
+        out.append(np.array([[0.0, p, q], [0.0, w * q, -w * p]]))
+    return out
+
+
+@pytest.mark.parametrize(("branch", "stable"), [(0, True), (1, False), (2, True)])
+def test_duffing_against_shooting_on_stable_and_unstable_branches(branch, stable):
+    # Reference: Newton shooting with its monodromy (solver/periodic/shooting.py), an
+    # independent method.  Inside the hysteresis band of this hardening oscillator
+    # (omega = 1.5, light damping) three period-1 solutions coexist, the middle one
+    # unstable; the damped one-harmonic balance starts harmonic balance on each.
+    system = _hardening(1.5, k=0.05, B=0.5)
+    starts = _one_harmonic_branches(1.0, 0.1, 0.05, 0.5, 1.5)
+    assert len(starts) == 3
+    sol = harmonic_balance(system, starts[branch], harmonics=15)
+    assert sol.residual < 1e-10 and sol.tail_share() < 1e-8
+    orbit = shoot(system, sol.state(0.0), 1, tol=1e-12)
+    assert np.max(np.abs(sol.state(0.0) - orbit.x0)) < 1e-6
+    got = np.sort_complex(sol.floquet.multipliers)
+    np.testing.assert_allclose(got, np.sort_complex(orbit.floquet.multipliers), atol=1e-6)
+    assert sol.floquet.stable == orbit.floquet.stable == stable
+    assert sol.floquet.liouville_error < 1e-8  # the exponents' sum is the mean trace
+
+
+def test_hill_multipliers_match_the_monodromy_along_the_response():
+    for omega in (0.6, 1.0, 1.2, 2.5):
+        system = _hardening(omega)
+        sol = harmonic_balance(system, harmonics=15)
+        orbit = shoot(system, sol.state(0.0), 1, tol=1e-12)
+        np.testing.assert_allclose(
+            np.sort_complex(sol.floquet.multipliers),
+            np.sort_complex(orbit.floquet.multipliers),
+            atol=1e-6,
+        )
+
+
+@pytest.mark.parametrize(("omega", "lam"), [(0.3, 0.8), (0.5, 0.4), (0.5, 0.8), (0.9, 0.8)])
+def test_reference_model_against_shooting_at_period_one_points(omega, lam):
+    # The reference DI-SO model (polynomial backlash, stated values) at several forcing
+    # frequencies where its motion is period-1; reference: shooting, an independent method.
+    system = System.load("reference_light", omega=omega, **{"lambda": lam})
+    sol = harmonic_balance(system, harmonics=24)
+    assert sol.tail_share() < 1e-6
+    orbit = shoot(system, sol.state(0.0), 1, tol=1e-12)
+    assert orbit.minimal_period == 1
+    assert np.max(np.abs(sol.state(0.0) - orbit.x0)) < 1e-6
+    np.testing.assert_allclose(
+        np.sort_complex(sol.floquet.multipliers),
+        np.sort_complex(orbit.floquet.multipliers),
+        atol=1e-6,
+    )
+    assert sol.floquet.stable == orbit.floquet.stable
+
+
+def test_bad_sizes_are_refused():
+    system = _hardening(1.0)
+    with pytest.raises(ValueError, match="harmonics must be >= 0"):
+        HarmonicBalance(system, -1)
+    with pytest.raises(ValueError, match="samples"):
+        HarmonicBalance(system, 10, samples=16)
+    with pytest.raises(HarmonicBalanceError, match="did not converge"):
+        harmonic_balance(system, np.full((2, 3), 1e6), harmonics=1, max_iter=2)
