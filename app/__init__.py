@@ -27,6 +27,9 @@ _EXPORTS = {
     "load": "gearsym.resolve",
     "analyse": ("gearsym.solver", "analyse_point"),
     "sweep": ("gearsym.solver.sweep", "sweep"),
+    "harmonic_balance": "gearsym.solver.periodic.harmonic_balance",
+    "continue_hb": "gearsym.solver.periodic.hb_continuation",
+    "frequency_response": "gearsym.solver.sweep.frequency",
     **{
         name: "gearsym.solver"
         for name in (
@@ -71,8 +74,11 @@ __all__ = [
     "System",
     "Trajectory",
     "analyse",
+    "continue_hb",
     "continue_orbit",
     "derive_model",
+    "frequency_response",
+    "harmonic_balance",
     "load",
     "load_target",
     "save",

@@ -4,6 +4,7 @@
 * ``point.py`` -- simulate, sweep;
 * ``orbits.py`` -- shoot, continue;
 * ``atlas.py`` -- map;
+* ``response.py`` -- frequency-response;
 * ``study.py`` -- reproduce, bench;
 * ``_common.py`` -- the one-line failure and the shared options.
 
@@ -23,7 +24,7 @@ import sys
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-from . import atlas, derive, orbits, point, study  # noqa: E402
+from . import atlas, derive, orbits, point, response, study  # noqa: E402
 from ._common import Fail  # noqa: E402
 
 __all__ = ["main"]
@@ -37,7 +38,7 @@ def _parser() -> argparse.ArgumentParser:
         "--debug", action="store_true", help="show full tracebacks instead of one-line errors"
     )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for group in (derive, point, orbits, atlas, study):
+    for group in (derive, point, orbits, atlas, response, study):
         group.register(sub)
     return parser
 

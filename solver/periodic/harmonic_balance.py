@@ -49,6 +49,7 @@ __all__ = [
     "HBSolution",
     "harmonic_balance",
     "hill",
+    "HILL_HARMONICS",
 ]
 
 
@@ -89,6 +90,13 @@ class HarmonicBalance:
             D[2 * kk - 1, 2 * kk] = kk
             D[2 * kk, 2 * kk - 1] = -kk
         self.Ds = D
+        # where w D sits in the (nx M) square Jacobian: the diagonal blocks' nonzeros
+        nz = np.flatnonzero(D)
+        rows, cols = np.divmod(nz, M)
+        n_states = system.n
+        self._dflat = np.tile(nz, n_states)
+        blocks = np.repeat(np.arange(n_states) * M, nz.size)
+        self._diag = (blocks + np.tile(rows, n_states), blocks + np.tile(cols, n_states))
 
     def omega(self, p) -> float:
         return float(p[self.system.module.PARAMETERS.index(self.system.contract.forcing_frequency)])
@@ -108,11 +116,44 @@ class HarmonicBalance:
         R = w * X @ self.Ds.T - F @ self.P.T
         if not jacobian:
             return R, None
-        J = self._jacobian(tau, x, p)
-        A = np.einsum("kj,abj,jm->akbm", self.P, J, self.E, optimize=True)
+        A = self.toeplitz(self._jacobian(tau, x, p))
         Jac = -A.reshape(nx * self.M, nx * self.M)
-        Jac += np.kron(np.eye(nx), w * self.Ds)
+        Jac[self._diag] += w * self.Ds.ravel()[self._dflat]
         return R, Jac
+
+    def toeplitz(self, J: np.ndarray, harmonics: int | None = None) -> np.ndarray:
+        """``P diag(J) E`` for every pair of states, (nx, M, nx, M), from the discrete
+        Fourier coefficients of ``J`` (exact on the AFT grid: with ``N > 4H`` the sums and
+        differences of two kept harmonics are not aliased).  With ``Jh_l`` the DFT
+        coefficient of harmonic l: cos-cos ``Re Jh_{k-m} + Re Jh_{k+m}``, cos-sin
+        ``Im Jh_{k-m} - Im Jh_{k+m}``, sin-cos ``-Im Jh_{k-m} - Im Jh_{k+m}``, sin-sin
+        ``Re Jh_{k-m} - Re Jh_{k+m}`` (rows k, columns m >= 1); row 0 and column 0 from
+        ``Jh_m`` and ``2 Jh_k``.  ``harmonics``: keep only the first (Hill's matrix of a
+        smaller size)."""
+        H = self.H if harmonics is None else harmonics
+        nx, M = J.shape[0], 2 * H + 1
+        if 2 * H >= self.N // 2:  # few samples: the sums would alias, use the products
+            keep = slice(0, M)
+            return np.einsum("kj,abj,jm->akbm", self.P[keep], J, self.E[:, keep], optimize=True)
+        Jh = np.fft.rfft(J, axis=-1) / self.N  # (nx, nx, N/2 + 1), l = 0..N/2
+        re, im = Jh.real, Jh.imag
+        k = np.arange(1, H + 1)
+        d = k[:, None] - k[None, :]
+        a = np.abs(d)
+        sg = np.sign(d)
+        sm = k[:, None] + k[None, :]
+        T = np.empty((nx, nx, M, M))
+        T[..., 0, 0] = re[..., 0]
+        T[..., 0, 1::2] = re[..., k]
+        T[..., 0, 2::2] = -im[..., k]
+        T[..., 1::2, 0] = 2 * re[..., k]
+        T[..., 2::2, 0] = -2 * im[..., k]
+        im_d = im[..., a] * sg  # Im Jh_{k-m} (odd in the index)
+        T[..., 1::2, 1::2] = re[..., a] + re[..., sm]
+        T[..., 1::2, 2::2] = im_d - im[..., sm]
+        T[..., 2::2, 1::2] = -im_d - im[..., sm]
+        T[..., 2::2, 2::2] = re[..., a] - re[..., sm]
+        return T.transpose(0, 2, 1, 3)
 
     def _jacobian(self, tau, x, p) -> np.ndarray:
         """The generated Jacobian at the AFT samples, (nx, nx, N) (a constant one too)."""
@@ -120,9 +161,21 @@ class HarmonicBalance:
         J = np.asarray(self.system.module.jacobian(tau, x, p), dtype=float)
         return np.broadcast_to(J.reshape(nx, nx, -1), (nx, nx, x.shape[1]))
 
-    def hill_matrix(self, X, p) -> np.ndarray:
-        """``A_hat - D`` (= -dR/dX): its eigenvalues are the Floquet exponents, shifted."""
-        return -self.residual(X, p)[1]
+    def hill_matrix(self, X, p, harmonics: int | None = None, J=None) -> np.ndarray:
+        """``A_hat - (omega/n) D`` (= -dR/dX with all H harmonics): its eigenvalues are the
+        Floquet exponents, shifted.  ``harmonics`` < H keeps the central part only (J of
+        the whole solution, perturbations with fewer harmonics); ``J``: the Jacobian at
+        the AFT samples when already known."""
+        Hh = self.H if harmonics is None else min(harmonics, self.H)
+        nx, Mh = self.system.n, 2 * Hh + 1
+        if J is None:
+            J = self._jacobian(self.times(p), X @ self.E.T, p)
+        A = self.toeplitz(J, Hh).reshape(nx * Mh, nx * Mh)
+        w = self.omega(p) / self.n
+        D = self.Ds[:Mh, :Mh]
+        for a in range(nx):
+            A[a * Mh : (a + 1) * Mh, a * Mh : (a + 1) * Mh] -= w * D
+        return A
 
     def time_series(self, X, phases) -> np.ndarray:
         """The states at the phases ``s`` (radians of the base period), (states, len)."""
@@ -223,13 +276,29 @@ class HBSolution:
         }
 
 
-def hill(problem: HarmonicBalance, X, p, *, error: float = 0.0) -> tuple[np.ndarray, Floquet]:
+HILL_HARMONICS = 8
+
+
+def hill(
+    problem: HarmonicBalance, X, p, *, error: float = 0.0, harmonics: int | None = None
+) -> tuple[np.ndarray, Floquet]:
     """The physical Floquet exponents of the solution ``X`` by Hill's method (eigenvector
     symmetry, see the module text) and the multipliers ``exp(sigma n T)`` judged as
     :func:`~.floquet.floquet` judges a monodromy's, with ``error`` (the truncation's
-    estimate, for example the tail share) as the multipliers' relative error."""
-    nx, H, M = problem.system.n, problem.H, problem.M
-    sigma, V = np.linalg.eig(problem.hill_matrix(X, p))
+    estimate, for example the tail share) as the multipliers' relative error.
+
+    ``harmonics``: the perturbations' harmonics of omega/n (default
+    ``min(H, HILL_HARMONICS n)``, as many harmonics of omega whatever n): the physical
+    exponents converge much faster in them than the solution does in H (on the reference
+    model's period-1 orbits 8 harmonics already agree with the monodromy to 1e-9, on its
+    period-2 orbit 16 of omega/2 to 1e-7), and the eigenproblem's cost grows with the
+    cube of its size."""
+    nx = problem.system.n
+    cap = HILL_HARMONICS * problem.n if harmonics is None else harmonics
+    H = min(problem.H, cap)
+    M = 2 * H + 1
+    J = problem._jacobian(problem.times(p), X @ problem.E.T, p)
+    sigma, V = np.linalg.eig(problem.hill_matrix(X, p, H, J))
     V = V.reshape(nx, M, -1)
     # complex harmonics -H..H of each eigenvector: c_k cos + s_k sin = ((c_k - i s_k) e^{iks}
     # + (c_k + i s_k) e^{-iks}) / 2
@@ -250,7 +319,6 @@ def hill(problem: HarmonicBalance, X, p, *, error: float = 0.0) -> tuple[np.ndar
             chosen.append(int(i))
     sig = sigma[chosen]
     # The trace integral that Liouville's check compares det M with, exact on the AFT grid.
-    J = problem._jacobian(problem.times(p), X @ problem.E.T, p)
     trace_integral = float(np.mean(np.trace(J, axis1=0, axis2=1)) * period)
     M_diag = np.diag(np.exp(sig * period))
     return sig, floquet(M_diag, trace_integral, rtol=1e-13, error=error)

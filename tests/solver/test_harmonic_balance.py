@@ -151,3 +151,38 @@ def test_bad_sizes_are_refused():
         HarmonicBalance(system, 10, samples=16)
     with pytest.raises(HarmonicBalanceError, match="did not converge"):
         harmonic_balance(system, np.full((2, 3), 1e6), harmonics=1, max_iter=2)
+
+
+def test_continuation_through_the_hysteresis_band_of_a_hardening_duffing():
+    # Pseudo-arclength continuation in omega from below resonance to above the band: the
+    # branch bends back at two folds, the segment between them is unstable, and Hill's
+    # multipliers along the whole branch (stable and unstable points) equal the
+    # eigenvalues of the monodromy integrated at the harmonic-balance state (reference:
+    # the variational equations of solver/periodic/flow.py, an independent method).
+    from gearsym.solver.periodic import StroboscopicMap
+    from gearsym.solver.periodic.hb_continuation import continue_hb
+
+    system = _hardening(0.8, k=0.05, B=0.5)
+    branch = continue_hb(system, "omega", 0.8, 2.6, harmonics=16)
+    folds = [e for e in branch.events if e["kind"] == "fold"]
+    assert len(folds) == 2 and folds[0]["omega"] > folds[1]["omega"]
+    lo, hi = folds[0]["index"], folds[1]["index"]
+    assert not branch.stable[lo:hi].any() and branch.stable[:lo].all()
+    assert branch.stable[hi:].all() and branch.values[-1] == 2.6
+    # the folds are converged in H: 12 harmonics give the same values
+    again = continue_hb(system, "omega", 0.8, 2.6, harmonics=12)
+    np.testing.assert_allclose(
+        [e["omega"] for e in again.events], [e["omega"] for e in folds], rtol=0, atol=1e-8
+    )
+    problem = HarmonicBalance(system, 16)
+    smap = StroboscopicMap(system, 1)
+    for point in branch.points[::40]:
+        p = system.parameters_with(omega=point.value)
+        x0 = problem.time_series(point.coefficients, np.array([0.0]))[:, 0]
+        _, M, _ = smap.jacobian(x0, p)
+        np.testing.assert_allclose(
+            np.sort_complex(point.multipliers), np.sort_complex(np.linalg.eigvals(M)), atol=1e-6
+        )
+    records = branch.records()
+    assert set(records[0]) == {"omega", "stable", "stability", "x"}
+    assert set(records[0]["x"]) == {"mean", "amplitude", "rms"}

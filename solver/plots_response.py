@@ -1,0 +1,81 @@
+"""The frequency-response figure: amplitude (half peak-to-peak) of every mesh coordinate
+against the parameter, stable branches solid and unstable dashed, one colour per method,
+folds (where a sweep jumps) and other stability changes marked."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+__all__ = ["frequency_response_figure"]
+
+_COLOURS = {"hb": "tab:blue", "shooting": "tab:orange", "integration": "tab:green"}
+_NAMES = {"hb": "harmonic balance", "shooting": "shooting", "integration": "integration"}
+_MARKS = {"fold": ("s", "tab:red"), "period-doubling": ("D", "tab:purple"),
+          "neimark-sacker": ("o", "tab:green")}  # fmt: skip
+
+
+def _segments(x, y, stable):
+    """Runs of equal stability, each sharing its end point with the next (no gaps)."""
+    start = 0
+    for k in range(1, len(x) + 1):
+        if k == len(x) or stable[k] != stable[start]:
+            stop = min(k + 1, len(x))
+            yield x[start:stop], y[start:stop], bool(stable[start])
+            start = k
+
+
+def frequency_response_figure(resp, path, physical: bool = False, title: str = "") -> Path:
+    """One panel per mesh coordinate.  ``physical``: mesh frequency in Hz and the
+    dynamic transmission error's amplitude in µm (only over the forcing frequency)."""
+    system = resp.system
+    coords = system.coordinates
+    scales = system.scales()
+    physical = physical and resp.parameter == system.contract.forcing_frequency
+    fx = scales["omega_n_rad_per_s"] / (2 * math.pi) if physical else 1.0
+    fig, axes = plt.subplots(len(coords), 1, figsize=(8, 3.2 * len(coords)), sharex=True,
+                             squeeze=False)  # fmt: skip
+    for ax, c in zip(axes[:, 0], coords, strict=True):
+        fy = scales["half_backlash_m"].get(c, 1.0) * 1e6 if physical else 1.0
+        for curve in resp.curves:
+            x = curve.values * fx
+            y = curve.stats[c]["amplitude"] * fy
+            colour = _COLOURS.get(curve.method, "k")
+            shown = set()
+            for xs, ys, st in _segments(x, y, curve.stable):
+                label = f"{_NAMES[curve.method]}, {'stable' if st else 'unstable'}"
+                ax.plot(xs, ys, "-" if st else "--", color=colour, lw=1.3 if st else 1.0,
+                        label=None if label in shown else label)  # fmt: skip
+                shown.add(label)
+            for e in curve.events:
+                marker, mc = _MARKS.get(e["kind"], ("x", "k"))
+                v = e[resp.parameter]
+                # the point before the event on the curve (a fold has two sides at
+                # nearly one parameter value: the nearest value would not do)
+                if "index" in e:
+                    k = min(max(int(e["index"]) - 1, 0), len(x) - 1)
+                else:
+                    k = int(np.argmin(np.abs(curve.values - v)))
+                ax.plot(v * fx, y[k], marker, color=mc, ms=6, mfc="none",
+                        label=f"{e['kind']}" + (" (a sweep jumps here)"
+                                                if e["kind"] == "fold" else ""))  # fmt: skip
+        ax.set_ylabel(f"half peak-to-peak of {c}" + (" (µm)" if physical else " (half backlashes)"))
+        ax.grid(alpha=0.3)
+        handles, labels = ax.get_legend_handles_labels()
+        unique = dict(zip(labels, handles, strict=True))
+        ax.legend(unique.values(), unique.keys(), fontsize=7, loc="best")
+    axes[-1, 0].set_xlabel("mesh frequency (Hz)" if physical else resp.parameter)
+    if title:
+        axes[0, 0].set_title(title, fontsize=10)
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path

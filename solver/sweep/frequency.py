@@ -1,0 +1,204 @@
+"""Frequency response: the periodic solutions over the forcing frequency (or any other
+parameter) by harmonic-balance continuation and by shooting continuation, as curves of
+mean, amplitude (half peak-to-peak) and RMS per coordinate with their stability.
+
+Both methods follow the solution curve by pseudo-arclength, so both find the unstable
+branches between the folds (the jumps of a backlash nonlinearity); harmonic balance
+judges stability by Hill's method, shooting by the monodromy.  Each curve keeps the
+method, its events (folds and stability changes, located) and its wall time.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..system import System
+
+__all__ = ["METHODS", "Curve", "FrequencyResponse", "frequency_response"]
+
+METHODS = ("hb", "shooting")
+
+
+@dataclass(frozen=True)
+class Curve:
+    """One method's solution curve: per point the parameter value, stability and, per
+    coordinate, mean, amplitude and RMS; the located events."""
+
+    method: str
+    parameter: str
+    values: np.ndarray
+    stable: np.ndarray
+    stats: dict  # coordinate -> {"mean", "amplitude", "rms", "max", "min"}: arrays
+    events: tuple = ()
+    wall_time: float = 0.0
+    details: dict = field(default_factory=dict)
+
+    def records(self) -> list[dict]:
+        out = []
+        for k, v in enumerate(self.values):
+            rec = {"method": self.method, self.parameter: float(v), "stable": bool(self.stable[k])}
+            for c, s in self.stats.items():
+                rec[c] = {q: float(s[q][k]) for q in ("mean", "amplitude", "rms")}
+            out.append(rec)
+        return out
+
+
+@dataclass(frozen=True)
+class FrequencyResponse:
+    system: System
+    parameter: str
+    start: float
+    stop: float
+    curves: tuple[Curve, ...]
+
+    def records(self) -> list[dict]:
+        return [r for c in self.curves for r in c.records()]
+
+    def to_dict(self) -> dict:
+        d = self.system.describe()
+        return {
+            "model": d["model"],
+            "model_hash": d["model_hash"],
+            "values": {k: float(v) for k, v in self.system.values.items()},
+            "scales": self.system.scales(),
+            "parameter": self.parameter,
+            "range": [self.start, self.stop],
+            "curves": [
+                {
+                    "method": c.method,
+                    "points": len(c.values),
+                    "wall_time_s": c.wall_time,
+                    "events": list(c.events),
+                    **c.details,
+                }
+                for c in self.curves
+            ],
+            "records": self.records(),
+        }
+
+    def to_table(self) -> tuple[list, list]:
+        coords = self.system.coordinates
+        columns = ["method", self.parameter, "stable"] + [
+            f"{c}_{q}" for c in coords for q in ("mean", "amplitude", "rms")
+        ]
+        rows = []
+        for r in self.records():
+            rows.append(
+                [r["method"], r[self.parameter], r["stable"]]
+                + [r[c][q] for c in coords for q in ("mean", "amplitude", "rms")]
+            )
+        return columns, rows
+
+    def save(self, path):
+        """Write to ``path``: ``.json``, ``.csv`` or ``.mat`` (see ``solver/export.py``)."""
+        from ..export import save
+
+        return save(self, path)
+
+
+def _hb_curve(system, parameter, start, stop, harmonics, n, ds) -> Curve:
+    from ..periodic.hb_continuation import continue_hb
+
+    span = abs(stop - start)
+    br = continue_hb(system, parameter, start, stop, harmonics=harmonics, n=n, ds=ds,
+                     ds_max=span / 10, dlam_max=ds)  # fmt: skip
+    stats = {}
+    for c in system.coordinates:
+        y = br.series(c)
+        stats[c] = {
+            "mean": br.mean(c),
+            "amplitude": (y.max(axis=1) - y.min(axis=1)) / 2,
+            "rms": br.rms(c),
+            "max": y.max(axis=1),
+            "min": y.min(axis=1),
+        }
+    tail = float(np.max(br.tail_shares())) if len(br.points) else 0.0
+    return Curve(
+        "hb",
+        parameter,
+        br.values,
+        br.stable,
+        stats,
+        br.events,
+        br.wall_time,
+        {
+            "harmonics": harmonics,
+            "samples": br.samples,
+            "largest_tail_share": tail,
+            "notes": list(br.notes),
+        },  # fmt: skip
+    )
+
+
+def _shooting_curve(system, parameter, start, stop, n, ds, guess) -> Curve:
+    from ..integrate import simulate
+    from ..periodic import continue_orbit
+
+    started = time.perf_counter()
+    br = continue_orbit(system, parameter, start, stop, guess, n=n, ds=ds, ds_max=2 * ds,
+                        max_points=20_000)  # fmt: skip
+    stats = {c: {q: [] for q in ("mean", "amplitude", "rms", "max", "min")} for c in
+             system.coordinates}  # fmt: skip
+    for v, x0 in zip(br.values, br.states, strict=True):
+        s = system.with_values(**{parameter: v})
+        tr = simulate(s, np.asarray(x0), transient=0, periods=n, samples_per_period=256)
+        for c in system.coordinates:
+            y = tr.coordinate(c)[:-1]
+            stats[c]["mean"].append(float(np.mean(y)))
+            stats[c]["amplitude"].append(float((y.max() - y.min()) / 2))
+            stats[c]["rms"].append(float(np.sqrt(np.mean(y**2))))
+            stats[c]["max"].append(float(y.max()))
+            stats[c]["min"].append(float(y.min()))
+    stats = {c: {q: np.array(v) for q, v in d.items()} for c, d in stats.items()}
+    events = tuple({"kind": b.kind, parameter: float(b.value)} for b in br.bifurcations)
+    return Curve(
+        "shooting",
+        parameter,
+        np.asarray(br.values, float),
+        np.asarray(br.stable, bool),
+        stats,
+        events,
+        time.perf_counter() - started,
+        {"message": br.message},
+    )
+
+
+def frequency_response(
+    system: System,
+    parameter: str = "omega",
+    start: float = 0.3,
+    stop: float = 1.0,
+    *,
+    points: int = 200,
+    methods=("hb",),
+    harmonics: int = 15,
+    n: int = 1,
+) -> FrequencyResponse:
+    """The periodic response over ``parameter`` from ``start`` to ``stop`` by each of
+    ``methods`` (``hb``, ``shooting``); ``points`` sets the resolution: the parameter
+    moves by at most the range over ``points`` per step (harmonic balance: about
+    ``points`` points where the curve runs straight, more where it turns; shooting: the
+    arclength step starts there and adapts up to twice that)."""
+    unknown = [m for m in methods if m not in METHODS]
+    if unknown:
+        raise ValueError(f"unknown method(s) {unknown}; methods: {', '.join(METHODS)}")
+    if points < 2:
+        raise ValueError(f"points must be >= 2, got {points}")
+    ds = abs(stop - start) / points
+    curves = []
+    guess = None
+    for m in methods:
+        if m == "hb":
+            curves.append(_hb_curve(system, parameter, start, stop, harmonics, n, ds))
+        else:
+            from ..periodic.harmonic_balance import harmonic_balance
+
+            if guess is None:
+                first = harmonic_balance(system.with_values(**{parameter: start}),
+                                         harmonics=harmonics, n=n, stability=False)  # fmt: skip
+                guess = first.state(0.0)
+            curves.append(_shooting_curve(system, parameter, start, stop, n, ds, guess))
+    return FrequencyResponse(system, parameter, float(start), float(stop), tuple(curves))

@@ -1,0 +1,73 @@
+"""`gearsym frequency-response` end to end: records, files, the two methods, errors."""
+
+import json
+
+import pytest
+from gearsym.cli import main
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_records_files_and_folds(capsys, tmp_path):
+    argv = ["frequency-response", "reference-light", "--param=omega=0.3:0.9:60"]
+    code, out, err = run(capsys, *argv, "--harmonics=12", "--json", f"--out={tmp_path}")
+    assert code == 0, err
+    records = [json.loads(line) for line in out.splitlines()]
+    assert len(records) >= 60
+    for r in records:
+        assert r["method"] == "hb" and isinstance(r["stable"], bool)
+        assert set(r) == {"method", "omega", "stable", "u", "v"}
+        assert set(r["u"]) == {"mean", "amplitude", "rms"} and r["u"]["amplitude"] >= 0
+    omegas = [r["omega"] for r in records]
+    assert min(omegas) == pytest.approx(0.3) and omegas[-1] == pytest.approx(0.9)
+    assert not all(r["stable"] for r in records)  # the branch between folds is unstable
+    names = {p.name for p in tmp_path.iterdir()}
+    assert {"frequency_response.json", "frequency_response.csv"} <= names
+    assert {"frequency_response.mat", "frequency_response.png"} <= names
+    data = json.loads((tmp_path / "frequency_response.json").read_text())
+    folds = [e for e in data["curves"][0]["events"] if e["kind"] == "fold"]
+    assert len(folds) % 2 == 0 and folds  # the branch enters and leaves each overhang
+
+
+def test_shooting_and_harmonic_balance_find_the_same_folds(capsys, tmp_path):
+    # Reference: shooting continuation (monodromy, located by bisection on det(M - I)),
+    # an independent method, over the first overhang of the light-load response.
+    argv = ["frequency-response", "reference-light", "--param=omega=0.3:0.5:40"]
+    code, out, err = run(capsys, *argv, "--method=all", "--no-figure", f"--out={tmp_path}")
+    assert code == 0, err
+    data = json.loads((tmp_path / "frequency_response.json").read_text())
+    hb, sh = data["curves"]
+    assert hb["method"] == "hb" and sh["method"] == "shooting"
+    a = sorted(e["omega"] for e in hb["events"] if e["kind"] == "fold")
+    b = sorted(e["omega"] for e in sh["events"] if e["kind"] == "fold")
+    assert len(a) == len(b) == 2
+    assert max(abs(x - y) for x, y in zip(a, b, strict=True)) < 1e-6
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--param=omega=0.3:0.9"], "expected NAME=START:STOP:NUM"),
+        (["--param=omega=0.5:0.5:10"], "must be finite and differ"),
+        (["--param=omega=0.3:0.9:1"], "NUM must be >= 2"),
+        (["--param=nope=0.3:0.9:10"], "--param nope"),
+        (["--param=omega=0.3:0.9:10", "--harmonics=0"], "--harmonics must be >= 1"),
+        (["--param=omega=0.3:0.9:10", "--period=0"], "--period must be >= 1"),
+    ],
+)
+def test_errors_are_one_line(capsys, tmp_path, args, message):
+    code, out, err = run(capsys, "frequency-response", "reference-light", *args,
+                         f"--out={tmp_path}")  # fmt: skip
+    assert code == 2 and message in err and len(err.strip().splitlines()) == 1
+
+
+def test_an_unwritable_folder_is_refused_before_computing(capsys, tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    code, out, err = run(capsys, "frequency-response", "reference-light",
+                         "--param=omega=0.3:0.9:10", f"--out={blocker / 'sub'}")  # fmt: skip
+    assert code == 2 and "--out" in err and "cannot write there" in err
