@@ -98,6 +98,35 @@ def test_reproduce_quick_has_the_sensitivity_table(tmp_path):
     assert "## Sensitivity to the values the study leaves open" in report
     assert "| light (f1 = 0.1) | q braking | `te_amplitude_um` (µm) |" in report
     assert "| heavy (f1 = 0.5) | both driving | `te_amplitude_um` (µm) |" in report
+    assert "## Frequency response around the study's operating point" in report
+    assert (tmp_path / "response_heavy.png").stat().st_size > 1000
     assert "### Physical scales" in report
     figure = tmp_path / "sensitivity" / "heavy-both-driving-te_amplitude_um-motion.png"
     assert figure.stat().st_size > 1000
+
+
+def test_response_section_counts_the_solutions_at_the_operating_frequency():
+    from types import SimpleNamespace
+
+    from gearsym.studies.response import _at, response_section
+
+    # a curve that folds back over omega = 0.5: three crossings, the middle one unstable
+    values = np.array([0.4, 0.6, 0.45, 0.7])
+    amp = np.array([0.1, 0.2, 0.3, 0.4])
+    curve = SimpleNamespace(
+        values=values,
+        stable=np.array([True, False, False, True]),
+        stats={"u": {"amplitude": amp, "mean": amp * 0}},
+        events=({"kind": "fold", "omega": 0.6}, {"kind": "fold", "omega": 0.45}),
+    )
+    sols = _at(curve, 0.5, ("u",))
+    assert len(sols) == 3
+    assert [s["stable"] for s in sols] == [False, False, False]  # each spans a change
+    assert sols[0]["amplitude"]["u"] == pytest.approx(0.15)
+    row = SimpleNamespace(
+        case="light", f1=0.1, lam=0.8, at_omega=sols, attractor=None,
+        resp=SimpleNamespace(system=SimpleNamespace(coordinates=("u",)), curves=[curve]),
+    )  # fmt: skip
+    text = response_section([row])
+    assert "| light (f1 = 0.1) | 0.8 | 0.6000, 0.4500 | 3: " in text
+    assert "not simulated" in text

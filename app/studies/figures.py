@@ -8,7 +8,13 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["backlash_figure", "floquet_figure", "stiffness_figure", "sweep_state_figure"]
+__all__ = [
+    "backlash_figure",
+    "floquet_figure",
+    "response_figure",
+    "stiffness_figure",
+    "sweep_state_figure",
+]
 
 
 def _plt():
@@ -144,5 +150,49 @@ def floquet_figure(branches, path: Path, title: str, caption: str) -> Path:
     _caption(fig, caption)
     fig.tight_layout(rect=(0, 0.04, 1, 1))
     fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def response_figure(responses: dict, path: Path, title: str, caption: str, mark: float) -> Path:
+    """Amplitude (half peak-to-peak) of each mesh coordinate over the forcing frequency,
+    one colour per load ratio, stable solid and unstable dashed, folds marked, the
+    study's operating frequency ``mark`` as a vertical line."""
+    plt = _plt()
+    first = next(iter(responses.values()))
+    coords = first.system.coordinates
+    fig, axes = plt.subplots(len(coords), 1, figsize=(8, 3.0 * len(coords) + 0.6),
+                             sharex=True, squeeze=False)  # fmt: skip
+    for ax, c in zip(axes[:, 0], coords, strict=True):
+        for k, (lam, resp) in enumerate(responses.items()):
+            curve = resp.curves[0]
+            x, y, st = curve.values, curve.stats[c]["amplitude"], curve.stable
+            colour = f"C{k}"
+            start = 0
+            for j in range(1, len(x) + 1):
+                if j == len(x) or st[j] != st[start]:
+                    stop = min(j + 1, len(x))
+                    stable = bool(st[start])
+                    ax.plot(x[start:stop], y[start:stop], "-" if stable else "--", color=colour,
+                            lw=1.3 if stable else 1.0,
+                            label=f"λ = {lam}, {'stable' if stable else 'unstable'}")  # fmt: skip
+                    start = j
+            for e in curve.events:
+                if e["kind"] == "fold":
+                    i = min(max(int(e.get("index", 1)) - 1, 0), len(x) - 1)
+                    ax.plot(e["omega"], y[i], "s", color="tab:red", mfc="none", ms=6,
+                            label="fold (a slow sweep jumps here)")  # fmt: skip
+        ax.axvline(mark, color="0.3", lw=0.8, ls=":", label=f"the study's ω̄ = {mark}")
+        ax.set_ylabel(f"half peak-to-peak of {c}\n(half backlashes)")
+        ax.grid(alpha=0.3)
+        handles, labels = ax.get_legend_handles_labels()
+        unique = dict(zip(labels, handles, strict=True))
+        ax.legend(unique.values(), unique.keys(), fontsize=7, loc="upper right")
+    axes[-1, 0].set_xlabel("ω̄ (mesh frequency over ω_n)")
+    axes[0, 0].set_title(title, fontsize=10)
+    fig.text(0.01, 0.005, caption, fontsize=7, ha="left", va="bottom", wrap=True)
+    fig.tight_layout(rect=(0, 0.06, 1, 1))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
     plt.close(fig)
     return path

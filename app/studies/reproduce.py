@@ -153,6 +153,10 @@ def reproduce(
         (out / "data" / f"continuation_{case}.json").write_text(
             dumps([b.describe() for b in branches[case]]), encoding="utf-8"
         )
+    from .response import response_section, run_response
+
+    stage("frequency response around omega = 0.5 (harmonic balance)")
+    response_rows = run_response(out, systems, CASES, points, quick=quick)
     from .report_sensitivity import sensitivity_section
     from .sensitivity import SCENES, physical_scales, run_sensitivity
 
@@ -167,7 +171,7 @@ def reproduce(
         res, lam, by_case, points, maps, map_lam, elapsed, quick, systems, branches, method
     )
     head, sep, tail = text.partition("## Figures")
-    text = head + section + "\n" + sep + tail
+    text = head + response_section(response_rows) + "\n" + section + "\n" + sep + tail
     path = out / "report.md"
     path.write_text(text, encoding="utf-8")
     return path
