@@ -127,11 +127,19 @@ def _cmd_response(args) -> int:
         for rec in resp.records():
             print(json.dumps(rec))
         return 0
+    if system.piecewise and "hb" in methods:
+        print(
+            "note: a piecewise force law (dead zone): Hill's stability is approximate here "
+            "(multipliers within about 1e-3 on orbits that cross the kinks; "
+            "docs/analysis.md); --method all adds shooting, which locates the kinks"
+        )
     for c in resp.curves:
         stable = int(c.stable.sum())
         print(f"{c.method}: {len(c.values)} points ({stable} stable) in {c.wall_time:.2f} s")
         for e in c.events:
             print(f"  {e['kind']:<16} {name} = {e[name]:.8g}")
+        for note in c.details.get("notes", []):
+            print(f"  note: {note}")
     print(f"wrote {out / 'frequency_response.json'}" + (f" and {figure}" if figure else ""))
     sys.stdout.flush()
     return 0

@@ -291,6 +291,9 @@ def continue_hb(
         if not lo - 1e-12 <= lam <= hi + 1e-12:
             # the last point exactly at the end (natural parameter: lambda fixed)
             end = stop if abs(lam - stop) <= abs(lam - start) else start
+            if end == start:
+                notes.append(f"the branch turned back and left the range at {parameter} = "
+                             f"{start:g}; continue from there to follow it further")  # fmt: skip
             sol = _at(curve, z, end, tol)
             if sol is not None:
                 _, G = curve(sol)

@@ -181,7 +181,9 @@ def frequency_response(
     ``methods`` (``hb``, ``shooting``); ``points`` sets the resolution: the parameter
     moves by at most the range over ``points`` per step (harmonic balance: about
     ``points`` points where the curve runs straight, more where it turns; shooting: the
-    arclength step starts there and adapts up to twice that)."""
+    arclength step starts there and adapts up to twice that).  When the harmonic-balance
+    branch turns back and leaves the range at ``start``, a second one is continued from
+    ``stop`` (two curves of method ``hb``)."""
     unknown = [m for m in methods if m not in METHODS]
     if unknown:
         raise ValueError(f"unknown method(s) {unknown}; methods: {', '.join(METHODS)}")
@@ -192,7 +194,12 @@ def frequency_response(
     guess = None
     for m in methods:
         if m == "hb":
-            curves.append(_hb_curve(system, parameter, start, stop, harmonics, n, ds))
+            curve = _hb_curve(system, parameter, start, stop, harmonics, n, ds)
+            curves.append(curve)
+            if abs(curve.values[-1] - stop) > 1e-9 * max(1.0, abs(stop)):
+                # the branch turned back out of the range: the rest of the range from the
+                # other end (the solution a simulation settles on there)
+                curves.append(_hb_curve(system, parameter, stop, start, harmonics, n, ds))
         else:
             from ..periodic.harmonic_balance import harmonic_balance
 
