@@ -9,7 +9,8 @@
   Neimark-Sacker points located;
 * ``switching.py`` -- branch switching at a period doubling;
 * ``harmonic_balance.py`` -- harmonic balance by alternating frequency-time with the
-  generated Jacobian, and Hill's stability.
+  generated Jacobian; ``hill.py`` -- Hill's stability; ``hb_continuation.py`` -- its
+  pseudo-arclength continuation.
 """
 
 from .continuation import Bifurcation, Branch, continue_orbit

@@ -40,7 +40,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..system import System
-from .floquet import Floquet, floquet
+from .floquet import Floquet
+from .hill import HILL_HARMONICS, hill
 from .newton import NewtonError, newton
 
 __all__ = [
@@ -274,54 +275,6 @@ class HBSolution:
             "stable": None if self.floquet is None else self.floquet.stable,
             "floquet": None if self.floquet is None else self.floquet.describe(),
         }
-
-
-HILL_HARMONICS = 8
-
-
-def hill(
-    problem: HarmonicBalance, X, p, *, error: float = 0.0, harmonics: int | None = None
-) -> tuple[np.ndarray, Floquet]:
-    """The physical Floquet exponents of the solution ``X`` by Hill's method (eigenvector
-    symmetry, see the module text) and the multipliers ``exp(sigma n T)`` judged as
-    :func:`~.floquet.floquet` judges a monodromy's, with ``error`` (the truncation's
-    estimate, for example the tail share) as the multipliers' relative error.
-
-    ``harmonics``: the perturbations' harmonics of omega/n (default
-    ``min(H, HILL_HARMONICS n)``, as many harmonics of omega whatever n): the physical
-    exponents converge much faster in them than the solution does in H (on the reference
-    model's period-1 orbits 8 harmonics already agree with the monodromy to 1e-9, on its
-    period-2 orbit 16 of omega/2 to 1e-7), and the eigenproblem's cost grows with the
-    cube of its size."""
-    nx = problem.system.n
-    cap = HILL_HARMONICS * problem.n if harmonics is None else harmonics
-    H = min(problem.H, cap)
-    M = 2 * H + 1
-    J = problem._jacobian(problem.times(p), X @ problem.E.T, p)
-    sigma, V = np.linalg.eig(problem.hill_matrix(X, p, H, J))
-    V = V.reshape(nx, M, -1)
-    # complex harmonics -H..H of each eigenvector: c_k cos + s_k sin = ((c_k - i s_k) e^{iks}
-    # + (c_k + i s_k) e^{-iks}) / 2
-    pos = (V[:, 1::2, :] - 1j * V[:, 2::2, :]) / 2
-    neg = (V[:, 1::2, :] + 1j * V[:, 2::2, :]) / 2
-    W = np.concatenate([np.abs(neg[:, ::-1, :]) ** 2, np.abs(V[:, :1, :]) ** 2,
-                        np.abs(pos) ** 2], axis=1).sum(axis=0)  # fmt: skip
-    k = np.arange(-H, H + 1)
-    centre = np.abs((k[:, None] * W).sum(axis=0) / W.sum(axis=0))
-    period = 2 * np.pi * problem.n / problem.omega(p)
-    mu_all = np.exp(sigma * period)
-    chosen: list[int] = []
-    for i in np.argsort(centre, kind="stable"):
-        if len(chosen) == nx:
-            break
-        close = [abs(mu_all[i] - mu_all[j]) <= 1e-6 * max(1.0, abs(mu_all[j])) for j in chosen]
-        if not any(close):
-            chosen.append(int(i))
-    sig = sigma[chosen]
-    # The trace integral that Liouville's check compares det M with, exact on the AFT grid.
-    trace_integral = float(np.mean(np.trace(J, axis1=0, axis2=1)) * period)
-    M_diag = np.diag(np.exp(sig * period))
-    return sig, floquet(M_diag, trace_integral, rtol=1e-13, error=error)
 
 
 def _initial_coefficients(problem: HarmonicBalance, guess, p) -> np.ndarray:
