@@ -1,6 +1,7 @@
 """The frequency-response figure: amplitude (half peak-to-peak) of every mesh coordinate
 against the parameter, stable branches solid and unstable dashed, one colour per method,
-folds (where a sweep jumps) and other stability changes marked."""
+folds (where a sweep jumps) and other stability changes marked, the up and down sweeps of
+time integration as triangles."""
 
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ import numpy as np  # noqa: E402
 
 __all__ = ["frequency_response_figure"]
 
-_COLOURS = {"hb": "tab:blue", "shooting": "tab:orange", "integration": "tab:green"}
+_COLOURS = {"hb": "tab:blue", "shooting": "tab:orange"}
 _NAMES = {"hb": "harmonic balance", "shooting": "shooting", "integration": "integration"}
 _MARKS = {"fold": ("s", "tab:red"), "period-doubling": ("D", "tab:purple"),
           "neimark-sacker": ("o", "tab:green")}  # fmt: skip
@@ -47,6 +48,12 @@ def frequency_response_figure(resp, path, physical: bool = False, title: str = "
             x = curve.values * fx
             y = curve.stats[c]["amplitude"] * fy
             colour = _COLOURS.get(curve.method, "k")
+            if curve.method == "integration":
+                up = curve.details.get("direction") == "up"
+                ax.plot(x, y, "^" if up else "v", color="tab:green" if up else "tab:olive",
+                        ms=3, mfc="none", lw=0,
+                        label=f"integration, {'up' if up else 'down'} sweep")  # fmt: skip
+                continue
             shown = set()
             for xs, ys, st in _segments(x, y, curve.stable):
                 label = f"{_NAMES[curve.method]}, {'stable' if st else 'unstable'}"

@@ -57,6 +57,8 @@ def test_shooting_and_harmonic_balance_find_the_same_folds(capsys, tmp_path):
         (["--param=nope=0.3:0.9:10"], "--param nope"),
         (["--param=omega=0.3:0.9:10", "--harmonics=0"], "--harmonics must be >= 1"),
         (["--param=omega=0.3:0.9:10", "--period=0"], "--period must be >= 1"),
+        (["--param=lambda=0:1:10", "--method=integration"], "forcing frequency 'omega' only"),
+        (["--param=omega=0.3:0.9:10", "--settle=0"], "--settle and --sampled must be >= 1"),
     ],
 )
 def test_errors_are_one_line(capsys, tmp_path, args, message):

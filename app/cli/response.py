@@ -41,9 +41,24 @@ def register(sub) -> None:
     fr.add_argument("--period", type=int, default=1, metavar="N", help="period N T (default 1)")
     fr.add_argument(
         "--method",
-        choices=("hb", "shooting", "all"),
+        choices=("hb", "shooting", "integration", "all"),
         default="hb",
-        help="hb (harmonic balance, default), shooting, or all",
+        help="hb (harmonic balance, default), shooting, integration (up and down stepped "
+        "sweeps in the compiled engine, over the forcing frequency), or all",
+    )
+    fr.add_argument(
+        "--settle",
+        type=int,
+        default=50,
+        metavar="N",
+        help="integration: periods settled at each frequency before sampling (50)",
+    )
+    fr.add_argument(
+        "--sampled",
+        type=int,
+        default=16,
+        metavar="N",
+        help="integration: periods sampled at each frequency (16)",
     )
     fr.add_argument(
         "--physical",
@@ -101,11 +116,18 @@ def _cmd_response(args) -> int:
         raise Fail(
             f"--out {out}: cannot write there ({err.strerror}); choose another folder"
         ) from None
-    methods = ("hb", "shooting") if args.method == "all" else (args.method,)
+    if args.settle < 1 or args.sampled < 1:
+        raise Fail(f"--settle and --sampled must be >= 1, got {args.settle}, {args.sampled}")
+    methods = ("hb", "shooting", "integration") if args.method == "all" else (args.method,)
+    if "integration" in methods and name != system.contract.forcing_frequency:
+        raise Fail(
+            f"--method integration sweeps the forcing frequency "
+            f"'{system.contract.forcing_frequency}' only, not '{name}'; use hb or shooting"
+        )
     try:
         resp = frequency_response(
             system, name, start, stop, points=num, methods=methods,
-            harmonics=args.harmonics, n=args.period,
+            harmonics=args.harmonics, n=args.period, settle=args.settle, sampled=args.sampled,
         )  # fmt: skip
     except (HarmonicBalanceError, ShootingError) as err:
         raise Fail(f"frequency-response: {err}") from None
@@ -135,6 +157,10 @@ def _cmd_response(args) -> int:
         )
     for c in resp.curves:
         stable = int(c.stable.sum())
+        if c.method == "integration":
+            print(f"integration, {c.details['direction']} sweep: {len(c.values)} points in "
+                  f"{c.wall_time:.2f} s (both sweeps together)")  # fmt: skip
+            continue
         print(f"{c.method}: {len(c.values)} points ({stable} stable) in {c.wall_time:.2f} s")
         for e in c.events:
             print(f"  {e['kind']:<16} {name} = {e[name]:.8g}")

@@ -19,7 +19,7 @@ from ..system import System
 
 __all__ = ["METHODS", "Curve", "FrequencyResponse", "frequency_response"]
 
-METHODS = ("hb", "shooting")
+METHODS = ("hb", "shooting", "integration")
 
 
 @dataclass(frozen=True)
@@ -40,6 +40,8 @@ class Curve:
         out = []
         for k, v in enumerate(self.values):
             rec = {"method": self.method, self.parameter: float(v), "stable": bool(self.stable[k])}
+            if "direction" in self.details:
+                rec["direction"] = self.details["direction"]
             for c, s in self.stats.items():
                 rec[c] = {q: float(s[q][k]) for q in ("mean", "amplitude", "rms")}
             out.append(rec)
@@ -86,8 +88,9 @@ class FrequencyResponse:
         ]
         rows = []
         for r in self.records():
+            method = r["method"] + (f" {r['direction']}" if "direction" in r else "")
             rows.append(
-                [r["method"], r[self.parameter], r["stable"]]
+                [method, r[self.parameter], r["stable"]]
                 + [r[c][q] for c in coords for q in ("mean", "amplitude", "rms")]
             )
         return columns, rows
@@ -166,6 +169,74 @@ def _shooting_curve(system, parameter, start, stop, n, ds, guess) -> Curve:
     )
 
 
+def _integration_curves(system, parameter, start, stop, points, settle, sampled, spp):
+    """Up and down stepped-frequency sweeps by time integration, the two in one lockstep
+    group in the excitation phase (``native.phase``): at each step every lane runs
+    ``settle`` periods from the previous frequency's end state, then ``sampled`` periods
+    sampled ``spp`` times each (the first step settles ``max(settle, 300)`` periods from
+    the loaded rest state).  Every point is where the simulation settles (an attractor):
+    ``stable`` is true; the Poincare spread tells a periodic point from the rest."""
+    from ..integrate import default_initial_state
+    from ..integrate.native.phase import run_phase
+
+    if parameter != system.contract.forcing_frequency:
+        raise ValueError(
+            f"integration sweeps run over the forcing frequency "
+            f"'{system.contract.forcing_frequency}' only, not '{parameter}'"
+        )
+    started = time.perf_counter()
+    up = np.linspace(start, stop, points)
+    lanes = (up, up[::-1])
+    x = np.array([default_initial_state(system)] * 2)
+    coords = system.coordinates
+    keys = ("mean", "amplitude", "rms", "max", "min", "poincare_spread")
+    stats = [{c: {q: np.empty(points) for q in keys} for c in coords} for _ in lanes]
+    status = [[] for _ in lanes]
+    poincare = [[] for _ in lanes]
+    for k in range(points):
+        P = np.array([system.parameters_with(**{parameter: float(w[k])}) for w in lanes])
+        run = run_phase(system.module, P, x, transient=max(settle, 300) if k == 0 else settle,
+                        periods=sampled, samples_per_period=spp)  # fmt: skip
+        for j in range(2):
+            status[j].append(run.status[j])
+            xs = run.x[j, :-1]  # the closing sample starts the next period
+            poincare[j].append(run.x[j, ::spp].tolist())
+            for c in coords:
+                y = xs[:, system.index(c)]
+                pts = run.x[j, ::spp, system.index(c)]
+                st = stats[j][c]
+                st["mean"][k], st["max"][k], st["min"][k] = y.mean(), y.max(), y.min()
+                st["amplitude"][k] = (y.max() - y.min()) / 2
+                st["rms"][k] = np.sqrt(np.mean(y**2))
+                st["poincare_spread"][k] = np.ptp(pts) if np.all(np.isfinite(pts)) else np.nan
+        ok = np.array([s == "ok" for s in run.status])
+        x = np.where(ok[:, None], run.x[:, -1], np.array([default_initial_state(system)] * 2))
+    wall = time.perf_counter() - started
+    out = []
+    for j, (name, w) in enumerate(zip(("up", "down"), lanes, strict=True)):
+        good = np.array([s == "ok" for s in status[j]])
+        out.append(
+            Curve(
+                "integration",
+                parameter,
+                w[good],
+                np.ones(int(good.sum()), bool),
+                {c: {q: v[good] for q, v in d.items()} for c, d in stats[j].items()},
+                (),
+                wall,
+                {
+                    "direction": name,
+                    "settle_periods": settle,
+                    "sampled_periods": sampled,
+                    "samples_per_period": spp,
+                    "failed": int((~good).sum()),
+                    "poincare": [q for q, g in zip(poincare[j], good, strict=True) if g],
+                },  # fmt: skip
+            )
+        )
+    return out
+
+
 def frequency_response(
     system: System,
     parameter: str = "omega",
@@ -176,6 +247,9 @@ def frequency_response(
     methods=("hb",),
     harmonics: int = 15,
     n: int = 1,
+    settle: int = 50,
+    sampled: int = 16,
+    samples_per_period: int = 64,
 ) -> FrequencyResponse:
     """The periodic response over ``parameter`` from ``start`` to ``stop`` by each of
     ``methods`` (``hb``, ``shooting``); ``points`` sets the resolution: the parameter
@@ -183,7 +257,9 @@ def frequency_response(
     ``points`` points where the curve runs straight, more where it turns; shooting: the
     arclength step starts there and adapts up to twice that).  When the harmonic-balance
     branch turns back and leaves the range at ``start``, a second one is continued from
-    ``stop`` (two curves of method ``hb``)."""
+    ``stop`` (two curves of method ``hb``).  ``integration``: up and down stepped sweeps of
+    ``points`` frequencies, ``settle`` + ``sampled`` periods each (only over the forcing
+    frequency; see :func:`_integration_curves`)."""
     unknown = [m for m in methods if m not in METHODS]
     if unknown:
         raise ValueError(f"unknown method(s) {unknown}; methods: {', '.join(METHODS)}")
@@ -200,6 +276,9 @@ def frequency_response(
                 # the branch turned back out of the range: the rest of the range from the
                 # other end (the solution a simulation settles on there)
                 curves.append(_hb_curve(system, parameter, stop, start, harmonics, n, ds))
+        elif m == "integration":
+            curves += _integration_curves(system, parameter, start, stop, points, settle,
+                                          sampled, samples_per_period)  # fmt: skip
         else:
             from ..periodic.harmonic_balance import harmonic_balance
 

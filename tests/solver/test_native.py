@@ -105,6 +105,26 @@ def test_lockstep_dense_output_equals_scipy_dop853_dense_output():
     np.testing.assert_allclose(dense.x, clipped.x, rtol=0, atol=1e-7)
 
 
+def test_phase_runs_of_three_frequencies_in_one_group_equal_scipy_in_tau():
+    # Reference: SciPy's DOP853 in tau at a tight tolerance, one frequency at a time.  In
+    # the phase s = omega tau the three frequencies share one lockstep group; the state is
+    # the physical one, so the samples compare directly.
+    from gearsym.solver.integrate.native.phase import run_phase
+
+    system = System.load("reference_light", **{"lambda": 0.8})
+    omegas = (0.45, 0.5, 0.55)
+    P = np.array([system.parameters_with(omega=w) for w in omegas])
+    X0 = np.repeat(default_initial_state(system)[None, :], 3, axis=0)
+    run = run_phase(system.module, P, X0, transient=60, periods=4, samples_per_period=16)
+    assert run.status == ("ok",) * 3
+    assert np.allclose(run.t, 2 * np.pi * (60 + np.arange(4 * 16 + 1) / 16))
+    for j, w in enumerate(omegas):
+        ref = simulate(system.with_values(omega=w), X0[j], method="DOP853", rtol=1e-11,
+                       atol=1e-13, transient=60, periods=4, samples_per_period=16)  # fmt: skip
+        np.testing.assert_allclose(ref.t * w, run.t[: ref.t.size], rtol=1e-12)
+        np.testing.assert_allclose(run.x[j, : ref.t.size], ref.x.T, rtol=0, atol=1e-7)
+
+
 def test_a_diverging_point_does_not_spoil_its_group():
     module = System.load("reference_light").module
     good = module.parameters(**{"lambda": 0.8})

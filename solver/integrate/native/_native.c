@@ -13,6 +13,9 @@
  */
 
 #include <math.h>
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
 #include <string.h>
 
 #define GS_OK 0
@@ -332,13 +335,35 @@ static void gs_extremes(const double *Y, int n, int g0, const int *alive, const 
     }
 }
 
+/* The group's right-hand side.  iw < 0: in tau, the excitation computed once for the group
+ * (gs_rhs_batch).  iw >= 0: in the excitation phase s = omega tau, each point with its own
+ * omega = P[iw]: dX/ds = f(s / omega, X) / omega, so points of different forcing frequency
+ * share the time grid (frequency sweeps in lockstep). */
+static void gs_rhs_group(int iw, double t, int n, const double *Y, const double *Pg,
+                         const double *Qg, double *K)
+{
+    if (iw < 0) {
+        gs_rhs_batch(t, n, Y, Pg, Qg, K);
+        return;
+    }
+    for (int j = 0; j < n; ++j) {
+        double x[GS_NX], p[GS_NP], q[GS_NQ > 0 ? GS_NQ : 1], dx[GS_NX];
+        for (int i = 0; i < GS_NX; ++i) x[i] = Y[(long)i * n + j];
+        for (int k = 0; k < GS_NP; ++k) p[k] = Pg[(long)k * n + j];
+        for (int k = 0; k < GS_NQ; ++k) q[k] = Qg[(long)k * n + j];
+        const double w = p[iw];
+        gs_rhs(t / w, x, p, q, dx);
+        for (int i = 0; i < GS_NX; ++i) K[(long)i * n + j] = dx[i] / w;
+    }
+}
+
 /* DOP853's dense output over the accepted step [t, t + hh] of a group (SciPy's
  * Dop853DenseOutput): the three extra stages into K rows 13..15, the seven interpolant
  * coefficients into F (7 x S), then y(t + x hh) = Y + a Horner-like sum in x and 1 - x. */
 #define GS_KROWS 16
-static void gs_dense_coefficients(double t, double hh, int n, const double *Y, const double *YN,
-                                  double *K, double *YT, const double *Pg, const double *Qg,
-                                  double *F)
+static void gs_dense_coefficients(int iw, double t, double hh, int n, const double *Y,
+                                  const double *YN, double *K, double *YT, const double *Pg,
+                                  const double *Qg, double *F)
 {
     const long S = (long)GS_NX * n;
     for (int x = 0; x < 3; ++x) {
@@ -348,7 +373,7 @@ static void gs_dense_coefficients(double t, double hh, int n, const double *Y, c
             for (int r = 0; r < row; ++r) acc += GS_DOP853_AX[x * GS_KROWS + r] * K[r * S + e];
             YT[e] = Y[e] + hh * acc;
         }
-        gs_rhs_batch(t + GS_DOP853_CX[x] * hh, n, YT, Pg, Qg, K + row * S);
+        gs_rhs_group(iw, t + GS_DOP853_CX[x] * hh, n, YT, Pg, Qg, K + row * S);
     }
     for (long e = 0; e < S; ++e) {
         const double dy = YN[e] - Y[e], f0 = K[e], f1 = K[12 * S + e];
@@ -385,9 +410,9 @@ static void gs_write_sample(double *OUT, int n_out, int g0, int n, int k, const 
 
 static int gs_lockstep(int method, int npts, int group, const double *P, const double *X0,
                        double t0, double period, int first, int n_stops, int spp, int dense,
-                       double rtol, double atol, double bound, long long max_steps, double *OUT,
-                       long long *NFEV, long long *NSTEP, int *STATUS, double *TFAIL,
-                       const gs_extras *m)
+                       int iw, double rtol, double atol, double bound, long long max_steps,
+                       double *OUT, long long *NFEV, long long *NSTEP, int *STATUS,
+                       double *TFAIL, const gs_extras *m)
 {
     /* dense: plain sampled DOP853 runs take their natural steps and interpolate the
      * samples (the 7th-order dense output) instead of shortening steps to land on them */
@@ -443,13 +468,15 @@ static int gs_lockstep(int method, int npts, int group, const double *P, const d
                 for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = 0.0;
                 continue;
             }
-            const double h0 = gs_initial_step(t0, x0, f, t_end - t0, T->error_order, rtol, atol,
-                                              p, q, &nfev);
+            /* in the phase (iw >= 0) a small first step; the control adapts it at once */
+            const double h0 = iw >= 0 ? 1e-3 * period
+                                      : gs_initial_step(t0, x0, f, t_end - t0, T->error_order,
+                                                        rtol, atol, p, q, &nfev);
             if (h0 < h_abs) h_abs = h0;
         }
         if (!isfinite(h_abs)) h_abs = 1e-6 * period;
         nfev = nfev / (n > 0 ? n : 1) + 1;
-        gs_rhs_batch(t0, n, Y, Pg, Qg, K); /* K[0] = f(t0, y0) */
+        gs_rhs_group(iw, t0, n, Y, Pg, Qg, K); /* K[0] = f(t0, y0) */
         int group_status = GS_OK;
         int next_out = 0; /* dense: the next sample to write */
         const double t_last = t0 + (double)(first + n_stops - 1) * period / (double)spp;
@@ -486,14 +513,14 @@ static int gs_lockstep(int method, int npts, int group, const double *P, const d
                             for (int r = 0; r < s; ++r) acc += T->A[s * ns + r] * K[r * S + e];
                             YT[e] = Y[e] + hh * acc;
                         }
-                        gs_rhs_batch(t + T->C[s] * hh, n, YT, Pg, Qg, K + s * S);
+                        gs_rhs_group(iw, t + T->C[s] * hh, n, YT, Pg, Qg, K + s * S);
                     }
                     for (long e = 0; e < S; ++e) {
                         double acc = 0.0;
                         for (int r = 0; r < ns; ++r) acc += T->B[r] * K[r * S + e];
                         YN[e] = Y[e] + hh * acc;
                     }
-                    gs_rhs_batch(t + hh, n, YN, Pg, Qg, K + ns * S);
+                    gs_rhs_group(iw, t + hh, n, YN, Pg, Qg, K + ns * S);
                     nfev += ns;
                     /* per-point error norms, structure-of-arrays */
                     for (int j = 0; j < n; ++j) E5s[j] = E3s[j] = 0.0;
@@ -558,7 +585,8 @@ static int gs_lockstep(int method, int npts, int group, const double *P, const d
                                     continue;
                                 }
                                 if (!have_f) {
-                                    gs_dense_coefficients(t, hh, n, Y, YN, K, YT, Pg, Qg, F);
+                                    gs_dense_coefficients(iw, t, hh, n, Y, YN, K, YT, Pg, Qg,
+                                                          F);
                                     nfev += 3;
                                     have_f = 1;
                                 }
@@ -601,7 +629,7 @@ static int gs_lockstep(int method, int npts, int group, const double *P, const d
                                 OUT[((long)(g0 + j) * n_stops + k) * GS_NX + i] = NAN;
                     }
                 }
-                if (dead) gs_rhs_batch(t, n, Y, Pg, Qg, K); /* refresh FSAL stage */
+                if (dead) gs_rhs_group(iw, t, n, Y, Pg, Qg, K); /* refresh FSAL stage */
                 if (in_window) gs_extremes(Y, n, g0, alive, m);
             }
             const int group_ok = group_status == GS_OK;
@@ -651,7 +679,7 @@ static int gs_lockstep(int method, int npts, int group, const double *P, const d
                             growth[j] / ((double)(ko - m->lyap_from) * period / spp);
                     }
                 }
-                gs_rhs_batch(t, n, Y, Pg, Qg, K);
+                gs_rhs_group(iw, t, n, Y, Pg, Qg, K);
                 nfev += 1;
             }
         }
@@ -678,8 +706,24 @@ int gs_run_lockstep(int method, int npts, int group, const double *P, const doub
                     long long *NFEV, long long *NSTEP, int *STATUS, double *TFAIL)
 {
     return gs_lockstep(method, npts, group, P, X0, t0, period, n_transient * spp,
-                       n_sample * spp + 1, spp, dense, rtol, atol, bound, max_steps, OUT, NFEV,
-                       NSTEP, STATUS, TFAIL, 0);
+                       n_sample * spp + 1, spp, dense, -1, rtol, atol, bound, max_steps, OUT,
+                       NFEV, NSTEP, STATUS, TFAIL, 0);
+}
+
+/* Sampled runs in the excitation phase s = omega tau (period 2 pi for every point): each
+ * point its own forcing frequency P[iw], all in lockstep.  OUT as gs_run_lockstep's, at
+ * s = s0 + 2 pi (n_transient + k / spp). */
+int gs_run_phase(int method, int npts, int group, const double *P, const double *X0, double s0,
+                 int iw, int n_transient, int n_sample, int spp, int dense, double rtol,
+                 double atol, double bound, long long max_steps, double *OUT, long long *NFEV,
+                 long long *NSTEP, int *STATUS, double *TFAIL)
+{
+    if (iw < 0 || iw >= GS_NP) return -2;
+    for (int j = 0; j < npts; ++j)
+        if (!(P[(long)j * GS_NP + iw] > 0.0)) return -3;
+    return gs_lockstep(method, npts, group, P, X0, s0, 2.0 * M_PI, n_transient * spp,
+                       n_sample * spp + 1, spp, dense, iw, rtol, atol, bound, max_steps, OUT,
+                       NFEV, NSTEP, STATUS, TFAIL, 0);
 }
 
 /* Maps: stops at every period t0 + k T, k = 0 .. n_transient + n_sample.  Keeps the
@@ -698,7 +742,7 @@ int gs_map_lockstep(int method, int npts, int group, const double *P, const doub
     if (tangent && (n_lyap < 1 || n_lyap > n_stops - 1)) return -2;
     gs_extras m = {tangent ? GS_NX / 2 : GS_NX, tangent, n_transient,
                    tangent ? n_stops - 1 - n_lyap : 0, RANGE, POINC, XMIN, XMAX, LYAP};
-    return gs_lockstep(method, npts, group, P, X0, t0, period, 0, n_stops, 1, 0, rtol, atol,
+    return gs_lockstep(method, npts, group, P, X0, t0, period, 0, n_stops, 1, 0, -1, rtol, atol,
                        bound, max_steps, 0, NFEV, NSTEP, STATUS, TFAIL, &m);
 }
 

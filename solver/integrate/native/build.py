@@ -189,6 +189,14 @@ def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
         ptr(np.float64, flags="C"), ptr(np.int64, flags="C"), ptr(np.int64, flags="C"),
         ptr(np.int32, flags="C"), ptr(np.float64, flags="C"),
     ]  # fmt: skip
+    lib.gs_run_phase.restype = i
+    lib.gs_run_phase.argtypes = [
+        i, i, i,
+        ptr(np.float64, flags="C"), ptr(np.float64, flags="C"),
+        d, i, i, i, i, i, d, d, d, ll,
+        ptr(np.float64, flags="C"), ptr(np.int64, flags="C"), ptr(np.int64, flags="C"),
+        ptr(np.int32, flags="C"), ptr(np.float64, flags="C"),
+    ]  # fmt: skip
     lib.gs_map_lockstep.restype = i
     lib.gs_map_lockstep.argtypes = [
         i, i, i,
