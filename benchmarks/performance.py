@@ -796,14 +796,28 @@ def _maps_lines(res: dict) -> list[str]:
     return map_section(res["maps"])
 
 
+def _response(quick: bool, res: dict) -> dict:
+    from gearsym.benchmarks.response import response_speed
+
+    return response_speed(quick)
+
+
+def _response_lines(res: dict) -> list[str]:
+    from gearsym.benchmarks.response import response_section
+
+    return response_section(res["response"])
+
+
 SECTIONS: list[Section] = [
     Section("cli_sweep", cli_sweep, cli_sweep_lines),
     Section("maps", _maps, _maps_lines),
+    Section("response", _response, _response_lines),
 ]
 
 
 def floors_lines(res: dict) -> list[str]:
-    """The speed floors of issue 12, side by side, as far as this run measured them."""
+    """The speed floors of issues 12 and 13, side by side, as far as this run measured
+    them."""
     rows = []
     if "cli_sweep" in res:
         r = res["cli_sweep"]
@@ -820,10 +834,17 @@ def floors_lines(res: dict) -> list[str]:
             f"periods, exponent over 200, {m['workers']} processes | ≤ 60 s | "
             f"**{m['with_exponent']['median_s']:.1f} s** |"
         )
+    if "response" in res:
+        r = res["response"]
+        rows.append(
+            f"| harmonic balance over {r['points']} frequencies of the reference model (issue "
+            f"13; {r['hb']['curve_points']} points with the overhangs, Hill's stability, folds "
+            f"located), one core | ≤ 2 s | **{r['hb']['median_s']:.2f} s** |"
+        )
     if not rows:
         return []
     return [
-        "## Speed floors (issue 12), measured side by side in this run",
+        "## Speed floors (issues 12 and 13), measured side by side in this run",
         "",
         "| floor | required | measured |",
         "|---|---|---|",

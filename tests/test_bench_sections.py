@@ -30,7 +30,7 @@ def test_the_cli_sweep_section_and_the_floors_table(tmp_path):
     report = tmp_path / performance.REPORT
     performance.write_doc(res, report)
     text = report.read_text(encoding="utf-8")
-    assert "## Speed floors (issue 12), measured side by side in this run" in text
+    assert "## Speed floors (issues 12 and 13), measured side by side in this run" in text
     assert "**1000×** (1.10 s against 1.1e+03 s)" in text
     assert "## The user-facing sweep, start-up included" in text
     assert "u: period-1, period-3" in text
@@ -52,3 +52,18 @@ def test_a_section_appended_to_the_list_is_measured_and_written(monkeypatch, tmp
     assert res["extra"] == {"value": 42} and seen["baseline"] == 1.0
     performance.write_doc(res, tmp_path / performance.REPORT)
     assert "extra: 42" in (tmp_path / performance.REPORT).read_text(encoding="utf-8")
+
+
+def test_the_response_section_and_its_floor_row():
+    from gearsym.benchmarks.response import response_section
+
+    method = {"median_s": 1.5, "curve_points": 634, "folds": [0.45838, 0.37922],
+              "error": 6.8e-10, "checked": 8}  # fmt: skip
+    r = {"points": 400, "range": [0.3, 0.9], "hb": method, "shooting": dict(method),
+         "integration": {**method, "settle": 50, "sampled": 16}}  # fmt: skip
+    text = "\n".join(response_section(r))
+    assert (
+        "(floor of issue 13: 2 s), median | 1.50 | 634 | 0.45838, 0.37922 | 6.8e-10 (8) |" in text
+    )
+    rows = "\n".join(performance.floors_lines({"response": r}))
+    assert "| ≤ 2 s | **1.50 s** |" in rows

@@ -203,24 +203,39 @@ def _kind(point: HBPoint) -> str:
 
 
 def _locate(curve, z0, t0, ds, test, tol, stability) -> tuple[np.ndarray, HBPoint]:
-    """Bisection in the arclength step from (z0, t0) for a sign change of ``test``."""
-    lo, hi = 0.0, ds
-    f_lo = test(_point(curve, z0, t0, stability), t0)
-    z_best, p_best = z0, None
+    """The arclength step from (z0, t0) where ``test`` changes sign, by the Illinois
+    variant of false position (Dowell and Jarratt 1971): the test functions (the tangent's
+    parameter component, the critical multiplier's distance from the circle) are smooth
+    in the step, so a few corrections do what forty bisections did."""
+    a, b = 0.0, ds
+    f_a = test(_point(curve, z0, t0, stability), t0)
+    z_end, _, G = _correct(curve, z0 + b * t0, t0, tol)
+    if z_end is None:
+        return z0, None
+    f_b = test(_point(curve, z_end, _tangent(G, t0), stability), _tangent(G, t0))
+    z_best, p_best, side = z0, None, 0
     for _ in range(40):
-        mid = 0.5 * (lo + hi)
+        mid = b - f_b * (b - a) / (f_b - f_a) if f_b != f_a else 0.5 * (a + b)
+        if not a < mid < b:
+            mid = 0.5 * (a + b)
         z, _, G = _correct(curve, z0 + mid * t0, t0, tol)
         if z is None:
             break
         t = _tangent(G, t0)
         p = _point(curve, z, t, stability)
         f = test(p, t)
-        if np.sign(f) == np.sign(f_lo):
-            lo, f_lo = mid, f
-        else:
-            hi = mid
         z_best, p_best = z, p
-        if hi - lo < 1e-10 * max(1.0, abs(ds)):
+        if np.sign(f) == np.sign(f_a):
+            a, f_a = mid, f
+            if side == -1:
+                f_b /= 2
+            side = -1
+        else:
+            b, f_b = mid, f
+            if side == 1:
+                f_a /= 2
+            side = 1
+        if b - a < 1e-10 * max(1.0, abs(ds)) or abs(f) < 1e-12:
             break
     return z_best, p_best
 
@@ -308,7 +323,13 @@ def continue_hb(
             zf, pf = _locate(curve, z, t, h, lambda q, tt: tt[-1], tol, False)
             if pf is not None:
                 events.append({"kind": "fold", parameter: pf.value, "index": len(points)})
-        if locate and stability and prev.stable != p.stable and prev.multipliers is not None:
+        folded = (
+            bool(events) and events[-1]["kind"] == "fold" and events[-1]["index"] == len(points)
+        )
+        changed = prev.multipliers is not None and prev.stable != p.stable
+        if changed and folded and _kind(p if not p.stable else prev) == "fold":
+            changed = False  # the fold located above is this change of stability
+        if locate and stability and changed:
             zb, pb = _locate(curve, z, t, h, lambda q, tt: _crit(q), tol, stability)
             if pb is not None:
                 kind = _kind(pb)

@@ -42,7 +42,55 @@ def hill(
     H = min(problem.H, cap)
     M = 2 * H + 1
     J = problem._jacobian(problem.times(p), X @ problem.E.T, p)
-    sigma, V = np.linalg.eig(problem.hill_matrix(X, p, H, J))
+    A = problem.hill_matrix(X, p, H, J)
+    period = 2 * np.pi * problem.n / problem.omega(p)
+    # The trace integral that Liouville's check compares det M with, exact on the AFT grid.
+    trace_integral = float(np.mean(np.trace(J, axis1=0, axis2=1)) * period)
+    sig = _strip(np.linalg.eigvals(A), nx, problem.omega(p) / problem.n, period, trace_integral)
+    if sig is None:
+        sig = _symmetric(A, nx, M, H, period)
+    M_diag = np.diag(np.exp(sig * period))
+    return sig, floquet(M_diag, trace_integral, rtol=1e-13, error=error)
+
+
+def _distinct(order, sigma, nx, period) -> list[int]:
+    """The first ``nx`` of ``order`` with distinct multipliers (shifted copies of one
+    exponent share their multiplier)."""
+    mu = np.exp(sigma * period)
+    chosen: list[int] = []
+    for i in order:
+        if len(chosen) == nx:
+            break
+        if not any(abs(mu[i] - mu[j]) <= 1e-6 * max(1.0, abs(mu[j])) for j in chosen):
+            chosen.append(int(i))
+    return chosen
+
+
+def _strip(sigma, nx, w, period, trace_integral):
+    """The fast path (eigenvalues only): the copies with |Im sigma| <= w/2, accepted when
+    there are exactly ``nx`` distinct ones and their sum passes Liouville's check (a
+    spurious eigenvalue of the truncation would fail it); else None."""
+    inside = np.flatnonzero(np.abs(sigma.imag) <= 0.5 * w * (1 + 1e-9))
+    chosen = _distinct(inside[np.argsort(np.abs(sigma.imag[inside]))], sigma, nx, period)
+    rest = [
+        i
+        for i in inside
+        if i not in chosen
+        and not any(
+            abs(np.exp(sigma[i] * period) - np.exp(sigma[j] * period)) <= 1e-6 for j in chosen
+        )
+    ]
+    if len(chosen) != nx or rest:
+        return None
+    total = float(np.sum(sigma[chosen].real) * period)
+    if abs(total - trace_integral) > 1e-8 * max(1.0, abs(trace_integral)):
+        return None
+    return sigma[chosen]
+
+
+def _symmetric(A, nx, M, H, period):
+    """The symmetry criterion on the eigenvectors (von Groll and Ewins 2001)."""
+    sigma, V = np.linalg.eig(A)
     V = V.reshape(nx, M, -1)
     # complex harmonics -H..H of each eigenvector: c_k cos + s_k sin = ((c_k - i s_k) e^{iks}
     # + (c_k + i s_k) e^{-iks}) / 2
@@ -52,17 +100,4 @@ def hill(
                         np.abs(pos) ** 2], axis=1).sum(axis=0)  # fmt: skip
     k = np.arange(-H, H + 1)
     centre = np.abs((k[:, None] * W).sum(axis=0) / W.sum(axis=0))
-    period = 2 * np.pi * problem.n / problem.omega(p)
-    mu_all = np.exp(sigma * period)
-    chosen: list[int] = []
-    for i in np.argsort(centre, kind="stable"):
-        if len(chosen) == nx:
-            break
-        close = [abs(mu_all[i] - mu_all[j]) <= 1e-6 * max(1.0, abs(mu_all[j])) for j in chosen]
-        if not any(close):
-            chosen.append(int(i))
-    sig = sigma[chosen]
-    # The trace integral that Liouville's check compares det M with, exact on the AFT grid.
-    trace_integral = float(np.mean(np.trace(J, axis1=0, axis2=1)) * period)
-    M_diag = np.diag(np.exp(sig * period))
-    return sig, floquet(M_diag, trace_integral, rtol=1e-13, error=error)
+    return sigma[_distinct(np.argsort(centre, kind="stable"), sigma, nx, period)]

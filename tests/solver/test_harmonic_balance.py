@@ -227,3 +227,27 @@ def test_integration_sweeps_in_the_phase_agree_with_harmonic_balance():
     # just below that fold the down sweep is on the upper branch, the up sweep on the lower
     d = int(np.argmin(np.abs(down.values - up.values[jump])))
     assert abs(down.stats["u"]["amplitude"][d] - amp[jump]) > 0.1
+
+
+def test_both_ways_of_picking_hills_exponents_agree():
+    # The fast path (eigenvalues in the strip |Im| <= omega/2n, accepted only when their
+    # sum passes Liouville's check) against the eigenvector-symmetry criterion on the
+    # three branches of the hardening Duffing oscillator (the middle one unstable).
+    import sys
+
+    hill_module = sys.modules["gearsym.solver.periodic.hill"]
+    system = _hardening(1.5, k=0.05, B=0.5)
+    for start in _one_harmonic_branches(1.0, 0.1, 0.05, 0.5, 1.5):
+        sol = harmonic_balance(system, start, harmonics=15)
+        problem = HarmonicBalance(system, 15)
+        A = problem.hill_matrix(sol.coefficients, system.p, 8)
+        period = system.period
+        slow = hill_module._symmetric(A, 2, 17, 8, period)
+        # copies shifted by i k omega are one exponent: compare the multipliers
+        np.testing.assert_allclose(
+            np.sort_complex(np.exp(sol.exponents * period)),
+            np.sort_complex(np.exp(slow * period)),
+            atol=1e-9,
+        )
+        # a wrong trace makes the fast path decline (and the caller fall back)
+        assert hill_module._strip(np.linalg.eigvals(A), 2, 1.5, period, 1e3) is None
