@@ -237,6 +237,21 @@ def audit_page(model: Model, command: str) -> str:
     w(_math(r"\begin{aligned}", *defs, r"\end{aligned}"))
     if model.valid_range is not None:
         w(f"The backlash model is valid for $|x| \\le {_num(model.valid_range)}$ only.\n")
+    w(
+        "The dynamic force of each mesh over its $k_m b$ (`mesh_force` of the generated "
+        "module; the dynamic factor is its peak over the static force, `static_mesh_force`, "
+        "the solution of $\\bar\\kappa F = f$ at the mean stiffness):"
+    )
+    w(
+        _math(
+            r"\begin{aligned}",
+            *(
+                f"F_{{{c}}} &= " + _latex(model.mesh_forces[i], names) + r" \\"
+                for i, c in enumerate(model.coordinates)
+            ),
+            r"\end{aligned}",
+        )
+    )
 
     w("## 8. Coefficients: closed form and value\n")
     rows = []

@@ -150,6 +150,20 @@ def emit_module(model: Model, command: str) -> str:
     rhs_lines, rhs_out = _body(model, rhs, np_printer)
     jac_lines, jac_out = _body(model, jac, np_printer)
     ca_lines, ca_out = _body(model, rhs, ca_printer)
+    force_lines, force_out = _body(model, list(model.mesh_forces), np_printer)
+    m_mesh = len(model.coordinates)
+    static_lines, static_out = _body(
+        model, list(model.static_kappa) + list(model.loads), np_printer
+    )
+    static_rows = ", ".join(
+        "[" + ", ".join(static_out[i * m_mesh : (i + 1) * m_mesh]) + "]" for i in range(m_mesh)
+    )
+    static_loads = ", ".join(static_out[m_mesh * m_mesh :])
+    damping_note = (
+        "elastic k_hat(tau) g(u) plus viscous c u' (one damper per mesh)"
+        if model.nondim.damping == "mesh"
+        else "elastic k_hat(tau) g(u) only (modal damping couples the meshes)"
+    )
 
     def fmt(v: float) -> str:
         # 15 significant digits: independent of the last-bit noise of LAPACK builds.
@@ -242,6 +256,22 @@ def emit_module(model: Model, command: str) -> str:
         "    return np.array(_broadcast(",
         f"        {jac_rows},",
         "    ))",
+        "",
+        "",
+        "def mesh_force(tau, x, p):",
+        f'    """Dynamic force of each mesh over its k_m b: {damping_note}; (m,) or (m, N)."""',
+        *force_lines,
+        "    return np.array(np.broadcast_arrays(",
+        *(f"        {o}," for o in force_out),
+        "    ), dtype=float)",
+        "",
+        "",
+        "def static_mesh_force(p):",
+        '    """Static force of each mesh over its k_m b: kappa F = f at the mean stiffness."""',
+        *static_lines,
+        f"    K = np.array([{static_rows}], dtype=float)",
+        f"    f = np.array([{static_loads}], dtype=float)",
+        "    return np.linalg.solve(K, f)",
         "",
         "",
         "def _broadcast(*rows):",

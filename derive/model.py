@@ -75,6 +75,9 @@ class Model:
     rhs: tuple[sp.Expr, ...]
     jacobian: sp.ImmutableMatrix
     accelerations: tuple[sp.Expr, ...]
+    mesh_forces: tuple[sp.Expr, ...]  # each mesh's dynamic force over its k_m b
+    static_kappa: sp.ImmutableMatrix  # kappa at the mean stiffness: kappa F_static = f
+    loads: tuple[sp.Symbol, ...]  # f of each coordinate
     kappa_t: sp.ImmutableMatrix  # kappa_ij(tau) in parameter symbols
     ebar: tuple[sp.Expr, ...]
     nondim: NonDim
@@ -299,6 +302,20 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
         - sum(kappa_t[i, j] * gexpr[j] for j in range(m) if (i, j) in kappa)
         for i in range(m)
     )
+    # The dynamic mesh force of each mesh over its k_m b: the elastic part k_hat g(u) and,
+    # with one damper per mesh ("mesh" damping), the viscous part c u', whose ratio to the
+    # stiffness is 2 xi_jj / kappa_jj in the model's own parameters.  With "modal" damping
+    # the damper couples the meshes and only the elastic part is a mesh's own.
+    mesh_forces = tuple(
+        khat[j] * gexpr[j]
+        + (
+            2 * xi[j, j] / kappa[j, j] * du[j]
+            if nd.damping == "mesh" and (j, j) in xi and (j, j) in kappa
+            else 0
+        )
+        for j in range(m)
+    )
+    static_kappa = sp.ImmutableMatrix(m, m, lambda i, j: kappa.get((i, j), 0))
     states = coords + tuple(f"d{c}" for c in coords)
     state_symbols = u + du
     rhs = du + acc
@@ -353,6 +370,9 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
         rhs=tuple(rhs),
         jacobian=jac,
         accelerations=acc,
+        mesh_forces=mesh_forces,
+        static_kappa=static_kappa,
+        loads=f,
         kappa_t=kappa_t,
         ebar=ebar,
         nondim=nd,

@@ -530,6 +530,55 @@ def jacobian(tau, x, p):
     ))
 
 
+def mesh_force(tau, x, p):
+    """Dynamic force of each mesh over its k_m b: elastic k_hat(tau) g(u) plus viscous c u' (one damper per mesh); (m,) or (m, N)."""
+    u = x[0]
+    v = x[1]
+    du = x[2]
+    dv = x[3]
+    omega = p[0]
+    xi_u_u = p[3]
+    xi_v_v = p[6]
+    kappa_u_u = p[7]
+    kappa_v_v = p[10]
+    kc_u_1 = p[11]
+    ks_u_1 = p[12]
+    kc_u_2 = p[13]
+    ks_u_2 = p[14]
+    kc_u_3 = p[15]
+    ks_u_3 = p[16]
+    kc_v_1 = p[17]
+    ks_v_1 = p[18]
+    kc_v_2 = p[19]
+    ks_v_2 = p[20]
+    kc_v_3 = p[21]
+    ks_v_3 = p[22]
+    phi_v = p[23]
+    _t0 = omega*tau
+    _t1 = 2*_t0
+    _t2 = 3*_t0
+    _t3 = _t0 - phi_v
+    _t4 = _t1 - 2*phi_v
+    _t5 = _t2 - 3*phi_v
+    return np.array(np.broadcast_arrays(
+        2*du*xi_u_u/kappa_u_u + (kc_u_1*np.cos(_t0) + kc_u_2*np.cos(_t1) + kc_u_3*np.cos(_t2) + ks_u_1*np.sin(_t0) + ks_u_2*np.sin(_t1) + ks_u_3*np.sin(_t2) + 1)*np.where((u > 1), u - 1, np.where((u < -1), u + 1, 0)),
+        2*dv*xi_v_v/kappa_v_v + (kc_v_1*np.cos(_t3) + kc_v_2*np.cos(_t4) + kc_v_3*np.cos(_t5) + ks_v_1*np.sin(_t3) + ks_v_2*np.sin(_t4) + ks_v_3*np.sin(_t5) + 1)*np.where((v > 1), v - 1, np.where((v < -1), v + 1, 0)),
+    ), dtype=float)
+
+
+def static_mesh_force(p):
+    """Static force of each mesh over its k_m b: kappa F = f at the mean stiffness."""
+    f_u = p[1]
+    f_v = p[2]
+    kappa_u_u = p[7]
+    kappa_u_v = p[8]
+    kappa_v_u = p[9]
+    kappa_v_v = p[10]
+    K = np.array([[kappa_u_u, kappa_u_v], [kappa_v_u, kappa_v_v]], dtype=float)
+    f = np.array([f_u, f_v], dtype=float)
+    return np.linalg.solve(K, f)
+
+
 def _broadcast(*rows):
     flat = np.broadcast_arrays(*(e for row in rows for e in row))
     n = len(rows)

@@ -599,6 +599,61 @@ def jacobian(tau, x, p):
     ))
 
 
+def mesh_force(tau, x, p):
+    """Dynamic force of each mesh over its k_m b: elastic k_hat(tau) g(u) plus viscous c u' (one damper per mesh); (m,) or (m, N)."""
+    u = x[0]
+    v = x[1]
+    du = x[2]
+    dv = x[3]
+    omega = p[0]
+    xi_u_u = p[3]
+    xi_v_v = p[6]
+    kappa_u_u = p[7]
+    kappa_v_v = p[10]
+    kc_u_1 = p[11]
+    ks_u_1 = p[12]
+    kc_u_2 = p[13]
+    ks_u_2 = p[14]
+    kc_u_3 = p[15]
+    ks_u_3 = p[16]
+    kc_v_1 = p[17]
+    ks_v_1 = p[18]
+    kc_v_2 = p[19]
+    ks_v_2 = p[20]
+    kc_v_3 = p[21]
+    ks_v_3 = p[22]
+    phi_v = p[23]
+    g1 = p[28]
+    g3 = p[29]
+    g5 = p[30]
+    g7 = p[31]
+    _t0 = u**2
+    _t1 = omega*tau
+    _t2 = 2*_t1
+    _t3 = 3*_t1
+    _t4 = v**2
+    _t5 = _t1 - phi_v
+    _t6 = _t2 - 2*phi_v
+    _t7 = _t3 - 3*phi_v
+    return np.array(np.broadcast_arrays(
+        2*du*xi_u_u/kappa_u_u + u*(_t0*(_t0*(_t0*g7 + g5) + g3) + g1)*(kc_u_1*np.cos(_t1) + kc_u_2*np.cos(_t2) + kc_u_3*np.cos(_t3) + ks_u_1*np.sin(_t1) + ks_u_2*np.sin(_t2) + ks_u_3*np.sin(_t3) + 1),
+        2*dv*xi_v_v/kappa_v_v + v*(_t4*(_t4*(_t4*g7 + g5) + g3) + g1)*(kc_v_1*np.cos(_t5) + kc_v_2*np.cos(_t6) + kc_v_3*np.cos(_t7) + ks_v_1*np.sin(_t5) + ks_v_2*np.sin(_t6) + ks_v_3*np.sin(_t7) + 1),
+    ), dtype=float)
+
+
+def static_mesh_force(p):
+    """Static force of each mesh over its k_m b: kappa F = f at the mean stiffness."""
+    f_u = p[1]
+    f_v = p[2]
+    kappa_u_u = p[7]
+    kappa_u_v = p[8]
+    kappa_v_u = p[9]
+    kappa_v_v = p[10]
+    K = np.array([[kappa_u_u, kappa_u_v], [kappa_v_u, kappa_v_v]], dtype=float)
+    f = np.array([f_u, f_v], dtype=float)
+    return np.linalg.solve(K, f)
+
+
 def _broadcast(*rows):
     flat = np.broadcast_arrays(*(e for row in rows for e in row))
     n = len(rows)

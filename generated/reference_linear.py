@@ -275,6 +275,35 @@ def jacobian(tau, x, p):
     ))
 
 
+def mesh_force(tau, x, p):
+    """Dynamic force of each mesh over its k_m b: elastic k_hat(tau) g(u) plus viscous c u' (one damper per mesh); (m,) or (m, N)."""
+    u = x[0]
+    v = x[1]
+    du = x[2]
+    dv = x[3]
+    xi_u_u = p[3]
+    xi_v_v = p[4]
+    kappa_u_u = p[5]
+    kappa_v_v = p[8]
+    return np.array(np.broadcast_arrays(
+        2*du*xi_u_u/kappa_u_u + u,
+        2*dv*xi_v_v/kappa_v_v + v,
+    ), dtype=float)
+
+
+def static_mesh_force(p):
+    """Static force of each mesh over its k_m b: kappa F = f at the mean stiffness."""
+    f_u = p[1]
+    f_v = p[2]
+    kappa_u_u = p[5]
+    kappa_u_v = p[6]
+    kappa_v_u = p[7]
+    kappa_v_v = p[8]
+    K = np.array([[kappa_u_u, kappa_u_v], [kappa_v_u, kappa_v_v]], dtype=float)
+    f = np.array([f_u, f_v], dtype=float)
+    return np.linalg.solve(K, f)
+
+
 def _broadcast(*rows):
     flat = np.broadcast_arrays(*(e for row in rows for e in row))
     n = len(rows)

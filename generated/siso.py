@@ -356,6 +356,41 @@ def jacobian(tau, x, p):
     ))
 
 
+def mesh_force(tau, x, p):
+    """Dynamic force of each mesh over its k_m b: elastic k_hat(tau) g(u) plus viscous c u' (one damper per mesh); (m,) or (m, N)."""
+    u = x[0]
+    du = x[1]
+    omega = p[0]
+    xi_u_u = p[2]
+    kappa_u_u = p[3]
+    kc_u_1 = p[4]
+    ks_u_1 = p[5]
+    kc_u_2 = p[6]
+    ks_u_2 = p[7]
+    kc_u_3 = p[8]
+    ks_u_3 = p[9]
+    g1 = p[12]
+    g3 = p[13]
+    g5 = p[14]
+    g7 = p[15]
+    _t0 = u**2
+    _t1 = omega*tau
+    _t2 = 2*_t1
+    _t3 = 3*_t1
+    return np.array(np.broadcast_arrays(
+        2*du*xi_u_u/kappa_u_u + u*(_t0*(_t0*(_t0*g7 + g5) + g3) + g1)*(kc_u_1*np.cos(_t1) + kc_u_2*np.cos(_t2) + kc_u_3*np.cos(_t3) + ks_u_1*np.sin(_t1) + ks_u_2*np.sin(_t2) + ks_u_3*np.sin(_t3) + 1),
+    ), dtype=float)
+
+
+def static_mesh_force(p):
+    """Static force of each mesh over its k_m b: kappa F = f at the mean stiffness."""
+    f_u = p[1]
+    kappa_u_u = p[3]
+    K = np.array([[kappa_u_u]], dtype=float)
+    f = np.array([f_u], dtype=float)
+    return np.linalg.solve(K, f)
+
+
 def _broadcast(*rows):
     flat = np.broadcast_arrays(*(e for row in rows for e in row))
     n = len(rows)

@@ -854,6 +854,83 @@ def jacobian(tau, x, p):
     ))
 
 
+def mesh_force(tau, x, p):
+    """Dynamic force of each mesh over its k_m b: elastic k_hat(tau) g(u) plus viscous c u' (one damper per mesh); (m,) or (m, N)."""
+    u = x[0]
+    v = x[1]
+    w = x[2]
+    du = x[3]
+    dv = x[4]
+    dw = x[5]
+    omega = p[0]
+    xi_u_u = p[4]
+    xi_v_v = p[8]
+    xi_w_w = p[12]
+    kappa_u_u = p[13]
+    kappa_v_v = p[17]
+    kappa_w_w = p[21]
+    kc_u_1 = p[22]
+    ks_u_1 = p[23]
+    kc_u_2 = p[24]
+    ks_u_2 = p[25]
+    kc_u_3 = p[26]
+    ks_u_3 = p[27]
+    kc_v_1 = p[28]
+    ks_v_1 = p[29]
+    kc_v_2 = p[30]
+    ks_v_2 = p[31]
+    kc_v_3 = p[32]
+    ks_v_3 = p[33]
+    kc_w_1 = p[34]
+    ks_w_1 = p[35]
+    kc_w_2 = p[36]
+    ks_w_2 = p[37]
+    kc_w_3 = p[38]
+    ks_w_3 = p[39]
+    phi_v = p[40]
+    phi_w = p[41]
+    g1 = p[48]
+    g3 = p[49]
+    g5 = p[50]
+    g7 = p[51]
+    _t0 = u**2
+    _t1 = omega*tau
+    _t2 = 2*_t1
+    _t3 = 3*_t1
+    _t4 = v**2
+    _t5 = _t1 - phi_v
+    _t6 = _t2 - 2*phi_v
+    _t7 = _t3 - 3*phi_v
+    _t8 = w**2
+    _t9 = _t1 - phi_w
+    _t10 = _t2 - 2*phi_w
+    _t11 = _t3 - 3*phi_w
+    return np.array(np.broadcast_arrays(
+        2*du*xi_u_u/kappa_u_u + u*(_t0*(_t0*(_t0*g7 + g5) + g3) + g1)*(kc_u_1*np.cos(_t1) + kc_u_2*np.cos(_t2) + kc_u_3*np.cos(_t3) + ks_u_1*np.sin(_t1) + ks_u_2*np.sin(_t2) + ks_u_3*np.sin(_t3) + 1),
+        2*dv*xi_v_v/kappa_v_v + v*(_t4*(_t4*(_t4*g7 + g5) + g3) + g1)*(kc_v_1*np.cos(_t5) + kc_v_2*np.cos(_t6) + kc_v_3*np.cos(_t7) + ks_v_1*np.sin(_t5) + ks_v_2*np.sin(_t6) + ks_v_3*np.sin(_t7) + 1),
+        2*dw*xi_w_w/kappa_w_w + w*(_t8*(_t8*(_t8*g7 + g5) + g3) + g1)*(kc_w_1*np.cos(_t9) + kc_w_2*np.cos(_t10) + kc_w_3*np.cos(_t11) + ks_w_1*np.sin(_t9) + ks_w_2*np.sin(_t10) + ks_w_3*np.sin(_t11) + 1),
+    ), dtype=float)
+
+
+def static_mesh_force(p):
+    """Static force of each mesh over its k_m b: kappa F = f at the mean stiffness."""
+    f_u = p[1]
+    f_v = p[2]
+    f_w = p[3]
+    kappa_u_u = p[13]
+    kappa_u_v = p[14]
+    kappa_u_w = p[15]
+    kappa_v_u = p[16]
+    kappa_v_v = p[17]
+    kappa_v_w = p[18]
+    kappa_w_u = p[19]
+    kappa_w_v = p[20]
+    kappa_w_w = p[21]
+    K = np.array([[kappa_u_u, kappa_u_v, kappa_u_w], [kappa_v_u, kappa_v_v, kappa_v_w], [kappa_w_u, kappa_w_v, kappa_w_w]], dtype=float)
+    f = np.array([f_u, f_v, f_w], dtype=float)
+    return np.linalg.solve(K, f)
+
+
 def _broadcast(*rows):
     flat = np.broadcast_arrays(*(e for row in rows for e in row))
     n = len(rows)

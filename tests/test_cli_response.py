@@ -21,7 +21,8 @@ def test_records_files_and_folds(capsys, tmp_path):
     for r in records:
         assert r["method"] == "hb" and isinstance(r["stable"], bool)
         assert set(r) == {"method", "omega", "stable", "u", "v"}
-        assert set(r["u"]) == {"mean", "amplitude", "rms"} and r["u"]["amplitude"] >= 0
+        assert set(r["u"]) == {"mean", "amplitude", "rms", "dynamic_factor"}
+        assert r["u"]["amplitude"] >= 0 and r["u"]["dynamic_factor"] >= 1 - 1e-9
     omegas = [r["omega"] for r in records]
     assert min(omegas) == pytest.approx(0.3) and omegas[-1] == pytest.approx(0.9)
     assert not all(r["stable"] for r in records)  # the branch between folds is unstable
@@ -31,6 +32,13 @@ def test_records_files_and_folds(capsys, tmp_path):
     data = json.loads((tmp_path / "frequency_response.json").read_text())
     folds = [e for e in data["curves"][0]["events"] if e["kind"] == "fold"]
     assert len(folds) % 2 == 0 and folds  # the branch enters and leaves each overhang
+    # each fold cross-checked by a time integration's monodromy: a multiplier at +1.  At a
+    # fold the critical multiplier moves with the square root of a perturbation of the
+    # equations, here harmonic balance's truncation (its tail share)
+    tail = data["curves"][0]["largest_tail_share"]
+    for e in folds:
+        assert abs(e["max_monodromy_multiplier"] - 1) < 10 * max(tail, 1e-12) ** 0.5
+        assert e["hill_vs_monodromy"] < 10 * max(tail, 1e-12) ** 0.5
 
 
 def test_shooting_and_harmonic_balance_find_the_same_folds(capsys, tmp_path):
@@ -40,8 +48,9 @@ def test_shooting_and_harmonic_balance_find_the_same_folds(capsys, tmp_path):
     code, out, err = run(capsys, *argv, "--method=all", "--no-figure", f"--out={tmp_path}")
     assert code == 0, err
     data = json.loads((tmp_path / "frequency_response.json").read_text())
-    hb, sh = data["curves"]
-    assert hb["method"] == "hb" and sh["method"] == "shooting"
+    methods = [c["method"] for c in data["curves"]]
+    assert methods == ["hb", "shooting", "integration", "integration"]
+    hb, sh = data["curves"][:2]
     a = sorted(e["omega"] for e in hb["events"] if e["kind"] == "fold")
     b = sorted(e["omega"] for e in sh["events"] if e["kind"] == "fold")
     assert len(a) == len(b) == 2

@@ -38,6 +38,13 @@ def register(sub) -> None:
     fr.add_argument(
         "--harmonics", type=int, default=15, metavar="H", help="harmonics of omega/n (15)"
     )
+    fr.add_argument(
+        "--tail",
+        type=float,
+        metavar="SHARE",
+        help="raise H (doubling, from --harmonics) until the top quarter of the harmonics "
+        "carries at most SHARE of the response at the start, for example 1e-6",
+    )
     fr.add_argument("--period", type=int, default=1, metavar="N", help="period N T (default 1)")
     fr.add_argument(
         "--method",
@@ -99,6 +106,8 @@ def _cmd_response(args) -> int:
         raise Fail(f"--harmonics must be >= 1, got {args.harmonics}")
     if args.period < 1:
         raise Fail(f"--period must be >= 1, got {args.period}")
+    if args.tail is not None and not (0 < args.tail < 1):
+        raise Fail(f"--tail must be a share in (0, 1), got {args.tail}")
     system = system_of(args.scene, parse_set(args.set))
     try:
         system.parameters_with(**{name: start})
@@ -128,6 +137,7 @@ def _cmd_response(args) -> int:
         resp = frequency_response(
             system, name, start, stop, points=num, methods=methods,
             harmonics=args.harmonics, n=args.period, settle=args.settle, sampled=args.sampled,
+            tail=args.tail,
         )  # fmt: skip
     except (HarmonicBalanceError, ShootingError) as err:
         raise Fail(f"frequency-response: {err}") from None
@@ -161,9 +171,20 @@ def _cmd_response(args) -> int:
             print(f"integration, {c.details['direction']} sweep: {len(c.values)} points in "
                   f"{c.wall_time:.2f} s (both sweeps together)")  # fmt: skip
             continue
-        print(f"{c.method}: {len(c.values)} points ({stable} stable) in {c.wall_time:.2f} s")
+        extra = ""
+        if c.method == "hb":
+            extra = (f"; H = {c.details['harmonics']}, top harmonics carry at most "
+                     f"{c.details['largest_tail_share']:.1e} of the response")  # fmt: skip
+        print(f"{c.method}: {len(c.values)} points ({stable} stable) in {c.wall_time:.2f} s"
+              + extra)  # fmt: skip
         for e in c.events:
-            print(f"  {e['kind']:<16} {name} = {e[name]:.8g}")
+            check = (
+                f"  (Hill against the monodromy: {e['hill_vs_monodromy']:.1e}; largest "
+                f"|monodromy multiplier| {e['max_monodromy_multiplier']:.9f})"
+                if "hill_vs_monodromy" in e
+                else ""
+            )
+            print(f"  {e['kind']:<16} {name} = {e[name]:.8g}{check}")
         for note in c.details.get("notes", []):
             print(f"  note: {note}")
     print(f"wrote {out / 'frequency_response.json'}" + (f" and {figure}" if figure else ""))

@@ -41,7 +41,11 @@ def _at(curve, value: float, coords) -> list[dict]:
             mean = {c: float((1 - w) * curve.stats[c]["mean"][k]
                              + w * curve.stats[c]["mean"][k + 1]) for c in coords}  # fmt: skip
             stable = bool(curve.stable[k]) and bool(curve.stable[k + 1])
-            out.append({"amplitude": amp, "mean": mean, "stable": stable})
+            factor = {}
+            for c in coords:
+                d = curve.stats[c].get("dynamic_factor")
+                factor[c] = float("nan") if d is None else float((1 - w) * d[k] + w * d[k + 1])
+            out.append({"amplitude": amp, "mean": mean, "stable": stable, "factor": factor})
     if v[-1] == value:
         k = len(v) - 1
         out.append({"amplitude": {c: float(curve.stats[c]["amplitude"][k]) for c in coords},
@@ -103,7 +107,11 @@ def run_response(out: Path, systems: dict, cases, points: dict, *, quick: bool) 
 
 def _fmt_solution(s, coords) -> str:
     amps = ", ".join(f"{c} {s['amplitude'][c]:.3g}" for c in coords)
-    return f"{'stable' if s['stable'] else 'unstable'} ({amps})"
+    factor = s.get("factor", {})
+    df = ", ".join(f"{c} {factor[c]:.3g}" for c in coords if np.isfinite(factor.get(c, np.nan)))
+    return f"{'stable' if s['stable'] else 'unstable'} ({amps}" + (
+        f"; dynamic factor {df})" if df else ")"
+    )
 
 
 def response_section(rows) -> str:
@@ -114,8 +122,10 @@ def response_section(rows) -> str:
         f"{RANGE[0]} to {RANGE[1]}, by harmonic-balance continuation (alternating "
         "frequency–time with the generated Jacobian; stability by Hill's method; "
         "`docs/analysis.md`), at the study's two load ratios. Amplitudes are half "
-        "peak-to-peak, in half backlashes. A fold is where a slow frequency sweep would "
-        "jump; between two folds the branch is unstable and two stable solutions coexist. "
+        "peak-to-peak, in half backlashes; the dynamic factor of a mesh is its peak dynamic "
+        "force (elastic and viscous) over its static force. A fold is where a slow "
+        "frequency sweep would jump; between two folds the branch is unstable and two "
+        "stable solutions coexist. "
         "Folds are listed in the order met along the branch from ω̄ = 0.3. The simulated "
         "operating point (the analysis of the section above) is matched to a solution when "
         "both are period-1 and their amplitudes agree within 1e-3 (the simulation's "

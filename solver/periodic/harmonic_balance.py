@@ -10,9 +10,9 @@ the unknowns ``X`` (states x ``2H + 1``, columns ``c0, c1, s1, c2, s2, ...``).  
 ``R(X) = D X - P f(tau_j, E X)`` balances the derivative (``D``, exact on the series) against
 the nonlinear force by the alternating frequency-time scheme (Cameron and Griffin 1989,
 "An alternating frequency/time domain method for calculating the steady-state response of
-nonlinear dynamic systems", J. Appl. Mech. 56): ``E`` evaluates the series at ``N``
-equally spaced phases, the generated right-hand side is evaluated there, and ``P`` (the
-discrete Fourier projection, exact for ``N > 2H``) takes the force back.  The Jacobian is
+nonlinear dynamic systems", J. Appl. Mech. 56): ``E`` (the inverse real FFT) evaluates
+the series at ``N`` equally spaced phases, the generated right-hand side is evaluated
+there, and ``P`` (the real FFT, exact for ``N > 2H``) takes the force back.  The Jacobian is
 ``dR/dX = D - P diag(J(tau_j)) E`` block by block, with ``J`` the generated Jacobian in the
 time domain: no finite differences.
 
@@ -112,15 +112,33 @@ class HarmonicBalance:
         mod, nx = self.system.module, self.system.n
         w = self.omega(p) / self.n
         tau = self.times(p)
-        x = X @ self.E.T  # (nx, N)
+        x = self.synthesis(X)  # (nx, N)
         F = np.broadcast_to(np.asarray(mod.rhs(tau, x, p), float).reshape(nx, -1), x.shape)
-        R = w * X @ self.Ds.T - F @ self.P.T
+        R = w * X @ self.Ds.T - self.analysis(F)
         if not jacobian:
             return R, None
         A = self.toeplitz(self._jacobian(tau, x, p))
         Jac = -A.reshape(nx * self.M, nx * self.M)
         Jac[self._diag] += w * self.Ds.ravel()[self._dflat]
         return R, Jac
+
+    def synthesis(self, X: np.ndarray) -> np.ndarray:
+        """The series at the N phases by the inverse real FFT (rows: states)."""
+        H, N = self.H, self.N
+        Z = np.zeros((X.shape[0], N // 2 + 1), dtype=complex)
+        Z[:, 0] = X[:, 0] * N
+        Z[:, 1 : H + 1] = (X[:, 1::2] - 1j * X[:, 2::2]) * (N / 2)
+        return np.fft.irfft(Z, n=N, axis=1)
+
+    def analysis(self, F: np.ndarray) -> np.ndarray:
+        """The kept Fourier coefficients of samples at the N phases by the real FFT (exact
+        for the harmonics up to H with N > 2H)."""
+        G = np.fft.rfft(F, axis=1) / self.N
+        out = np.empty((F.shape[0], self.M))
+        out[:, 0] = G[:, 0].real
+        out[:, 1::2] = 2 * G[:, 1 : self.H + 1].real
+        out[:, 2::2] = -2 * G[:, 1 : self.H + 1].imag
+        return out
 
     def toeplitz(self, J: np.ndarray, harmonics: int | None = None) -> np.ndarray:
         """``P diag(J) E`` for every pair of states, (nx, M, nx, M), from the discrete
@@ -329,6 +347,8 @@ def harmonic_balance(
     tol: float = 1e-10,
     max_iter: int = 40,
     stability: bool = True,
+    tail: float | None = None,
+    max_harmonics: int = 256,
 ) -> HBSolution:
     """The period-``n T`` solution of ``system`` by harmonic balance with ``harmonics``
     harmonics of ``omega / n``.
@@ -336,8 +356,21 @@ def harmonic_balance(
     ``guess``: None (integrate to a steady state and project its last ``n`` periods),
     a trajectory, a state on the orbit at ``tau = 0``, or coefficients (states x
     ``2H' + 1``, padded or cut to ``2H + 1``).  Newton on the residual's max-norm to
-    ``tol``; Hill's stability with ``stability``.
+    ``tol``; Hill's stability with ``stability``.  ``tail``: double H (from the last
+    solution, up to ``max_harmonics``) until the highest quarter of the harmonics carries
+    at most this share of the response (:meth:`HBSolution.tail_share`).
     """
+    if tail is not None:
+        if not tail > 0:
+            raise ValueError(f"tail must be a positive share, got {tail}")
+        sol = harmonic_balance(system, guess, harmonics=harmonics, n=n, samples=samples,
+                               tol=tol, max_iter=max_iter, stability=False)  # fmt: skip
+        while sol.tail_share() > tail and 2 * sol.harmonics <= max_harmonics:
+            sol = harmonic_balance(system, sol.coefficients, harmonics=2 * sol.harmonics, n=n,
+                                   tol=tol, max_iter=max_iter, stability=False)  # fmt: skip
+        return harmonic_balance(system, sol.coefficients, harmonics=sol.harmonics, n=n,
+                                samples=samples if sol.harmonics == harmonics else None,
+                                tol=tol, max_iter=max_iter, stability=stability)  # fmt: skip
     problem = HarmonicBalance(system, harmonics, n, samples)
     p = system.p
     X0 = _initial_coefficients(problem, guess, p)

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..system import System
 
-__all__ = ["METHODS", "Curve", "FrequencyResponse", "frequency_response"]
+__all__ = ["METHODS", "Curve", "FrequencyResponse", "dynamic_factor", "frequency_response"]
 
 METHODS = ("hb", "shooting", "integration")
 
@@ -31,7 +31,8 @@ class Curve:
     parameter: str
     values: np.ndarray
     stable: np.ndarray
-    stats: dict  # coordinate -> {"mean", "amplitude", "rms", "max", "min"}: arrays
+    stats: dict  # coordinate -> {"mean", "amplitude", "rms", "max", "min",
+    # "dynamic_factor"}: arrays
     events: tuple = ()
     wall_time: float = 0.0
     details: dict = field(default_factory=dict)
@@ -44,6 +45,8 @@ class Curve:
                 rec["direction"] = self.details["direction"]
             for c, s in self.stats.items():
                 rec[c] = {q: float(s[q][k]) for q in ("mean", "amplitude", "rms")}
+                if "dynamic_factor" in s:
+                    rec[c]["dynamic_factor"] = float(s["dynamic_factor"][k])
             out.append(rec)
         return out
 
@@ -84,14 +87,18 @@ class FrequencyResponse:
     def to_table(self) -> tuple[list, list]:
         coords = self.system.coordinates
         columns = ["method", self.parameter, "stable"] + [
-            f"{c}_{q}" for c in coords for q in ("mean", "amplitude", "rms")
+            f"{c}_{q}" for c in coords for q in ("mean", "amplitude", "rms", "dynamic_factor")
         ]
         rows = []
         for r in self.records():
             method = r["method"] + (f" {r['direction']}" if "direction" in r else "")
             rows.append(
                 [method, r[self.parameter], r["stable"]]
-                + [r[c][q] for c in coords for q in ("mean", "amplitude", "rms")]
+                + [
+                    r[c].get(q, float("nan"))
+                    for c in coords
+                    for q in ("mean", "amplitude", "rms", "dynamic_factor")
+                ]  # fmt: skip
             )
         return columns, rows
 
@@ -100,6 +107,51 @@ class FrequencyResponse:
         from ..export import save
 
         return save(self, path)
+
+
+def dynamic_factor(system: System, tau, x, p) -> dict:
+    """Per mesh coordinate: the peak of the dynamic mesh force over the static one,
+    max |F(tau)| / |F_static| over the samples ``x`` (states x samples) at ``tau``
+    (nan where the model does not emit its mesh forces or a mesh carries no static load)."""
+    mod = system.module
+    coords = system.coordinates
+    if not (hasattr(mod, "mesh_force") and hasattr(mod, "static_mesh_force")):
+        return {c: float("nan") for c in coords}
+    F = np.asarray(mod.mesh_force(np.asarray(tau, float), np.asarray(x, float), p))
+    F = F.reshape(len(coords), -1)
+    static = np.asarray(mod.static_mesh_force(p), float)
+    out = {}
+    for i, c in enumerate(coords):
+        ok = abs(static[i]) > 1e-12 and np.all(np.isfinite(F[i]))
+        out[c] = float(np.max(np.abs(F[i])) / abs(static[i])) if ok else float("nan")
+    return out
+
+
+def _hb_factors(system, parameter, br, n, samples: int = 512) -> dict:
+    """The dynamic factor at every point of a harmonic-balance branch, in one vectorised
+    call of the generated mesh forces (``samples`` phases a period)."""
+    coords = system.coordinates
+    npts = len(br.points)
+    mod = system.module
+    if not npts or not (hasattr(mod, "mesh_force") and hasattr(mod, "static_mesh_force")):
+        return {c: np.full(npts, np.nan) for c in coords}
+    prob = br._problem()
+    phases = 2 * np.pi * np.arange(samples) / samples
+    C = np.array([pt.coefficients for pt in br.points])  # (P, nx, M)
+    X = prob.time_series(C.reshape(-1, prob.M), phases).reshape(npts, system.n, samples)
+    P = np.array([system.parameters_with(**{parameter: pt.value}) for pt in br.points])
+    iw = mod.PARAMETERS.index(system.contract.forcing_frequency)
+    tau = n * phases[None, :] / P[:, iw, None]  # (P, samples)
+    F = np.asarray(mod.mesh_force(tau.ravel(), X.transpose(1, 0, 2).reshape(system.n, -1),
+                                  np.repeat(P.T, samples, axis=1)))  # fmt: skip
+    F = F.reshape(len(coords), npts, samples)
+    static = np.array([mod.static_mesh_force(p) for p in P])  # (P, m)
+    out = {}
+    for i, c in enumerate(coords):
+        s = np.abs(static[:, i])
+        peak = np.max(np.abs(F[i]), axis=1)
+        out[c] = np.where(s > 1e-12, peak / np.where(s > 1e-12, s, 1.0), np.nan)
+    return out
 
 
 def _hb_curve(system, parameter, start, stop, harmonics, n, ds) -> Curve:
@@ -118,6 +170,8 @@ def _hb_curve(system, parameter, start, stop, harmonics, n, ds) -> Curve:
             "max": y.max(axis=1),
             "min": y.min(axis=1),
         }
+    for c, d in _hb_factors(system, parameter, br, n).items():
+        stats[c]["dynamic_factor"] = d
     tail = float(np.max(br.tail_shares())) if len(br.points) else 0.0
     return Curve(
         "hb",
@@ -143,11 +197,13 @@ def _shooting_curve(system, parameter, start, stop, n, ds, guess) -> Curve:
     started = time.perf_counter()
     br = continue_orbit(system, parameter, start, stop, guess, n=n, ds=ds, ds_max=2 * ds,
                         max_points=20_000)  # fmt: skip
-    stats = {c: {q: [] for q in ("mean", "amplitude", "rms", "max", "min")} for c in
-             system.coordinates}  # fmt: skip
+    keys = ("mean", "amplitude", "rms", "max", "min", "dynamic_factor")
+    stats = {c: {q: [] for q in keys} for c in system.coordinates}
     for v, x0 in zip(br.values, br.states, strict=True):
         s = system.with_values(**{parameter: v})
         tr = simulate(s, np.asarray(x0), transient=0, periods=n, samples_per_period=256)
+        for c, d in dynamic_factor(s, tr.t, tr.x, s.p).items():
+            stats[c]["dynamic_factor"].append(d)
         for c in system.coordinates:
             y = tr.coordinate(c)[:-1]
             stats[c]["mean"].append(float(np.mean(y)))
@@ -189,7 +245,8 @@ def _integration_curves(system, parameter, start, stop, points, settle, sampled,
     lanes = (up, up[::-1])
     x = np.array([default_initial_state(system)] * 2)
     coords = system.coordinates
-    keys = ("mean", "amplitude", "rms", "max", "min", "poincare_spread")
+    iw = system.module.PARAMETERS.index(system.contract.forcing_frequency)
+    keys = ("mean", "amplitude", "rms", "max", "min", "poincare_spread", "dynamic_factor")
     stats = [{c: {q: np.empty(points) for q in keys} for c in coords} for _ in lanes]
     status = [[] for _ in lanes]
     poincare = [[] for _ in lanes]
@@ -201,7 +258,9 @@ def _integration_curves(system, parameter, start, stop, points, settle, sampled,
             status[j].append(run.status[j])
             xs = run.x[j, :-1]  # the closing sample starts the next period
             poincare[j].append(run.x[j, ::spp].tolist())
+            factor = dynamic_factor(system, run.t[:-1] / P[j, iw], xs.T, P[j])
             for c in coords:
+                stats[j][c]["dynamic_factor"][k] = factor[c]
                 y = xs[:, system.index(c)]
                 pts = run.x[j, ::spp, system.index(c)]
                 st = stats[j][c]
@@ -250,6 +309,7 @@ def frequency_response(
     settle: int = 50,
     sampled: int = 16,
     samples_per_period: int = 64,
+    tail: float | None = None,
 ) -> FrequencyResponse:
     """The periodic response over ``parameter`` from ``start`` to ``stop`` by each of
     ``methods`` (``hb``, ``shooting``); ``points`` sets the resolution: the parameter
@@ -259,7 +319,9 @@ def frequency_response(
     branch turns back and leaves the range at ``start``, a second one is continued from
     ``stop`` (two curves of method ``hb``).  ``integration``: up and down stepped sweeps of
     ``points`` frequencies, ``settle`` + ``sampled`` periods each (only over the forcing
-    frequency; see :func:`_integration_curves`)."""
+    frequency; see :func:`_integration_curves`).  ``tail``: harmonic balance raises H at
+    the start until the top harmonics carry at most this share (``harmonic_balance``);
+    the largest share along the branch is reported in the curve's details."""
     unknown = [m for m in methods if m not in METHODS]
     if unknown:
         raise ValueError(f"unknown method(s) {unknown}; methods: {', '.join(METHODS)}")
@@ -270,6 +332,12 @@ def frequency_response(
     guess = None
     for m in methods:
         if m == "hb":
+            if tail is not None:
+                from ..periodic.harmonic_balance import harmonic_balance
+
+                harmonics = harmonic_balance(system.with_values(**{parameter: start}),
+                                             harmonics=harmonics, n=n, tail=tail,
+                                             stability=False).harmonics  # fmt: skip
             curve = _hb_curve(system, parameter, start, stop, harmonics, n, ds)
             curves.append(curve)
             if abs(curve.values[-1] - stop) > 1e-9 * max(1.0, abs(stop)):

@@ -170,3 +170,40 @@ def test_c_printer_keeps_reciprocals_of_sums_and_leaves_state_trig_alone():
     assert exprs[0] == sp.sin(u) and exprs[1] == sp.cos(omega * tau + u)
     assert exprs[2] == sp.cos(r * tau)
     assert list(bases) == [omega] and sp.cos(a) in q and sp.sin(a) in q
+
+
+def test_mesh_forces_close_the_equations_of_motion():
+    # With one damper per mesh and damping coupling on, every term of a mesh's
+    # acceleration that depends on the meshes' deflections is kappa times the mesh
+    # forces: u_i'' = f_i + e_i'' - sum_j kappa_ij F_j (derivation, docs/derivation);
+    # without transmission error e'' = 0, so the emitted rhs and mesh_force must agree.
+    import numpy as np
+    from gearsym.solver.system import System
+
+    system = System.load("reference_light")
+    mod = system.module
+    p = mod.parameters(E_u_1=0.0, E_v_1=0.0)
+    K = np.array([[p[mod.PARAMETERS.index(f"kappa_{a}_{b}")] for b in "uv"] for a in "uv"])
+    f = p[[mod.PARAMETERS.index("f_u"), mod.PARAMETERS.index("f_v")]]
+    rng = np.random.default_rng(3)
+    for _ in range(10):
+        x, tau = rng.uniform(-2, 2, 4), rng.uniform(0, 100)
+        acc = mod.rhs(tau, x, p)[2:]
+        np.testing.assert_allclose(acc, f - K @ mod.mesh_force(tau, x, p), rtol=0, atol=1e-12)
+    # the static force solves kappa F = f
+    np.testing.assert_allclose(K @ mod.static_mesh_force(p), f, atol=1e-14)
+
+
+def test_a_periodic_orbit_carries_the_static_force_on_average():
+    # Averaging the equations of motion over a period (u', u'' and e'' average to zero)
+    # gives sum_j kappa_ij <F_j> = f_i: the mean mesh force is the static one, so the
+    # dynamic factor (peak over static) is at least 1.  Harmonic balance averages exactly.
+    import numpy as np
+    from gearsym.solver.periodic.harmonic_balance import harmonic_balance
+    from gearsym.solver.system import System
+
+    system = System.load("reference_light", **{"lambda": 0.8})
+    sol = harmonic_balance(system, harmonics=16)
+    tau = np.linspace(0.0, system.period, 1024, endpoint=False)
+    F = system.module.mesh_force(tau, sol.at(tau), system.p)
+    np.testing.assert_allclose(F.mean(axis=1), system.module.static_mesh_force(system.p), rtol=1e-9)

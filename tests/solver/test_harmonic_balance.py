@@ -251,3 +251,19 @@ def test_both_ways_of_picking_hills_exponents_agree():
         )
         # a wrong trace makes the fast path decline (and the caller fall back)
         assert hill_module._strip(np.linalg.eigvals(A), 2, 1.5, period, 1e3) is None
+
+
+def test_harmonics_are_raised_until_the_tail_is_small():
+    # the dead zone's kinks need many harmonics: from H = 4 the share carried by the top
+    # quarter is above 1e-4 (docs/analysis.md); raising H doubles it until below
+    system = System.load("reference_dead_zone", omega=0.3350715452962742, **{"lambda": 0.1})
+    sol = harmonic_balance(system, harmonics=4, tail=1e-4, stability=False)
+    assert sol.harmonics > 4 and sol.tail_share() <= 1e-4
+    assert (
+        harmonic_balance(
+            system, sol.coefficients, harmonics=sol.harmonics // 2, stability=False
+        ).tail_share()
+        > 1e-4
+    )
+    with pytest.raises(ValueError, match="tail must be a positive share"):
+        harmonic_balance(system, harmonics=4, tail=0.0)
