@@ -161,7 +161,7 @@ def response_figure(responses: dict, path: Path, title: str, caption: str, mark:
     plt = _plt()
     first = next(iter(responses.values()))
     coords = first.system.coordinates
-    fig, axes = plt.subplots(len(coords), 1, figsize=(8, 3.0 * len(coords) + 0.6),
+    fig, axes = plt.subplots(len(coords), 1, figsize=(10, 3.0 * len(coords) + 0.6),
                              sharex=True, squeeze=False)  # fmt: skip
     for ax, c in zip(axes[:, 0], coords, strict=True):
         for k, (lam, resp) in enumerate(responses.items()):
@@ -187,7 +187,8 @@ def response_figure(responses: dict, path: Path, title: str, caption: str, mark:
         ax.grid(alpha=0.3)
         handles, labels = ax.get_legend_handles_labels()
         unique = dict(zip(labels, handles, strict=True))
-        ax.legend(unique.values(), unique.keys(), fontsize=7, loc="upper right")
+        ax.legend(unique.values(), unique.keys(), fontsize=7, loc="upper left",
+                  bbox_to_anchor=(1.01, 1.0), frameon=False)  # fmt: skip
     axes[-1, 0].set_xlabel("ω̄ (mesh frequency over ω_n)")
     axes[0, 0].set_title(title, fontsize=10)
     fig.text(0.01, 0.005, caption, fontsize=7, ha="left", va="bottom", wrap=True)
