@@ -20,6 +20,8 @@ from .sweep import SweepResult  # noqa: E402
 
 __all__ = ["bifurcation_diagram", "map_figure", "point_figure"]
 
+PORTRAIT_PERIODS = 500  # periods a phase portrait draws at most
+
 _COLOURS = {"forward": "tab:blue", "backward": "tab:orange", "independent": "tab:blue"}
 
 
@@ -89,10 +91,13 @@ def point_figure(tr: Trajectory, path: Path, title: str = "", periods_shown: int
         ax.set_ylabel(f"{c} (half backlashes)")
         ax.set_title(f"{c}: time series (last {periods_shown} periods)", fontsize=9)
         ax = axes[row, 1]
-        ax.plot(u, du, lw=0.3, color="tab:blue", alpha=0.6)
+        # at most the last PORTRAIT_PERIODS periods (a path of every sample of a long run
+        # takes matplotlib gigabytes); the Poincare points likewise
+        tail = slice(max(0, tr.t.size - PORTRAIT_PERIODS * spp), None)
+        ax.plot(u[tail], du[tail], lw=0.3, color="tab:blue", alpha=0.6)
         ax.plot(
-            tr.poincare[tr.system.index(c)],
-            tr.poincare[tr.system.velocity_index(c)],
+            tr.poincare[tr.system.index(c)][-PORTRAIT_PERIODS:],
+            tr.poincare[tr.system.velocity_index(c)][-PORTRAIT_PERIODS:],
             "o",
             ms=2.5,
             color="tab:red",
@@ -100,7 +105,8 @@ def point_figure(tr: Trajectory, path: Path, title: str = "", periods_shown: int
         )
         ax.set_xlabel(c)
         ax.set_ylabel(f"d{c}/dτ")
-        ax.set_title(f"{c}: phase portrait", fontsize=9)
+        shown_periods = min(PORTRAIT_PERIODS, tr.poincare.shape[1])
+        ax.set_title(f"{c}: phase portrait (last {shown_periods} periods)", fontsize=9)
         ax.legend(fontsize=7, loc="upper right")
         ax = axes[row, 2]
         sp = spectrum(tr, c)

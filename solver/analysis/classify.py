@@ -73,15 +73,26 @@ def periodicity(points: np.ndarray, tol: float) -> int | None:
     return None
 
 
+# Pair distances grow with the square of the points: the dimension is estimated on at most
+# this many, evenly spread over the run (2,000 points: 2 million pairs, 16 MB), so memory
+# stays bounded whatever the number of sampled periods.
+DIMENSION_SAMPLE_MAX = 2000
+
+
 def correlation_dimension(points: np.ndarray) -> float | None:
     """Grassberger-Procaccia slope of log C(r) against log r over the middle of the
-    pair-distance distribution (points scaled to unit size).  None if degenerate."""
+    pair-distance distribution (points scaled to unit size), on at most
+    :data:`DIMENSION_SAMPLE_MAX` points taken at even strides.  None if degenerate."""
+    from scipy.spatial.distance import pdist
+
+    K = points.shape[1]
+    if K > DIMENSION_SAMPLE_MAX:
+        points = points[:, np.linspace(0, K - 1, DIMENSION_SAMPLE_MAX).astype(int)]
     P = points / max(np.ptp(points, axis=1).max(), 1e-300)
     K = P.shape[1]
     if K < 20:
         return None
-    d = np.sqrt(((P[:, :, None] - P[:, None, :]) ** 2).sum(axis=0))
-    d = d[np.triu_indices(K, 1)]
+    d = pdist(P.T)
     d = np.sort(d[d > 0])
     if d.size < 50:
         return 0.0
@@ -104,14 +115,18 @@ def extent(points: np.ndarray) -> dict:
 
 def distinct_points(points: np.ndarray, tol: float) -> int:
     """Number of clusters of points closer than ``tol`` (greedy; enough to tell a finite
-    set of points from a curve or a cloud)."""
-    centres: list[np.ndarray] = []
+    set of points from a curve or a cloud), among the last :data:`DIMENSION_SAMPLE_MAX`."""
+    # the last DIMENSION_SAMPLE_MAX consecutive points: a window of a period-n orbit
+    # holds all its n points, and the count stays linear in the run's length
+    points = points[:, -DIMENSION_SAMPLE_MAX:]
+    limit = points.shape[1] // 2
+    centres = np.empty((points.shape[0], 0))
     for p in points.T:
-        if not any(np.linalg.norm(p - c) <= tol for c in centres):
-            centres.append(p)
-            if len(centres) > points.shape[1] // 2:
+        if centres.shape[1] == 0 or np.min(np.linalg.norm(centres - p[:, None], axis=0)) > tol:
+            centres = np.column_stack([centres, p])
+            if centres.shape[1] > limit:
                 break
-    return len(centres)
+    return centres.shape[1]
 
 
 def classify_points(
@@ -161,7 +176,7 @@ def classify_points(
             return Classification("undetermined", None, evidence)
         return Classification(f"period-{n}", n, evidence)
     clusters = distinct_points(points, tol * scale)
-    if clusters <= points.shape[1] // 2:
+    if clusters <= min(points.shape[1], DIMENSION_SAMPLE_MAX) // 2:
         evidence["distinct_points"] = clusters
         evidence["why"] = (
             f"a finite set of {clusters} points: a period above {MAX_PERIOD}, or not settled"

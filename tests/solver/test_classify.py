@@ -64,3 +64,25 @@ def test_henon_points_are_not_a_torus():
             points.append((x, y))
     verdict = classify_points(np.array(points).T, tol=1e-6)
     assert verdict.motion == "chaotic", verdict.evidence
+
+
+def test_correlation_dimension_is_bounded_on_long_runs():
+    # Closed forms: a circle has dimension 1, a filled square 2.  50,000 points would need
+    # 40 GB for all pair distances; the estimate takes at most DIMENSION_SAMPLE_MAX of
+    # them, evenly spread, so memory stays bounded (numpy allocations are traced).
+    import tracemalloc
+
+    import numpy as np
+    from gearsym.solver.analysis.classify import correlation_dimension, distinct_points
+
+    rng = np.random.default_rng(0)
+    t = rng.uniform(0, 2 * np.pi, 50_000)
+    tracemalloc.start()
+    circle = correlation_dimension(np.vstack([np.cos(t), np.sin(t)]))
+    square = correlation_dimension(rng.uniform(size=(2, 50_000)))
+    clusters = distinct_points(rng.uniform(size=(2, 50_000)), 1e-6)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert abs(circle - 1.0) < 0.05 and abs(square - 2.0) < 0.2
+    assert clusters == 1001  # a cloud: more clusters than half the window of 2,000
+    assert peak < 200e6
