@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..system import System
+from .continuation import _tangent as _null_tangent
 from .harmonic_balance import HarmonicBalance, harmonic_balance, hill
 
 __all__ = ["HBBranch", "HBPoint", "continue_hb"]
@@ -150,16 +151,9 @@ class _Curve:
 
 
 def _tangent(G: np.ndarray, previous: np.ndarray | None) -> np.ndarray:
-    """Unit null vector of ``G`` (size x size + 1), oriented along ``previous``."""
-    rows = G.shape[0]
-    A = np.vstack([G, previous if previous is not None else np.r_[np.zeros(rows), 1.0]])
-    b = np.zeros(rows + 1)
-    b[-1] = 1.0
-    t = np.linalg.solve(A, b)
-    t /= np.linalg.norm(t)
-    if previous is not None and t @ previous < 0:
-        t = -t
-    return t
+    """Unit null vector of the bordered Jacobian ``G`` (size x size + 1), oriented along
+    ``previous`` (the shooting continuation's own construction)."""
+    return _null_tangent(G[:, :-1], G[:, -1], previous)
 
 
 def _correct(curve: _Curve, z_pred, t, tol, max_iter=10):
