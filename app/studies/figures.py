@@ -158,6 +158,8 @@ def response_figure(responses: dict, path: Path, title: str, caption: str, mark:
     """Amplitude (half peak-to-peak) of each mesh coordinate over the forcing frequency,
     one colour per load ratio, stable solid and unstable dashed, folds marked, the
     study's operating frequency ``mark`` as a vertical line."""
+    from gearsym.solver.plots_response import _segments
+
     plt = _plt()
     first = next(iter(responses.values()))
     coords = first.system.coordinates
@@ -168,15 +170,9 @@ def response_figure(responses: dict, path: Path, title: str, caption: str, mark:
             curve = resp.curves[0]
             x, y, st = curve.values, curve.stats[c]["amplitude"], curve.stable
             colour = f"C{k}"
-            start = 0
-            for j in range(1, len(x) + 1):
-                if j == len(x) or st[j] != st[start]:
-                    stop = min(j + 1, len(x))
-                    stable = bool(st[start])
-                    ax.plot(x[start:stop], y[start:stop], "-" if stable else "--", color=colour,
-                            lw=1.3 if stable else 1.0,
-                            label=f"λ = {lam}, {'stable' if stable else 'unstable'}")  # fmt: skip
-                    start = j
+            for xs, ys, stable in _segments(x, y, st):
+                ax.plot(xs, ys, "-" if stable else "--", color=colour, lw=1.3 if stable else 1.0,
+                        label=f"λ = {lam}, {'stable' if stable else 'unstable'}")  # fmt: skip
             for e in curve.events:
                 if e["kind"] == "fold":
                     i = min(max(int(e.get("index", 1)) - 1, 0), len(x) - 1)

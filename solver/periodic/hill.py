@@ -71,17 +71,11 @@ def _strip(sigma, nx, w, period, trace_integral):
     there are exactly ``nx`` distinct ones and their sum passes Liouville's check (a
     spurious eigenvalue of the truncation would fail it); else None."""
     inside = np.flatnonzero(np.abs(sigma.imag) <= 0.5 * w * (1 + 1e-9))
-    chosen = _distinct(inside[np.argsort(np.abs(sigma.imag[inside]))], sigma, nx, period)
-    rest = [
-        i
-        for i in inside
-        if i not in chosen
-        and not any(
-            abs(np.exp(sigma[i] * period) - np.exp(sigma[j] * period)) <= 1e-6 for j in chosen
-        )
-    ]
-    if len(chosen) != nx or rest:
+    order = inside[np.argsort(np.abs(sigma.imag[inside]))]
+    # exactly nx distinct multipliers in the strip: one more would be a spurious one
+    if len(_distinct(order, sigma, nx + 1, period)) != nx:
         return None
+    chosen = _distinct(order, sigma, nx, period)
     total = float(np.sum(sigma[chosen].real) * period)
     if abs(total - trace_integral) > 1e-8 * max(1.0, abs(trace_integral)):
         return None
