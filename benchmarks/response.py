@@ -62,16 +62,9 @@ def response_speed(quick: bool = False, repeats: int = 3) -> dict:
     # harmonic balance against shooting from its own states
     errs = []
     c0 = hb.curves[0]
-    from gearsym.solver.periodic.hb_continuation import continue_hb
-
-    branch = continue_hb(system, "omega", *RANGE, harmonics=15, ds=(RANGE[1] - RANGE[0]) / points,
-                         ds_max=(RANGE[1] - RANGE[0]) / 10,
-                         dlam_max=(RANGE[1] - RANGE[0]) / points, stability=False)  # fmt: skip
-    prob = branch._problem()
-    for k in _picks(len(branch.points)):
-        pt = branch.points[k]
-        s = system.with_values(omega=pt.value)
-        x0 = prob.time_series(pt.coefficients, np.array([0.0]))[:, 0]
+    for k in _picks(len(c0.values)):
+        s = system.with_values(omega=float(c0.values[k]))
+        x0 = c0.states[k]
         try:
             orbit = shoot(s, x0, 1, tol=1e-12)
             errs.append(float(np.max(np.abs(orbit.x0 - x0))))
@@ -80,25 +73,19 @@ def response_speed(quick: bool = False, repeats: int = 3) -> dict:
     out["hb"] = {"median_s": t_hb, "curve_points": int(sum(len(c.values) for c in hb.curves)),
                  "folds": [e["omega"] for e in c0.events if e["kind"] == "fold"],
                  "error": max(errs) if errs else None, "checked": len(errs)}  # fmt: skip
-    # shooting against harmonic balance from its states (the curve keeps amplitudes, not
-    # states: the branch is continued once more for its x0)
-    from gearsym.solver.periodic import continue_orbit
-
-    first = harmonic_balance(system.with_values(omega=RANGE[0]), harmonics=15, stability=False)
-    sb = continue_orbit(system, "omega", *RANGE, first.state(0.0), n=1,
-                        ds=(RANGE[1] - RANGE[0]) / points,
-                        ds_max=2 * (RANGE[1] - RANGE[0]) / points, max_points=20_000)  # fmt: skip
+    # shooting against harmonic balance from its states
     errs = []
-    for k in _picks(len(sb.values)):
-        s = system.with_values(omega=float(sb.values[k]))
-        x0 = np.asarray(sb.states[k])
+    c1 = sh.curves[0]
+    for k in _picks(len(c1.values)):
+        s = system.with_values(omega=float(c1.values[k]))
+        x0 = c1.states[k]
         try:
             sol = harmonic_balance(s, x0, harmonics=32, stability=False)
             errs.append(float(np.max(np.abs(sol.state(0.0) - x0))))
         except Exception:  # noqa: BLE001
             continue
-    out["shooting"] = {"median_s": t_sh, "curve_points": len(sh.curves[0].values),
-                       "folds": [e["omega"] for e in sh.curves[0].events if e["kind"] == "fold"],
+    out["shooting"] = {"median_s": t_sh, "curve_points": len(c1.values),
+                       "folds": [e["omega"] for e in c1.events if e["kind"] == "fold"],
                        "error": max(errs) if errs else None, "checked": len(errs)}  # fmt: skip
     # integration: mean and RMS against harmonic balance from the Poincare state
     errs = []

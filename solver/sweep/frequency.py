@@ -36,6 +36,9 @@ class Curve:
     events: tuple = ()
     wall_time: float = 0.0
     details: dict = field(default_factory=dict)
+    # the state at tau = 0 (mod n T) of each point (harmonic balance, shooting), kept for
+    # checks and restarts; not written to the result files
+    states: tuple = ()
 
     def records(self) -> list[dict]:
         out = []
@@ -187,6 +190,7 @@ def _hb_curve(system, parameter, start, stop, harmonics, n, ds) -> Curve:
             "largest_tail_share": tail,
             "notes": list(br.notes),
         },  # fmt: skip
+        tuple(br._problem().time_series(pt.coefficients, np.zeros(1))[:, 0] for pt in br.points),
     )
 
 
@@ -222,6 +226,7 @@ def _shooting_curve(system, parameter, start, stop, n, ds, guess) -> Curve:
         events,
         time.perf_counter() - started,
         {"message": br.message},
+        tuple(np.asarray(x, float) for x in br.states),
     )
 
 
