@@ -639,14 +639,7 @@ static int gs_lockstep(int method, int npts, int group, const double *P, const d
                     gs_write_sample(OUT, n_stops, g0, n, next_out++, Y, alive, 0);
                 continue;
             }
-            if (OUT) {
-                const int n_out = n_stops;
-                for (int j = 0; j < n; ++j) {
-                    double *out = OUT + ((long)(g0 + j) * n_out + ko) * GS_NX;
-                    const int ok = alive[j] && group_ok;
-                    for (int i = 0; i < GS_NX; ++i) out[i] = ok ? Y[i * n + j] : NAN;
-                }
-            }
+            if (OUT) gs_write_sample(OUT, n_stops, g0, n, ko, Y, alive, group_ok);
             if (!m) continue;
             if (ko >= m->first_kept) {
                 if (ko == m->first_kept) gs_extremes(Y, n, g0, alive, m);
