@@ -44,8 +44,14 @@ def load_toml(path: Path) -> dict[str, Any]:
         text = Path(path).read_text(encoding="utf-8")
     except FileNotFoundError:
         raise InputError(str(path), "", "file not found; give the path of a .toml file") from None
+    except IsADirectoryError:
+        raise InputError(str(path), "", "is a folder; give the path of a .toml file") from None
     except OSError as err:
         raise InputError(str(path), "", f"cannot be read ({err.strerror})") from None
+    except UnicodeDecodeError as err:
+        raise InputError(
+            str(path), "", f"is not UTF-8 text (byte {err.start}); save it as UTF-8"
+        ) from None
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:

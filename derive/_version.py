@@ -1,3 +1,9 @@
 """The generator's version (written into every input hash); imports nothing."""
 
 __version__ = "0.1.0"
+
+# The emitted module's format: bump it whenever the generated code changes for the same
+# inputs (a new table, a new check), so that models derived into the cache before the
+# change are derived again instead of being loaded stale.  2: parameter limits and the
+# stiffness-sign check in parameters() (issue 14).
+EMITTED_FORMAT = 2

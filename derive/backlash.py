@@ -210,6 +210,12 @@ BACKLASH_MODELS = {
 _MAX_SAMPLES = 1_000_000
 
 
+# The one rule for the fit's order and range (the scene's backlash_order and
+# backlash_range, the backlash command's --order and --range).
+MAX_ORDER = 31
+MAX_RANGE = 100.0
+
+
 def fit_dead_zone(
     order: int = 7, fit_range: float = 3.0, step: float | None = 0.01
 ) -> PolynomialFit:
@@ -228,10 +234,15 @@ def fit_dead_zone(
     (601 samples) give ``0.0017 x^7 - 0.0366 x^5 + 0.2833 x^3 - 0.1555 x`` to its
     printed four decimals.
     """
-    if not (isinstance(order, int) and order >= 1 and order % 2 == 1):
-        raise ValueError(f"order must be an odd whole number >= 1, got {order!r}")
-    if not (math.isfinite(fit_range) and fit_range > 1.0):
-        raise ValueError(f"range must be > 1 (it must contain the backlash), got {fit_range}")
+    if not (isinstance(order, int) and 1 <= order <= MAX_ORDER and order % 2 == 1):
+        raise ValueError(
+            f"order must be an odd whole number from 1 to {MAX_ORDER}, got {order!r} (higher "
+            "orders swing between the samples and lose every digit in floating point)"
+        )
+    if not (math.isfinite(fit_range) and 1.0 < fit_range <= MAX_RANGE):
+        raise ValueError(
+            f"range must be in (1, {MAX_RANGE:g}] (it must contain the backlash), got {fit_range}"
+        )
     powers = range(1, order + 1, 2)
     a = Fraction(fit_range)  # exact: the float the caller gave
     if step is None:

@@ -22,6 +22,7 @@ from sympy.printing.str import StrPrinter
 
 from .emit_c import c_source
 from .model import Model, operation_count  # operation_count re-exported
+from .scene import PARAMETER_LIMITS
 
 __all__ = ["CodePrinter", "emit_module", "operation_count", "write_atomic"]
 
@@ -95,6 +96,19 @@ def _body(model: Model, outputs, printer: CodePrinter, indent: str = "    ") -> 
     for sym, expr in replacements:
         lines.append(f"{indent}{sym.name} = {printer.doprint(expr)}")
     return lines, [printer.doprint(e) for e in reduced]
+
+
+def _stiffness_terms(names) -> dict:
+    """``{coordinate: ((kc index, ks index, order), ...)}`` from the parameter names
+    ``kc_<coordinate>_<order>`` and ``ks_<coordinate>_<order>``."""
+    import re
+
+    out: dict = {}
+    for i, name in enumerate(names):
+        m = re.fullmatch(r"kc_(.+)_(\d+)", name)
+        if m and f"ks_{m[1]}_{m[2]}" in names:
+            out.setdefault(m[1], []).append((i, names.index(f"ks_{m[1]}_{m[2]}"), int(m[2])))
+    return {c: tuple(t) for c, t in out.items()}
 
 
 def _docstring(model: Model, command: str) -> str:
@@ -198,6 +212,14 @@ def emit_module(model: Model, command: str) -> str:
         "SCENE_PARAMETERS = {"
         + ", ".join(f"{k!r}: {fmt(v)}" for k, v in model.scene_parameters.items())
         + "}",
+        "# (low, high, low excluded): derive/scene.py PARAMETER_LIMITS",
+        "SCENE_PARAMETER_LIMITS = {"
+        + ", ".join(
+            f"{k!r}: {v!r}" for k, v in PARAMETER_LIMITS.items() if k in model.scene_parameters
+        )  # fmt: skip
+        + "}",
+        "# mesh coordinate: ((cos index, sin index, harmonic), ...) of k_hat = 1 + sum ...",
+        f"STIFFNESS_TERMS = {_stiffness_terms(model.parameter_names)!r}",
         f"OPERATIONS = {model.operations!r}",
         "",
         "# What a solver needs to know about this model, as plain data (Model.contract in",
@@ -239,6 +261,15 @@ def emit_module(model: Model, command: str) -> str:
         "                       f'{list(PARAMETERS)}')",
         "    s = dict(SCENE_PARAMETERS)",
         "    s.update((k, float(v)) for k, v in values.items() if k in SCENE_PARAMETERS)",
+        "    for k, v in s.items():",
+        "        if not np.isfinite(v):",
+        "            raise ValueError(f'{k} = {v} is not a finite number')",
+        "        if k in SCENE_PARAMETER_LIMITS:",
+        "            low, high, low_open = SCENE_PARAMETER_LIMITS[k]",
+        "            if v < low or (low_open and v == low) or (high is not None and v > high):",
+        "                rule = f'in [{low:g}, {high:g}]' if high is not None else (",
+        "                    f'> {low:g}' if low_open else f'>= {low:g}')",
+        "                raise ValueError(f'{k} must be {rule}, got {v:g}')",
         "    p = list(DEFAULTS)",
         *(
             f"    p[{model.parameter_names.index(k)}] = {src}  # {k}"
@@ -247,7 +278,24 @@ def emit_module(model: Model, command: str) -> str:
         "    for k, v in values.items():",
         "        if k in PARAMETERS and k not in SCENE_PARAMETERS:",
         "            p[PARAMETERS.index(k)] = float(v)",
+        "    _check_stiffness(p)",
         "    return np.array(p, dtype=float)",
+        "",
+        "",
+        "def _check_stiffness(p):",
+        '    """A mesh stiffness k_hat(tau) that is negative somewhere in its cycle is not',
+        '    physical: refuse it with the value (721 phases per mesh period)."""',
+        "    theta = np.linspace(0.0, 2.0 * np.pi, 721)",
+        "    for c, terms in STIFFNESS_TERMS.items():",
+        "        k = 1.0 + sum(p[i] * np.cos(n * theta) + p[j] * np.sin(n * theta)",
+        "                      for i, j, n in terms)",
+        "        if np.min(k) <= 0.0:",
+        "            m = int(np.argmin(k))",
+        "            raise ValueError(",
+        "                f'the stiffness of mesh {c} falls to {k[m]:.3g} times its mean at mesh '",
+        "                f'phase {np.degrees(theta[m]):.0f} deg (harmonics '",
+        "                + ', '.join(PARAMETERS[i][3:] for i, _, _ in terms)",
+        "                + '): a negative stiffness is not physical; use smaller harmonics')",
         "",
         "",
         "def jacobian(tau, x, p):",

@@ -33,7 +33,7 @@ from functools import cached_property
 import sympy as sp
 
 from ._input import InputError, expression_source
-from ._version import __version__
+from ._version import EMITTED_FORMAT, __version__
 from .contract import CONTRACT_FORMAT, model_contract
 from .equations import derive_equations
 from .nondim import NonDim, nondimensionalise
@@ -127,6 +127,7 @@ def inputs_hash(scene: Scene) -> str:
 
     payload = {
         "gearsym": __version__,
+        "format": EMITTED_FORMAT,
         "sympy": sp.__version__,
         "parameters": scene.parameters,
         "kind": scene.kind,

@@ -118,15 +118,18 @@ class Scene:
 
 
 def _polynomial(t: Table) -> Backlash:
-    order = t.integer("backlash_order", 7, low=1, high=31)
+    order = t.integer("backlash_order", 7)
     if order % 2 == 0:
         raise t.error("backlash_order", f"must be odd (the dead zone is odd), got {order}")
-    fit_range = t.number("backlash_range", 3.0, low=1.0, low_open=True, high=100.0)
+    fit_range = t.number("backlash_range", 3.0)
     step = t.number("backlash_step", 0.01, low=0.0)
     try:
         return fit_dead_zone(order, fit_range, step if step > 0 else None)
     except ValueError as err:
-        raise t.error("backlash_step", str(err)) from None
+        key = {"order": "backlash_order", "range": "backlash_range"}.get(
+            str(err).split(" ", 1)[0], "backlash_step"
+        )
+        raise t.error(key, str(err)) from None
 
 
 # Registry: backlash kind -> (the keys it reads, how it is built from the [features] table).
@@ -334,11 +337,29 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
     )
 
 
+# The one rule per scene parameter: (low, high, low excluded).  The scene file is checked
+# here; the generated module carries the same table (SCENE_PARAMETER_LIMITS, emit.py) and
+# checks every value that reaches parameters(): --set, sweep ranges, map axes, continuation.
+PARAMETER_LIMITS = {"omega": (0.0, None, True), "damping_ratio": (0.0, 1.0, False)}
+
+
+def limit_text(key: str, value: float) -> str | None:
+    """Why ``value`` is not allowed for scene parameter ``key``, or None."""
+    if key not in PARAMETER_LIMITS:
+        return None
+    low, high, low_open = PARAMETER_LIMITS[key]
+    if high is None:
+        ok = value > low if low_open else value >= low
+        rule = f"{'>' if low_open else '>='} {low:g}"
+    else:
+        ok, rule = low <= value <= high, f"in [{low:g}, {high:g}]"
+    return None if ok else f"must be {rule}, got {value:g}"
+
+
 def _check_parameters(t: Table, parameters: dict[str, float]) -> None:
-    if "omega" in parameters and not parameters["omega"] > 0:
-        raise t.error("omega", f"must be > 0, got {parameters['omega']:g}")
-    if not 0 <= parameters["damping_ratio"] <= 1:
-        raise t.error("damping_ratio", f"must be in [0, 1], got {parameters['damping_ratio']:g}")
+    for key, value in parameters.items():
+        if (why := limit_text(key, value)) is not None:
+            raise t.error(key, why)
 
 
 def load_target(path: Path | str, overrides: dict[str, float] | None = None) -> Scene:
