@@ -26,7 +26,6 @@ class Spectrum:
     unit tau.
     """
 
-    frequency: np.ndarray
     amplitude: np.ndarray
     omega: float
     window: str
@@ -36,6 +35,12 @@ class Spectrum:
     @property
     def resolution(self) -> float:
         return 2 * np.pi / self.duration
+
+    @property
+    def frequency(self) -> np.ndarray:
+        """The bins' frequencies (made on demand: a long run's would be as big as its
+        amplitudes)."""
+        return np.arange(self.amplitude.size) * self.resolution
 
     def peaks(self, count: int = 5, floor: float = 1e-3) -> list[dict]:
         """Largest local maxima above ``floor`` times the highest one."""
@@ -48,11 +53,11 @@ class Spectrum:
         idx = idx[np.argsort(a[idx])[::-1][:count]]
         return [
             {
-                "frequency": float(self.frequency[k]),
-                "per_omega": float(self.frequency[k] / self.omega),
+                "frequency": float(k * self.resolution),
+                "per_omega": float(k * self.resolution / self.omega),
                 "amplitude": float(a[k]),
             }
-            for k in sorted(idx, key=lambda k: self.frequency[k])
+            for k in sorted(idx)
         ]
 
     def describe(self) -> dict:
@@ -83,13 +88,23 @@ def spectrum(tr: Trajectory, state: str) -> Spectrum:
     y = tr.coordinate(state)
     dt = tr.period / tr.samples_per_period
     if not np.all(np.isfinite(y)):
-        empty = np.zeros(0)
-        return Spectrum(empty, empty, tr.system.omega, "hann", 0, y.size * dt)
+        return Spectrum(np.zeros(0), tr.system.omega, "hann", 0, y.size * dt)
     n = y.size
-    w, w_sum = _hann(n)
-    amp = 2.0 * np.abs(np.fft.rfft((y - y.mean()) * w)) / w_sum
-    freq = 2 * np.pi * np.fft.rfftfreq(n, dt)
-    return Spectrum(freq, amp, tr.system.omega, "hann", n, n * dt)
+    z = y - y.mean()
+    if n <= _CACHED:  # a sweep's points share one cached window
+        w, w_sum = _hann(n)
+        z *= w
+    else:  # a long run's window is applied block by block: no second signal-sized array
+        for k0 in range(0, n, _CACHED):
+            k = np.arange(k0, min(k0 + _CACHED, n))
+            z[k0 : k0 + k.size] *= 0.5 - 0.5 * np.cos(2 * np.pi * k / n)
+        w_sum = n / 2.0  # the periodic Hann window's sum
+    amp = np.abs(np.fft.rfft(z))
+    amp *= 2.0 / w_sum
+    return Spectrum(amp, tr.system.omega, "hann", n, n * dt)
+
+
+_CACHED = 1 << 20
 
 
 def extremes(tr: Trajectory) -> dict:

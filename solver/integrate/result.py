@@ -60,9 +60,10 @@ def first_exit(system, t, x) -> tuple | None:
         return None
     idx = [i for i, _ in bounds]
     a = np.array([b for _, b in bounds])[:, None]
-    out = np.abs(x[idx]) > a * (1 + 1e-12)
-    if not np.any(out):
-        return None
-    k = int(np.argmax(np.any(out, axis=0)))
-    j = int(np.argmax(out[:, k]))
-    return float(t[k]), system.states[idx[j]], float(x[idx[j], k])
+    for k0 in range(0, x.shape[1], 1 << 16):  # blocks: small temporaries on long runs
+        out = np.abs(x[idx, k0 : k0 + (1 << 16)]) > a * (1 + 1e-12)
+        if np.any(out):
+            k = int(np.argmax(np.any(out, axis=0)))
+            j = int(np.argmax(out[:, k]))
+            return float(t[k0 + k]), system.states[idx[j]], float(x[idx[j], k0 + k])
+    return None

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .._memory import require
 from ..system import System
 from .events import SimulationError
 from .methods import METHODS, get_method
@@ -177,6 +178,7 @@ def _check(system: System, req: Request) -> None:
             f"{f'{unit} x ' if unit > 1 else ''}samples_per_period ({samples_per_period}) "
             f"for '{method}', so that every sample interval holds whole steps"
         )
+    check_samples(periods, samples_per_period, system.n)
     if not math.isfinite(system.omega) or system.omega <= 0:
         raise ValueError(f"omega must be a positive number, got {system.omega:g}")
     if record.family != "casadi" and rtol < 100 * np.finfo(float).eps:
@@ -287,9 +289,13 @@ def _request(system, x0, method, rtol, atol, transient, periods, samples_per_per
         on_invalid=on_invalid,
     )
     _check(system, req)
-    x0 = default_initial_state(system) if x0 is None else np.asarray(x0, dtype=float)
+    if x0 is None:
+        check_start(system)
+        x0 = default_initial_state(system)
+    x0 = np.asarray(x0, dtype=float)
     if x0.shape != (system.n,) or not np.all(np.isfinite(x0)):
         raise ValueError(f"x0 must be {system.n} finite numbers ({', '.join(system.states)})")
+    check_start(system, x0)
     T = system.period
     t_start = t0 + transient * T
     grid = t_start + T * np.arange(periods * samples_per_period + 1) / samples_per_period
@@ -351,6 +357,52 @@ def _backend(family: str):
     return run
 
 
+def check_samples(periods: int, samples_per_period: int, n: int) -> None:
+    """Refuse a run whose samples would not fit in memory, before allocating them: the
+    samples, the run's own output and the analysis' copies, about four times the
+    samples of ``n`` states and the times."""
+    require(
+        32.0 * (periods * samples_per_period + 1) * (n + 1),
+        f"{periods} sampled periods at {samples_per_period} samples each",
+        "sample fewer periods",
+    )
+
+
+def check_start(system: System, x0=None) -> None:
+    """Refuse a start outside the force law's valid range (``x0``, or the default start
+    the loads give): a run from there would be reported as diverging, not as a state the
+    model does not describe."""
+    given = x0 is not None
+    x0 = default_initial_state(system) if x0 is None else np.asarray(x0, dtype=float)
+    for i, bound in system.contract.valid_bounds():
+        if abs(x0[i]) > bound:
+            state = system.states[i]
+            why = (
+                "the initial state"
+                if given
+                else f"the start pressed in by the static load ({state} = 1 + load)"
+            )
+            raise ValueError(
+                f"{why} {state} = {x0[i]:.6g} is outside the backlash model's valid range "
+                f"|{state}| <= {bound:g}; lower the load, start inside the range, or use "
+                "backlash = 'dead-zone' (valid everywhere)"
+            )
+
+
+SAMPLE_BUDGET = 1 << 20  # samples per state a command keeps of one run (8 MiB each)
+
+
+def samples_for(periods: int, wanted: int = 64) -> int:
+    """Samples per period for a run of ``periods`` sampled periods: ``wanted`` while the
+    run keeps at most :data:`SAMPLE_BUDGET` samples, else the largest power of two that
+    fits, down to 8 (a spectrum still reaching 4 omega): 20,000 periods take 32, 100,000
+    take 8."""
+    spp = wanted
+    while spp > 8 and periods * spp > SAMPLE_BUDGET:
+        spp //= 2
+    return spp
+
+
 def default_initial_state(system: System) -> np.ndarray:
     """Each coordinate pressed into contact by its static load (past the contact edge on
     the load's side by the load, ``u = 1 + f`` for a forward load), at rest: close to the
@@ -369,8 +421,14 @@ def default_initial_state(system: System) -> np.ndarray:
 def _check_bound(t, x, status, message, bound):
     if status != "ok":
         return status, message
-    bad = ~np.all(np.isfinite(x) & (np.abs(x) <= bound), axis=0)
-    if np.any(bad):
-        k = int(np.argmax(bad))
-        return "divergent", f"a state passed |x| = {bound:g} by tau = {t[k]:.6g}"
+    # In blocks of samples: a long run's temporaries stay small (issue 14).
+    for k0 in range(0, x.shape[1], _BLOCK):
+        xb = x[:, k0 : k0 + _BLOCK]
+        bad = ~np.all(np.isfinite(xb) & (np.abs(xb) <= bound), axis=0)
+        if np.any(bad):
+            k = k0 + int(np.argmax(bad))
+            return "divergent", f"a state passed |x| = {bound:g} by tau = {t[k]:.6g}"
     return status, message
+
+
+_BLOCK = 1 << 16

@@ -19,7 +19,7 @@ import numpy as np
 from ..analysis.point import analyse_point, analyse_trajectory
 from ..integrate import SimulationError
 from ..integrate.methods import get_method
-from ..integrate.simulate import fastest_method, simulate_many
+from ..integrate.simulate import check_start, fastest_method, simulate_many
 from ..system import System
 from .points import SweepPoint
 from .store import point_text, store_chunk, store_point
@@ -28,6 +28,7 @@ __all__ = ["Chain", "ChainDone", "checked_values", "module_ref", "plan", "run_ch
 
 # Points of one lockstep chunk: the engine's group size (``run_batch(group=64)``).
 CHUNK = 64
+CHUNK_BYTES = 256 << 20  # and at most this much of samples per chunk (issue 14)
 SPREAD = 4
 _FAILURES = (SimulationError, ValueError, FloatingPointError)
 _SIMULATE = ("method", "rtol", "atol", "transient", "periods", "samples_per_period",
@@ -74,15 +75,22 @@ def module_ref(system: System) -> str:
     return system.module.__file__
 
 
-def checked_values(system: System, parameter: str, values) -> np.ndarray:
+def checked_values(system: System, parameter: str, values, x0=None) -> np.ndarray:
     """The sweep values as an array, after checking them and the parameter's name."""
     values = np.asarray(values, dtype=float)
     if values.ndim != 1 or values.size == 0 or not np.all(np.isfinite(values)):
         raise ValueError("sweep values must be a non-empty list of finite numbers")
-    try:
-        system.with_values(**{parameter: float(values[0])})  # an unknown name fails here
-    except KeyError as err:
-        raise ValueError(err.args[0]) from None
+    # Every value once through the model's own checks (an unknown name, a limit, a
+    # negative stiffness) and, from the default start, the force law's valid range.
+    for v in values[:1] if values.size > 4096 else values:
+        try:
+            point = system.with_values(**{parameter: float(v)})
+            if x0 is None:
+                check_start(point)
+        except KeyError as err:
+            raise ValueError(err.args[0]) from None
+        except ValueError as err:
+            raise ValueError(f"{parameter} = {v:g}: {err}") from None
     return values
 
 
@@ -168,7 +176,7 @@ def plan(
     store: Path | None = None,
 ) -> list[Chain]:
     """The chains of a sweep, without the points already ``done`` (from the store)."""
-    values = checked_values(system, parameter, values)
+    values = checked_values(system, parameter, values, x0)
     order = [float(v) for v in (values[::-1] if backward else values)]
     x0 = None if x0 is None else [float(v) for v in x0]
     done = done or {}
@@ -195,7 +203,10 @@ def plan(
     # number of points alone (not from the executor, the machine or what a resumed store
     # holds), so that a sweep's results are the same bits whichever way it runs; a
     # resumed sweep runs the chunks that are not done.
-    count = -(-max(1, -(-len(order) // CHUNK)) // SPREAD) * SPREAD
+    # A chunk's samples stay within CHUNK_BYTES: long runs take fewer points per chunk.
+    samples = settings.get("periods", 100) * settings.get("samples_per_period", 64) + 1
+    size = max(1, min(CHUNK, CHUNK_BYTES // (8 * system.n * samples)))
+    count = -(-max(1, -(-len(order) // size)) // SPREAD) * SPREAD
     chunks = np.array_split(np.arange(len(order)), min(count, len(order)))
     chunks = [c for c in chunks if c.size and any(int(i) not in done for i in c)]
     return [

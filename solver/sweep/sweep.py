@@ -109,7 +109,7 @@ def sweep(
     """
     direction = ("backward" if backward else "forward") if continuation else "independent"
     x0_list = None if x0 is None else [float(v) for v in x0]
-    values = checked_values(system, parameter, values)  # before any folder is created
+    values = checked_values(system, parameter, values, x0)  # before any folder is created
     done: dict[int, SweepPoint] = {}
     texts: dict[int, str] = {}  # the points' stored JSON, for the sweep's file
     if store is not None:

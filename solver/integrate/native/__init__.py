@@ -83,7 +83,8 @@ def _options(req: Request) -> dict:
 
 
 def _as_run(res, i: int, req: Request) -> Run:
-    x = res.x[i].T.copy()
+    # A view (states x samples) of the engine's output: no second copy of a long run.
+    x = res.x[i].T
     status = res.status[i]
     nfev, nsteps = int(res.nfev[i]), int(res.nsteps[i])
     if status == "ok":
