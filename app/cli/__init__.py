@@ -25,19 +25,21 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 from . import atlas, derive, orbits, point, response, study  # noqa: E402
-from ._common import Fail  # noqa: E402
+from ._common import Fail, OneLineParser, RunFailed, out_folder  # noqa: E402
 
 __all__ = ["main"]
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="gearsym", description="Gear-train nonlinear dynamics: derive, generate code, analyse."
     )
     parser.add_argument(
         "--debug", action="store_true", help="show full tracebacks instead of one-line errors"
     )
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    sub = parser.add_subparsers(
+        dest="command", required=True, metavar="COMMAND", parser_class=OneLineParser
+    )
     for group in (derive, point, orbits, atlas, response, study):
         group.register(sub)
     return parser
@@ -55,9 +57,26 @@ def main(argv: list[str] | None = None) -> int:
     from gearsym.derive import InputError
 
     try:
+        if getattr(args, "out", None):
+            out_folder(args.out)
         return args.func(args)
     except (InputError, Fail) as err:
         print(f"gearsym: error: {err}", file=sys.stderr)
+        return 2
+    except RunFailed as err:
+        print(f"gearsym: run failed: {err}", file=sys.stderr)
+        return 3
+    except OSError as err:
+        # A file-system failure the checks before computing could not foresee (the disk
+        # filling up, say): the file and the reason; what was stored so far stays.
+        where = err.filename or "a file"
+        print(f"gearsym: error: cannot write or read {where} ({err.strerror or err}); "
+              "free space or choose another folder, and run again (finished work is kept)",
+              file=sys.stderr)  # fmt: skip
+        return 2
+    except MemoryError:
+        print("gearsym: error: out of memory; ask for fewer periods, points or harmonics",
+              file=sys.stderr)  # fmt: skip
         return 2
     except KeyboardInterrupt:
         print("gearsym: interrupted", file=sys.stderr)

@@ -3,18 +3,27 @@ analysis options, the scene resolver's error wrapping and JSON output."""
 
 from __future__ import annotations
 
+import argparse
 import math
+import os
+import sys
 from pathlib import Path
 
 import numpy as np
 
 __all__ = [
     "Fail",
+    "OneLineParser",
+    "RunFailed",
+    "figure_file",
+    "out_folder",
     "analysis_options",
     "analysis_settings",
     "orbit_guess",
     "parse_range",
     "parse_set",
+    "refuse_conflicts",
+    "require",
     "system_of",
     "write_json",
 ]
@@ -22,6 +31,75 @@ __all__ = [
 
 class Fail(Exception):
     """A user-facing failure: one line, exit code 2."""
+
+
+class RunFailed(Exception):
+    """A run that ended invalid, divergent or failed numerically: one line, exit code 3."""
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """argparse's parser whose refusals are one line (no usage block), exit code 2."""
+
+    def error(self, message: str):
+        import difflib
+        import re
+
+        option = re.search(r"argument (--[\w-]+)", message)
+        if "expected one argument" in message and option:
+            message += f" (write {option[1]}=VALUE when the value starts with '-')"
+        if message.startswith("unrecognized arguments: "):
+            known = sorted(self._options())
+            for word in message.split(": ", 1)[1].split():
+                near = difflib.get_close_matches(word.split("=")[0], known, n=1)
+                if near:
+                    message += f" (did you mean {near[0]}?)"
+                    break
+        self.exit(2, f"{self.prog}: error: {message}; see `{self.prog} --help`\n")
+
+    def _options(self) -> set[str]:
+        """Every option string of this parser and its commands' parsers."""
+        out = set()
+        for action in self._actions:
+            out.update(s for s in action.option_strings if s.startswith("--"))
+            choices = getattr(action, "choices", None)
+            for sub in choices.values() if isinstance(choices, dict) else ():
+                if isinstance(sub, argparse.ArgumentParser):
+                    out |= OneLineParser._options(sub)
+        return out
+
+
+def out_folder(path, option: str = "--out") -> Path:
+    """The output folder ``path``, created and shown writable before anything is
+    computed; otherwise a :class:`Fail` naming it and the fix."""
+    out = Path(path)
+    fix = f"choose another folder with {option}"
+    if out.exists() and not out.is_dir():
+        kind = "a file" if out.is_file() else "not a folder"
+        raise Fail(f"{option} {out}: is {kind}; {fix}")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / f".gearsym-write-test-{os.getpid()}"
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as err:
+        raise Fail(f"{option} {out}: cannot write there ({err.strerror}); {fix}") from None
+    return out
+
+
+def figure_file(path, option: str) -> Path:
+    """A figure's file name: a format matplotlib writes and a writable folder."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    out = Path(path)
+    formats = FigureCanvasAgg.get_supported_filetypes()
+    suffix = out.suffix.lstrip(".").lower()
+    if out.is_dir() or not suffix:
+        raise Fail(f"{option} {out}: give a file name with a format, for example k.png")
+    if suffix not in formats:
+        raise Fail(f"{option} {out}: '.{suffix}' is not a figure format; use one of "
+                   + ", ".join(sorted(formats)))  # fmt: skip
+    out_folder(out.parent if str(out.parent) else ".", option)
+    return out
 
 
 def parse_set(items: list[str]) -> dict[str, float | str]:
@@ -34,6 +112,8 @@ def parse_set(items: list[str]) -> dict[str, float | str]:
         key, sep, value = item.partition("=")
         if not sep or not key:
             raise Fail(f"--set {item}: expected key=value, for example --set lambda=0.5")
+        if key.strip() in out:
+            raise Fail(f"--set {item}: {key.strip()} is set twice; give it once")
         if key.strip() in CHOICES:
             if not value.strip():
                 raise Fail(f"--set {item}: give a value ({CHOICES[key.strip()]})")
@@ -65,6 +145,9 @@ def parse_range(text: str):
         raise Fail(f"--range {text}: START and STOP must be finite numbers")
     if num < 1 or (num == 1 and start != stop):
         raise Fail(f"--range {text}: NUM must be >= 2, or 1 with START equal to STOP")
+    if num > 1 and start == stop:
+        raise Fail(f"--range {text}: START equals STOP, so all {num} values are the same; "
+                   f"give different ends, or {start:g}:{stop:g}:1")  # fmt: skip
     return np.linspace(start, stop, num)
 
 
@@ -87,7 +170,31 @@ def system_of(scene_arg: str, sets: dict[str, float]):
         more = f"{hint}; open values (derived anew): {', '.join(sorted(OPEN_VALUE_BASES))}"
         raise Fail(f"--set: {err.args[0]}{more}") from None
     except ValueError as err:
-        raise Fail(f"--set: {err}") from None
+        given = " ".join(f"{k}={v}" for k, v in rest.items())
+        raise Fail(f"--set {given}: {err}" if given else f"{scene_arg}: {err}") from None
+
+
+def require(nbytes: float, what: str, fix: str) -> None:
+    """:func:`gearsym.solver._memory.require` as a one-line failure."""
+    from gearsym.solver._memory import MemoryRefused
+    from gearsym.solver._memory import require as _require
+
+    try:
+        _require(nbytes, what, fix)
+    except MemoryRefused as err:
+        raise Fail(str(err)) from None
+
+
+def refuse_conflicts(args, varied: list[str], option: str) -> None:
+    """Options that contradict each other, refused instead of one silently winning:
+    ``--set`` of a parameter the command varies, and ``--scheduler`` without dask."""
+    for item in getattr(args, "set", None) or []:
+        key = item.partition("=")[0].strip()
+        if key in varied:
+            raise Fail(f"--set {item} contradicts {option}, which varies {key}; drop one")
+    if getattr(args, "scheduler", None) and getattr(args, "executor", "dask") != "dask":
+        raise Fail(f"--scheduler {args.scheduler} needs --executor dask (not "
+                   f"'{args.executor}'); drop --scheduler or add --executor dask")  # fmt: skip
 
 
 def analysis_settings(args) -> dict:
@@ -95,15 +202,31 @@ def analysis_settings(args) -> dict:
         value = getattr(args, name)
         if not (value > 0 and math.isfinite(value)):
             raise Fail(f"--{name} must be a positive number, got {value}")
-    for name in ("transient", "periods"):
-        if getattr(args, name) < (0 if name == "transient" else 1):
-            raise Fail(f"--{name} must be a whole number >= {0 if name == 'transient' else 1}")
+    for name, low in (("transient", 0), ("periods", 1), ("lyapunov_periods", 0)):
+        if getattr(args, name) < low:
+            option = "--" + name.replace("_", "-")
+            raise Fail(f"{option} must be a whole number >= {low}, got {getattr(args, name)}")
+    if args.rtol > 0.1:
+        raise Fail(f"--rtol {args.rtol:g}: a relative tolerance above 0.1 controls nothing; "
+                   "give 1e-3 or less")  # fmt: skip
+    from gearsym.solver.integrate.simulate import check_samples, samples_for
+
+    spp = samples_for(args.periods)
+    try:
+        check_samples(args.periods, spp, 8)
+    except ValueError as err:
+        raise Fail(f"--periods {args.periods}: {err}") from None
+    if spp < 64 and not getattr(args, "quiet", False):
+        print(f"gearsym: note: {args.periods} periods are sampled {spp} times each (not 64) "
+              f"to bound memory; spectra reach {spp // 2} times the excitation frequency",
+              file=sys.stderr)  # fmt: skip
     return dict(
         method=args.method,
         rtol=args.rtol,
         atol=args.atol,
         transient=args.transient,
         periods=args.periods,
+        samples_per_period=spp,
         lyapunov_periods=args.lyapunov_periods,
         on_invalid=args.on_invalid,
     )
@@ -164,8 +287,12 @@ def orbit_guess(system, n: int, settle: int):
         run = simulate(
             system, method="cvodes", transient=settle * n, periods=n, samples_per_period=1
         )
-    except (SimulationError, ValueError) as err:
-        raise Fail(f"the simulation that gives the initial guess failed: {err}") from None
+    except SimulationError as err:
+        raise RunFailed(f"the simulation that gives the initial guess failed: {err}") from None
+    except ValueError as err:
+        raise Fail(f"the simulation that gives the initial guess: {err}") from None
     if run.status != "ok":
-        raise Fail(f"the simulation that gives the initial guess ended {run.status}: {run.message}")
+        raise RunFailed(
+            f"the simulation that gives the initial guess ended {run.status}: {run.message}"
+        )
     return run.poincare[:, 0]

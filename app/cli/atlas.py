@@ -5,9 +5,8 @@ from __future__ import annotations
 import json
 import math
 import sys
-from pathlib import Path
 
-from ._common import Fail, parse_range, parse_set, system_of
+from ._common import Fail, out_folder, parse_range, parse_set, refuse_conflicts, require, system_of
 
 __all__ = ["register"]
 
@@ -154,6 +153,14 @@ def _cmd_map(args) -> int:
         )
     if not (args.rtol > 0 and args.atol > 0):
         raise Fail("--rtol and --atol must be positive numbers")
+    if args.workers is not None and args.workers < 1:
+        raise Fail(f"--workers must be >= 1, got {args.workers}")
+    refuse_conflicts(args, [xn, yn], f"--x {xn} / --y {yn}")
+    # per run: its Poincare points (4 states), its extremes and its exponent's history
+    runs = xv.size * yv.size * args.initial_states
+    require(runs * 8.0 * (4 * (args.periods + 1) + 8 + args.lyapunov_periods) * 2,
+            f"{xv.size} x {yv.size} x {args.initial_states} runs of {args.periods} periods",
+            "map fewer points, initial states or periods")  # fmt: skip
     sets = parse_set(args.set)
     box = _box(args.box)
     system = system_of(args.scene, sets)
@@ -170,16 +177,7 @@ def _cmd_map(args) -> int:
             raise Fail(f"{flag} {name}: {err.args[0]}") from None
         except ValueError as err:
             raise Fail(f"{flag} {name}: {err}") from None
-    out = Path(args.out or f"map_{system.name}_{xn}_{yn}")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        probe = out / ".write-test"
-        probe.write_text("")
-        probe.unlink()
-    except OSError as err:
-        raise Fail(
-            f"--out {out}: cannot write there ({err.strerror}); choose another folder"
-        ) from None
+    out = out_folder(args.out or f"map_{system.name}_{xn}_{yn}")
     stored = len(list((out / "store" / "columns").glob("*.json")))
     try:
         result = regime_map(

@@ -6,7 +6,7 @@ import json
 import sys
 from pathlib import Path
 
-from ._common import Fail, parse_set
+from ._common import Fail, figure_file, parse_set
 
 __all__ = ["register"]
 
@@ -59,7 +59,7 @@ def register(sub) -> None:
         "--range", type=float, default=3.0, metavar="A", help="fit on [-A, A] (default 3)"
     )
     b.add_argument(
-        "--step", type=float, default=0.01, help="spacing of the uniform samples (default 0.01)"
+        "--step", type=float, default=None, help="spacing of the uniform samples (default 0.01)"
     )
     b.add_argument("--continuous", action="store_true", help="continuous L2 fit instead of samples")
     b.add_argument("--json", action="store_true", help="print JSON")
@@ -116,9 +116,9 @@ def _cmd_derive(args) -> int:
     from gearsym.derive.scene import resolve_target
 
     if args.check:
-        if args.targets or args.set or args.out:
+        if args.targets or args.set or args.out or args.dry_run:
             raise Fail(
-                "derive --check takes no targets, --set or --out: it checks the "
+                "derive --check takes no targets, --set, --out or --dry-run: it checks the "
                 "shipped scenes and topologies"
             )
         stale = check()
@@ -212,10 +212,16 @@ def _summary(model) -> None:
 def _cmd_backlash(args) -> int:
     from gearsym.derive.backlash import fit_dead_zone
 
+    if args.continuous and args.step is not None:
+        raise Fail(f"--step {args.step:g} sets the samples of a discrete fit and --continuous "
+                   "asks for none; drop one")  # fmt: skip
+    if args.step is None:
+        args.step = 0.01
     try:
         fit = fit_dead_zone(args.order, args.range, None if args.continuous else args.step)
     except ValueError as err:
-        raise Fail(f"backlash: {err}") from None
+        option = {"order": "--order", "range": "--range"}.get(str(err).split(" ")[0], "--step")
+        raise Fail(f"backlash {option}: {err}") from None
     error = fit.max_error()
     if args.json:
         print(
@@ -266,6 +272,8 @@ def _cmd_stiffness(args) -> int:
         raise Fail(f"--slices {args.slices}: give a number of slices from 1 to 100000")
     if not 0 <= args.harmonics <= 64:
         raise Fail(f"--harmonics {args.harmonics}: give 0 to 64 harmonics")
+    if args.plot:
+        figure_file(args.plot, "--plot")
     path = resolve_target(args.target)
     data = load_toml(path)
     topology = load_scene(path).topology if "scene" in data else load_topology(path)

@@ -3,11 +3,20 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 
-from ._common import Fail, orbit_guess, parse_set, system_of, write_json
+from ._common import (
+    Fail,
+    RunFailed,
+    orbit_guess,
+    out_folder,
+    parse_set,
+    refuse_conflicts,
+    require,
+    system_of,
+    write_json,
+)
 from ._start import resolve_start, start_options
 
 __all__ = ["register"]
@@ -110,8 +119,13 @@ def _cmd_shoot(args) -> int:
         raise Fail("--period and --segments must be whole numbers >= 1")
     if args.tries < 0:
         raise Fail(f"--tries must be >= 0, got {args.tries}")
+    if args.seed is not None and args.seed < 0:
+        raise Fail(f"--seed must be a whole number >= 0, got {args.seed}")
     start = resolve_start(args)
     system = start.system
+    # Newton's matrix on all segments, dense: (n S)^2 numbers, and its factors
+    require(24.0 * (system.n * args.segments) ** 2, f"--segments {args.segments}",
+            "use fewer segments (one per period is the default; a few suffice)")  # fmt: skip
     if start.x0 is None:
         settle = 300 if args.settle is None else args.settle
         guess = orbit_guess(system, args.period, settle)
@@ -137,7 +151,7 @@ def _cmd_shoot(args) -> int:
             system, args.period, guesses, segments=args.segments, monodromy=args.monodromy
         )
     except ShootingError as err:
-        raise Fail(f"shoot: {err}; residuals {[f'{r:.2g}' for r in err.history]}") from None
+        raise RunFailed(f"shoot: {err}; residuals {[f'{r:.2g}' for r in err.history]}") from None
     orbit = found.orbit or found.lower
     data = orbit.describe()
     data["requested_period_multiple"] = args.period
@@ -157,14 +171,14 @@ def _cmd_shoot(args) -> int:
         from gearsym.solver.periodic import FlowMap, monodromy_agreement
 
         data["monodromy_agreement"] = monodromy_agreement(FlowMap(system), orbit.x0, orbit.period)
-    status = 0 if found.found else 1
+    status = 0 if found.found else 3
     if args.json:
         print(dumps(data, indent=1))
         return status
     if not found.found:
         print(
             f"no orbit of minimal period {args.period} found from {len(found.attempts)} "
-            f"guess(es); they led to the period-{orbit.n} orbit below (exit status 1)"
+            f"guess(es); they led to the period-{orbit.n} orbit below (exit status 3)"
         )
     print(
         f"{system.name}: period-{orbit.n} orbit, residual {orbit.residual:.2e} after "
@@ -218,13 +232,26 @@ def _cmd_continue(args) -> int:
         raise Fail(f"--step must be a positive number, got {args.step}")
     if args.period < 1:
         raise Fail(f"--period must be >= 1, got {args.period}")
+    if args.settle < 0:
+        raise Fail(f"--settle must be >= 0, got {args.settle}")
+    if args.from_ == args.to:
+        raise Fail(f"--to {args.to:g} equals --from: there is nothing to continue; give "
+                   "another end")  # fmt: skip
+    refuse_conflicts(args, [args.param], f"--param {args.param}")
     system = system_of(args.scene, parse_set(args.set))
-    try:
-        start = system.with_values(**{args.param: args.from_})
-    except KeyError as err:
-        raise Fail(f"--param: {err.args[0]}") from None
-    except ValueError as err:
-        raise Fail(f"--from: {err}") from None
+    from gearsym.solver.integrate.simulate import check_start
+
+    for option, value in (("--from", args.from_), ("--to", args.to)):
+        try:
+            point = system.with_values(**{args.param: value})
+            if option == "--from":
+                start = point
+                check_start(point)
+        except KeyError as err:
+            raise Fail(f"--param: {err.args[0]}") from None
+        except ValueError as err:
+            raise Fail(f"{option} {value:g}: {args.param} = {value:g}: {err}") from None
+    out = out_folder(args.out or f"continue_{system.name}_{args.param}")
     guess = orbit_guess(start, args.period, args.settle)
     try:
         branches = [
@@ -240,7 +267,7 @@ def _cmd_continue(args) -> int:
             )
         ]
     except ShootingError as err:
-        raise Fail(f"continue: the first orbit was not found: {err}") from None
+        raise RunFailed(f"continue: the first orbit was not found: {err}") from None
     except ValueError as err:
         raise Fail(f"continue: {err}") from None
     if args.switch:
@@ -260,8 +287,6 @@ def _cmd_continue(args) -> int:
                     )
                 except ShootingError as err:
                     print(f"  branch switching at {bif.value:.6g} failed: {err}")
-    out = Path(args.out or f"continue_{system.name}_{args.param}")
-    out.mkdir(parents=True, exist_ok=True)
     (out / "branches.json").write_text(
         dumps([b.describe() for b in branches], indent=1), encoding="utf-8"
     )

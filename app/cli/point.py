@@ -2,16 +2,17 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 from ._common import (
     Fail,
     analysis_options,
     analysis_settings,
+    out_folder,
     parse_range,
     parse_set,
+    refuse_conflicts,
+    require,
     system_of,
     write_json,
 )
@@ -80,7 +81,7 @@ def register(sub) -> None:
 
 def _cmd_simulate(args) -> int:
     from gearsym.solver._json import dumps
-    from gearsym.solver.analysis import analyse_point, meshing_states, spectrum
+    from gearsym.solver.analysis import analyse_point, meshing_states
     from gearsym.solver.integrate import SimulationError
 
     start = resolve_start(args)
@@ -96,10 +97,12 @@ def _cmd_simulate(args) -> int:
 
         out = write_json(args.out, "point.json", data)
         plots.point_figure(result.trajectory, out / "point.png", title=system.name)
+    tr = result.trajectory
+    # exit status 3: the run ended invalid, divergent or failed (docs/user-guide.md)
+    code = 0 if tr.status == "ok" else 3
     if args.json:
         print(dumps(data, indent=1))
-        return 0
-    tr = result.trajectory
+        return code
     print(
         f"{system.name}: {tr.method}, rtol {tr.rtol:g}, {tr.transient} + {tr.periods} periods, "
         f"{tr.wall_time:.2f} s, status {tr.status}"
@@ -123,7 +126,7 @@ def _cmd_simulate(args) -> int:
         u = tr.coordinate(c)
         u = u[np.isfinite(u)]
         low, high = (float(u.min()), float(u.max())) if u.size else (None, None)
-        peaks = ", ".join(f"{p['frequency']:.3g}" for p in spectrum(tr, c).peaks()[:4])
+        peaks = ", ".join(f"{p['frequency']:.3g}" for p in result._spectrum(c).peaks()[:4])
         line = f"  {c}: {k.motion:<15} range [{num(low)}, {num(high)}]  peaks at {peaks or 'n/a'}"
         if c in shares:
             f, s, b = (num(shares[c][key], ".2f") for key in ("forward", "separated", "backward"))
@@ -145,7 +148,7 @@ def _cmd_simulate(args) -> int:
             f"  warning: {c} = {v:.3g} at tau = {t:.6g} is outside the backlash model's "
             f"valid range |{c}| <= {system.contract.valid_range[c]:g}"
         )
-    return 0
+    return code
 
 
 def _cmd_sweep(args) -> int:
@@ -166,6 +169,14 @@ def _cmd_sweep(args) -> int:
             super().step(note)
 
     values = parse_range(args.range)
+    refuse_conflicts(args, [args.param], f"--param {args.param}")
+    if args.backward and args.independent:
+        raise Fail("--backward orders a continuation, and --independent has none; drop one")
+    settings = analysis_settings(args)
+    # each point keeps its Poincare points and a summary (about 4 KiB)
+    require(len(values) * (8.0 * 4 * args.periods + 4096) * 2,
+            f"--range {args.range}: {len(values)} points of {args.periods} periods",
+            "sweep fewer points or periods")  # fmt: skip
     from gearsym.derive.open_values import is_open_value
 
     if is_open_value(args.param):
@@ -175,7 +186,13 @@ def _cmd_sweep(args) -> int:
             "lambda=...`, or set one value with --set"
         )
     system = system_of(args.scene, parse_set(args.set))
-    out = Path(args.out or f"sweep_{system.name}_{args.param}")
+    from gearsym.solver.sweep.chains import checked_values
+
+    try:
+        checked_values(system, args.param, values)  # before the folder is made
+    except ValueError as err:
+        raise Fail(f"--param {args.param} --range {args.range}: {err}") from None
+    out = out_folder(args.out or f"sweep_{system.name}_{args.param}")
     bar = _Bar(len(values), f"{args.param}", enabled=not args.quiet)
     stored = stored_count(out / "store")
     try:
@@ -189,7 +206,7 @@ def _cmd_sweep(args) -> int:
             progress=bar,
             scheduler=args.scheduler,
             store=out / "store",
-            **analysis_settings(args),
+            **settings,
         )
     except (SimulationError, ValueError) as err:
         raise Fail(f"sweep: {err}") from None
@@ -215,5 +232,6 @@ def _cmd_sweep(args) -> int:
         print(
             f"  {len(failed)} point(s) did not finish normally (status in sweep.json): "
             + ", ".join(f"{v:g}" for v in failed[:10])
+            + " (exit status 3)"
         )
-    return 0
+    return 3 if failed else 0

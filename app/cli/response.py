@@ -6,9 +6,8 @@ from __future__ import annotations
 import json
 import math
 import sys
-from pathlib import Path
 
-from ._common import Fail, parse_set, system_of
+from ._common import Fail, out_folder, parse_set, refuse_conflicts, require, system_of
 
 __all__ = ["register"]
 
@@ -108,23 +107,18 @@ def _cmd_response(args) -> int:
         raise Fail(f"--period must be >= 1, got {args.period}")
     if args.tail is not None and not (0 < args.tail < 1):
         raise Fail(f"--tail must be a share in (0, 1), got {args.tail}")
+    refuse_conflicts(args, [name], f"--param {args.param}")
     system = system_of(args.scene, parse_set(args.set))
-    try:
-        system.parameters_with(**{name: start})
-    except KeyError as err:
-        raise Fail(f"--param {name}: {err.args[0]}") from None
-    except ValueError as err:
-        raise Fail(f"--param {args.param}: {err}") from None
-    out = Path(args.out or f"response_{system.name}")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        probe = out / ".write-test"
-        probe.write_text("", encoding="utf-8")
-        probe.unlink()
-    except OSError as err:
-        raise Fail(
-            f"--out {out}: cannot write there ({err.strerror}); choose another folder"
-        ) from None
+    for value in (start, stop):
+        try:
+            system.parameters_with(**{name: value})
+        except KeyError as err:
+            raise Fail(f"--param {name}: {err.args[0]}") from None
+        except ValueError as err:
+            raise Fail(f"--param {args.param}: {name} = {value:g}: {err}") from None
+    # the harmonic balance's Jacobian and Hill's matrix: (n (2H + 1))^2 numbers, a few times
+    size = system.n * (2 * max(args.harmonics, 8 * args.period) + 1)
+    require(32.0 * size**2, f"--harmonics {args.harmonics}", "use fewer harmonics")
     if args.settle < 1 or args.sampled < 1:
         raise Fail(f"--settle and --sampled must be >= 1, got {args.settle}, {args.sampled}")
     methods = ("hb", "shooting", "integration") if args.method == "all" else (args.method,)
@@ -133,6 +127,7 @@ def _cmd_response(args) -> int:
             f"--method integration sweeps the forcing frequency "
             f"'{system.contract.forcing_frequency}' only, not '{name}'; use hb or shooting"
         )
+    out = out_folder(args.out or f"response_{system.name}")
     try:
         resp = frequency_response(
             system, name, start, stop, points=num, methods=methods,

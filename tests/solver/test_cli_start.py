@@ -62,11 +62,11 @@ def test_shoot_reports_a_lower_period_as_what_it_is(capsys):
     # Reference: at lambda = 0.8 the attractor is the period-1 orbit (test_layers.py); a
     # period-2 search from it and one more settled guess finds no true period-2 orbit.
     argv = ["shoot", "reference-light", "--set", "lambda=0.8", "--period", "2", "--tries", "1"]
-    assert main([*argv, "--json"]) == 1
+    assert main([*argv, "--json"]) == 3  # not the period asked for: exit status 3
     data = json.loads(capsys.readouterr().out)
     assert data["found_requested_period"] is False and data["requested_period_multiple"] == 2
     assert data["period_multiple"] == 1 and data["minimal_period_multiple"] == 1
-    assert main(argv) == 1
+    assert main(argv) == 3
     out = capsys.readouterr().out
     assert out.startswith("no orbit of minimal period 2 found") and "period-1 orbit" in out
 
