@@ -6,6 +6,7 @@ import numpy as np
 
 from ._common import (
     Fail,
+    RunFailed,
     analysis_options,
     analysis_settings,
     out_folder,
@@ -88,7 +89,9 @@ def _cmd_simulate(args) -> int:
     system = start.system
     try:
         result = analyse_point(system, start.x0, **analysis_settings(args))
-    except (SimulationError, ValueError) as err:
+    except SimulationError as err:
+        raise RunFailed(f"simulate: {err}") from None
+    except ValueError as err:
         raise Fail(f"simulate: {err}") from None
     data = result.describe()
     data["initial_state"] = start.describe()

@@ -128,7 +128,7 @@ def test_phase_runs_of_three_frequencies_in_one_group_equal_scipy_in_tau():
 def test_a_diverging_point_does_not_spoil_its_group():
     module = System.load("reference_light").module
     good = module.parameters(**{"lambda": 0.8})
-    bad = module.parameters(**{"lambda": 0.8, "damping_ratio": -0.5})
+    bad = module.parameters(**{"lambda": 0.8, "xi_u_u": -0.5, "xi_v_v": -0.5})
     P = np.array([good, bad, good])
     x0 = default_initial_state(System.load("reference_light"))
     X0 = np.repeat(x0[None, :], 3, axis=0)
@@ -216,7 +216,7 @@ def test_fallback_with_workers_and_a_diverging_point(monkeypatch):
     P = np.array(
         [
             module.parameters(**{"lambda": 0.8}),
-            module.parameters(**{"lambda": 0.8, "damping_ratio": -0.5}),
+            module.parameters(**{"lambda": 0.8, "xi_u_u": -0.5, "xi_v_v": -0.5}),
         ]
     )
     x0 = default_initial_state(System.load("reference_light"))

@@ -53,9 +53,9 @@ def run(system, req: Request) -> Run:
         system.p[None, :],
         np.asarray(req.x0, float)[None, :],
         lockstep=False,
-        **_options(req),
+        **_options(req, system),
     )
-    return _as_run(res, 0, req)
+    return _as_run(res, 0, req, system)
 
 
 def run_many(systems, reqs, workers: int = 1) -> list[Run]:
@@ -64,12 +64,19 @@ def run_many(systems, reqs, workers: int = 1) -> list[Run]:
     first = reqs[0]
     P = np.array([s.p for s in systems])
     X0 = np.array([np.asarray(q.x0, float) for q in reqs])
-    res = run_batch(systems[0].module, P, X0, lockstep=True, workers=workers, **_options(first))
-    return [_as_run(res, i, q) for i, q in enumerate(reqs)]
+    res = run_batch(
+        systems[0].module, P, X0, lockstep=True, workers=workers, **_options(first, systems[0])
+    )
+    return [_as_run(res, i, q, s) for i, (q, s) in enumerate(zip(reqs, systems, strict=True))]
 
 
-def _options(req: Request) -> dict:
+def _options(req: Request, system) -> dict:
+    bounds = np.full(system.n, np.inf)
+    for i, b in system.contract.valid_bounds():
+        bounds[i] = b
     return dict(
+        valid_range=bounds,
+        stop_on_exit=req.on_invalid == "error",
         method=req.method,
         rtol=req.rtol,
         atol=req.atol,
@@ -82,15 +89,21 @@ def _options(req: Request) -> dict:
     )
 
 
-def _as_run(res, i: int, req: Request) -> Run:
+def _as_run(res, i: int, req: Request, system) -> Run:
     # A view (states x samples) of the engine's output: no second copy of a long run.
     x = res.x[i].T
     status = res.status[i]
     nfev, nsteps = int(res.nfev[i]), int(res.nsteps[i])
-    if status == "ok":
-        return Run(x, "ok", "", nfev, nsteps)
+    exit_ = None
+    if res.exits is not None and np.isfinite(res.exits[i, 0]):
+        tau, k, value = res.exits[i]
+        exit_ = (float(tau), system.states[int(k)], float(value))
+    if status in ("ok", "left the valid range"):
+        # simulate() turns an exit into status "invalid" when asked to stop there
+        return Run(x, "ok", "", nfev, nsteps, None, exit_)
     t_fail = float(res.t_fail[i])
     if status == "divergent":
         message = f"a state passed |x| = {req.bound:g} at tau = {t_fail:.6g}"
-        return Run(x, "divergent", message, nfev, nsteps)
-    return Run(x, "failed", f"{req.method} stopped at tau = {t_fail:.6g}: {status}", nfev, nsteps)
+        return Run(x, "divergent", message, nfev, nsteps, None, exit_)
+    message = f"{req.method} stopped at tau = {t_fail:.6g}: {status}"
+    return Run(x, "failed", message, nfev, nsteps, None, exit_)

@@ -23,6 +23,7 @@
 #define GS_TOO_MANY_STEPS 2
 #define GS_NOT_FINITE 3
 #define GS_STEP_TOO_SMALL 4
+#define GS_LEFT_RANGE 5 /* left the force law's valid range (maps; runs that stop there) */
 
 typedef struct {
     int ns;           /* stages */
@@ -133,11 +134,81 @@ static int gs_check(const double *y, double bound)
     return GS_OK;
 }
 
+/* ---- The force law's valid range (|x_i| <= range_i), checked at every accepted step. ----
+ * A step from (t, a0) to (t + h, a1) with slopes f0, f1 (NULL: a fixed step, straight
+ * line) left the range of state i when the cubic Hermite interpolant of the step passes
+ * |x| = r; the crossing is found by bisection on it.  A cheap bound skips almost every
+ * step: |p| <= max(|a0|, |a1|) + (4/27) h (|f0| + |f1|) on the step. */
+typedef struct {
+    const double *range; /* GS_NX bounds (INFINITY: none), or NULL */
+    int stop;            /* 1: the point stops at its first exit (status GS_LEFT_RANGE) */
+    double *exit;        /* npts x 3: tau, state index, value of the first exit (tau NaN) */
+} gs_range_t;
+
+static double gs_hermite(double a0, double a1, double f0, double f1, double h, double x)
+{
+    const double x2 = x * x, x3 = x2 * x;
+    return (2 * x3 - 3 * x2 + 1) * a0 + (x3 - 2 * x2 + x) * h * f0 + (-2 * x3 + 3 * x2) * a1 +
+           (x3 - x2) * h * f1;
+}
+
+/* Fraction x in (0, 1] of the step where |x_i| first passes r, or -1. */
+static double gs_crossing(double a0, double a1, const double *f0, const double *f1, double h,
+                          double r)
+{
+    const double d0 = f0 ? f0[0] : 0.0, d1 = f1 ? f1[0] : 0.0;
+    const double reach = fmax(fabs(a0), fabs(a1)) + (f0 ? 0.15 * fabs(h) * (fabs(d0) + fabs(d1)) : 0.0);
+    if (!(reach > r) || fabs(a0) > r) return -1.0;
+    double lo = 0.0, hi = -1.0;
+    for (int k = 1; k <= 16; ++k) {
+        const double x = k / 16.0;
+        const double v = f0 ? gs_hermite(a0, a1, d0, d1, h, x) : a0 + x * (a1 - a0);
+        if (fabs(v) > r) {
+            hi = x;
+            break;
+        }
+        lo = x;
+    }
+    if (hi < 0) return -1.0;
+    for (int it = 0; it < 50; ++it) {
+        const double x = 0.5 * (lo + hi);
+        const double v = f0 ? gs_hermite(a0, a1, d0, d1, h, x) : a0 + x * (a1 - a0);
+        if (fabs(v) > r) hi = x; else lo = x;
+    }
+    return hi;
+}
+
+/* Record point j's first exit in a step of length h from t (state i of y0 / y1 at
+ * stride `st`, slopes likewise or NULL); returns 1 when the point must stop. */
+static int gs_range_step(const gs_range_t *rg, int j, double t, double h, const double *y0,
+                         const double *y1, const double *f0, const double *f1, long st)
+{
+    if (!rg || !rg->range || !isnan(rg->exit[3 * (long)j])) return 0;
+    double best = 2.0, value = 0.0;
+    int which = -1;
+    for (int i = 0; i < GS_NX; ++i) {
+        const double r = rg->range[i];
+        if (!isfinite(r)) continue;
+        const long e = (long)i * st;
+        const double x = gs_crossing(y0[e], y1[e], f0 ? f0 + e : 0, f1 ? f1 + e : 0, h, r);
+        if (x >= 0.0 && x < best) {
+            best = x;
+            which = i;
+            value = f0 ? gs_hermite(y0[e], y1[e], f0[e], f1[e], h, x) : y0[e] + x * (y1[e] - y0[e]);
+        }
+    }
+    if (which < 0) return 0;
+    rg->exit[3 * (long)j] = t + best * h;
+    rg->exit[3 * (long)j + 1] = which;
+    rg->exit[3 * (long)j + 2] = value;
+    return rg->stop;
+}
+
 /* Advance (t, y, f) to `target` with the adaptive method. */
 static int gs_adaptive_to(const gs_tableau *T, double *t, double *y, double *f, double *h_abs,
                           double target, double rtol, double atol, const double *p,
                           const double *q, double bound, long long max_steps, long long *nfev,
-                          long long *nsteps)
+                          long long *nsteps, const gs_range_t *rg, int j)
 {
     double K[GS_MAXS + 1][GS_NX], ynew[GS_NX], scale[GS_NX];
     const double exponent = -1.0 / (T->error_order + 1);
@@ -169,9 +240,14 @@ static int gs_adaptive_to(const gs_tableau *T, double *t, double *y, double *f, 
                 const double next = hh * factor;
                 /* keep the unclipped proposal after a step shortened to hit a sample */
                 *h_abs = clipped && !rejected && h > next ? h : next;
+                const int leave = gs_range_step(rg, j, *t, hh, y, ynew, f, K[T->ns], 1);
                 *t = t_new;
                 memcpy(y, ynew, sizeof(double) * GS_NX);
                 memcpy(f, K[T->ns], sizeof(double) * GS_NX);
+                if (leave) {
+                    *nsteps += 1;
+                    return GS_LEFT_RANGE;
+                }
                 break;
             }
             double factor = 0.9 * pow(err, exponent);
@@ -206,8 +282,10 @@ static void gs_rk4_step(double t, double *y, double h, const double *p, const do
 int gs_run(int method, int npts, const double *P, const double *X0, double t0, double period,
            int n_transient, int n_sample, int spp, double rtol, double atol, int rk4_steps,
            double bound, long long max_steps, double *OUT, long long *NFEV, long long *NSTEP,
-           int *STATUS, double *TFAIL)
+           int *STATUS, double *TFAIL, const double *RANGE, int stop_exit, double *EXIT)
 {
+    const gs_range_t rg = {RANGE, stop_exit, EXIT};
+    for (long k = 0; k < 3L * npts; ++k) EXIT[k] = NAN;
     const gs_tableau *T = method == 0 ? &GS_RK45 : &GS_DOP853;
     const int n_out = n_sample * spp + 1;
     for (int i = 0; i < npts; ++i) {
@@ -241,10 +319,14 @@ int gs_run(int method, int npts, const double *P, const double *X0, double t0, d
                     ((long long)n_transient * spp + k) * (long long)rk4_steps / spp;
                 const double h = period / rk4_steps;
                 for (; done < upto; ++done) {
+                    double y_old[GS_NX];
+                    memcpy(y_old, y, sizeof(double) * GS_NX);
                     gs_rk4_step(t0 + done * h, y, h, p, q);
                     nfev += 4;
                     nsteps += 1;
                     status = gs_check(y, bound);
+                    if (status == GS_OK && gs_range_step(&rg, i, t0 + done * h, h, y_old, y, 0, 0, 1))
+                        status = GS_LEFT_RANGE;
                     if (status != GS_OK) {
                         t = t0 + (done + 1) * h;
                         break;
@@ -253,7 +335,7 @@ int gs_run(int method, int npts, const double *P, const double *X0, double t0, d
                 if (status == GS_OK) t = target;
             } else {
                 status = gs_adaptive_to(T, &t, y, f, &h_abs, target, rtol, atol, p, q, bound,
-                                        max_steps, &nfev, &nsteps);
+                                        max_steps, &nfev, &nsteps, &rg, i);
             }
             if (status != GS_OK) break;
             memcpy(out + (long)k * GS_NX, y, sizeof(double) * GS_NX);
@@ -263,7 +345,7 @@ int gs_run(int method, int npts, const double *P, const double *X0, double t0, d
         NFEV[i] = nfev;
         NSTEP[i] = nsteps;
         STATUS[i] = status;
-        TFAIL[i] = status == GS_OK ? NAN : t;
+        TFAIL[i] = status == GS_OK ? NAN : status == GS_LEFT_RANGE ? EXIT[3 * (long)i] : t;
     }
     return 0;
 }
@@ -292,8 +374,6 @@ double gs_rhs_loop(const double *p, const double *x0, long long n, double dt)
  * group stops at t0 + (first + k) period / spp, k = 0 .. n_stops - 1, and `gs_extras`
  * says what a map keeps at each stop and after each accepted step. */
 #include <stdlib.h>
-
-#define GS_LEFT_RANGE 5
 
 typedef struct {
     int n_state;         /* components of the physical state (GS_NX / 2 with a tangent) */
@@ -412,7 +492,7 @@ static int gs_lockstep(int method, int npts, int group, const double *P, const d
                        double t0, double period, int first, int n_stops, int spp, int dense,
                        int iw, double rtol, double atol, double bound, long long max_steps,
                        double *OUT, long long *NFEV, long long *NSTEP, int *STATUS,
-                       double *TFAIL, const gs_extras *m)
+                       double *TFAIL, const gs_extras *m, const gs_range_t *rg)
 {
     /* dense: plain sampled DOP853 runs take their natural steps and interpolate the
      * samples (the 7th-order dense output) instead of shortening steps to land on them */
@@ -429,10 +509,12 @@ static int gs_lockstep(int method, int npts, int group, const double *P, const d
     double *YN = malloc(sizeof(double) * GS_NX * G);
     double *K = malloc(sizeof(double) * GS_KROWS * GS_NX * G);
     double *F = use_dense ? malloc(sizeof(double) * 7 * GS_NX * G) : 0;
-    int *alive = malloc(sizeof(int) * G);
+    int *alive = malloc(sizeof(int) * G), *leave = malloc(sizeof(int) * G);
+    if (rg && rg->exit)
+        for (long k = 0; k < 3L * npts; ++k) rg->exit[k] = NAN;
     double *E5s = malloc(sizeof(double) * G), *E3s = malloc(sizeof(double) * G);
     double *growth = malloc(sizeof(double) * G);
-    if (!Pg || !Qg || !Y || !YT || !YN || !K || !alive || !E5s || !E3s || !growth ||
+    if (!Pg || !Qg || !Y || !YT || !YN || !K || !alive || !leave || !E5s || !E3s || !growth ||
         (use_dense && !F))
         return -1;
     for (int g0 = 0; g0 < npts; g0 += G) {
@@ -450,6 +532,7 @@ static int gs_lockstep(int method, int npts, int group, const double *P, const d
             for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = x0[i];
             gs_rhs(t0, x0, p, q, f);
             alive[j] = 1;
+            leave[j] = 0;
             growth[j] = 0.0;
             STATUS[g0 + j] = GS_OK;
             TFAIL[g0 + j] = NAN;
@@ -601,6 +684,14 @@ static int gs_lockstep(int method, int npts, int group, const double *P, const d
                                 next_out++;
                             }
                         }
+                        if (rg && rg->range) {
+                            /* the valid range on the step, from its ends and slopes (the
+                             * excitation phase's time s = omega tau: Python converts) */
+                            for (int j = 0; j < n; ++j)
+                                if (alive[j])
+                                    leave[j] = gs_range_step(rg, g0 + j, t, hh, Y + j, YN + j,
+                                                             K + j, K + ns * S + j, n);
+                        }
                         t = t_new;
                         memcpy(Y, YN, sizeof(double) * S);
                         memcpy(K, K + ns * S, sizeof(double) * S); /* FSAL */
@@ -616,11 +707,12 @@ static int gs_lockstep(int method, int npts, int group, const double *P, const d
                 int dead = 0;
                 for (int j = 0; j < n; ++j) {
                     if (!alive[j]) continue;
-                    const int c = gs_check_soa(Y, n, j, bound, m);
+                    int c = gs_check_soa(Y, n, j, bound, m);
+                    if (c == GS_OK && leave[j]) c = GS_LEFT_RANGE;
                     if (c != GS_OK) {
                         alive[j] = 0;
                         STATUS[g0 + j] = c;
-                        TFAIL[g0 + j] = t;
+                        TFAIL[g0 + j] = leave[j] ? rg->exit[3 * (long)(g0 + j)] : t;
                         for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = 0.0;
                         dead = 1;
                         /* as without dense output: no samples from the failing step */
@@ -687,8 +779,8 @@ static int gs_lockstep(int method, int npts, int group, const double *P, const d
                 for (int k = 0; k < n_lyap; ++k) m->lyap[(long)(g0 + j) * n_lyap + k] = NAN;
         }
     }
-    free(Pg); free(Qg); free(Y); free(YT); free(YN); free(K); free(alive); free(E5s); free(E3s);
-    free(growth); free(F);
+    free(Pg); free(Qg); free(Y); free(YT); free(YN); free(K); free(alive); free(leave);
+    free(E5s); free(E3s); free(growth); free(F);
     return 0;
 }
 
@@ -696,11 +788,13 @@ static int gs_lockstep(int method, int npts, int group, const double *P, const d
 int gs_run_lockstep(int method, int npts, int group, const double *P, const double *X0,
                     double t0, double period, int n_transient, int n_sample, int spp, int dense,
                     double rtol, double atol, double bound, long long max_steps, double *OUT,
-                    long long *NFEV, long long *NSTEP, int *STATUS, double *TFAIL)
+                    long long *NFEV, long long *NSTEP, int *STATUS, double *TFAIL,
+                    const double *RANGE, int stop_exit, double *EXIT)
 {
+    const gs_range_t rg = {RANGE, stop_exit, EXIT};
     return gs_lockstep(method, npts, group, P, X0, t0, period, n_transient * spp,
                        n_sample * spp + 1, spp, dense, -1, rtol, atol, bound, max_steps, OUT,
-                       NFEV, NSTEP, STATUS, TFAIL, 0);
+                       NFEV, NSTEP, STATUS, TFAIL, 0, &rg);
 }
 
 /* Sampled runs in the excitation phase s = omega tau (period 2 pi for every point): each
@@ -709,14 +803,16 @@ int gs_run_lockstep(int method, int npts, int group, const double *P, const doub
 int gs_run_phase(int method, int npts, int group, const double *P, const double *X0, double s0,
                  int iw, int n_transient, int n_sample, int spp, int dense, double rtol,
                  double atol, double bound, long long max_steps, double *OUT, long long *NFEV,
-                 long long *NSTEP, int *STATUS, double *TFAIL)
+                 long long *NSTEP, int *STATUS, double *TFAIL, const double *RANGE,
+                 int stop_exit, double *EXIT)
 {
     if (iw < 0 || iw >= GS_NP) return -2;
     for (int j = 0; j < npts; ++j)
         if (!(P[(long)j * GS_NP + iw] > 0.0)) return -3;
+    const gs_range_t rg = {RANGE, stop_exit, EXIT};
     return gs_lockstep(method, npts, group, P, X0, s0, 2.0 * M_PI, n_transient * spp,
                        n_sample * spp + 1, spp, dense, iw, rtol, atol, bound, max_steps, OUT,
-                       NFEV, NSTEP, STATUS, TFAIL, 0);
+                       NFEV, NSTEP, STATUS, TFAIL, 0, &rg);
 }
 
 /* Maps: stops at every period t0 + k T, k = 0 .. n_transient + n_sample.  Keeps the
@@ -736,7 +832,7 @@ int gs_map_lockstep(int method, int npts, int group, const double *P, const doub
     gs_extras m = {tangent ? GS_NX / 2 : GS_NX, tangent, n_transient,
                    tangent ? n_stops - 1 - n_lyap : 0, RANGE, POINC, XMIN, XMAX, LYAP};
     return gs_lockstep(method, npts, group, P, X0, t0, period, 0, n_stops, 1, 0, -1, rtol, atol,
-                       bound, max_steps, 0, NFEV, NSTEP, STATUS, TFAIL, &m);
+                       bound, max_steps, 0, NFEV, NSTEP, STATUS, TFAIL, &m, 0);
 }
 
 /* One right-hand-side evaluation (tests compare it with the NumPy code). */
@@ -785,7 +881,8 @@ int gs_benettin(const double *p, const double *z0, double t0, double period, int
     double h_abs = gs_initial_step(t, z, f, period, 7, rtol, atol, p, q, &nfev);
     for (int k = 0; k < periods; ++k) {
         const int status = gs_adaptive_to(&GS_DOP853, &t, z, f, &h_abs, t0 + (k + 1) * period,
-                                          rtol, atol, p, q, bound, max_steps, &nfev, &nsteps);
+                                          rtol, atol, p, q, bound, max_steps, &nfev, &nsteps,
+                                          0, 0);
         if (status != GS_OK) {
             *NFEV = nfev;
             return status;

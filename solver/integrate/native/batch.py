@@ -27,7 +27,8 @@ __all__ = ["NATIVE_METHODS", "STATUS", "BatchResult", "benettin", "run_batch"]
 
 NATIVE_METHODS = ("dopri5", "dop853", "rk4")
 _CODES = {"dopri5": 0, "dop853": 1, "rk4": 2}
-STATUS = {0: "ok", 1: "divergent", 2: "too many steps", 3: "not finite", 4: "step too small"}
+STATUS = {0: "ok", 1: "divergent", 2: "too many steps", 3: "not finite", 4: "step too small",
+          5: "left the valid range"}  # fmt: skip
 _warned: set[str] = set()
 
 
@@ -44,6 +45,9 @@ class BatchResult:
     backend: str  # "native" or "numpy"
     wall_time: float
     compile_seconds: float = 0.0
+    # (N, 3): tau, state index, value of each point's first exit from the valid range
+    # (tau NaN: none), located on the accepted steps; None where not tracked (NumPy)
+    exits: np.ndarray | None = None
 
 
 def run_batch(
@@ -66,6 +70,8 @@ def run_batch(
     workers: int = 1,
     fallback: bool = True,
     dense: bool = True,
+    valid_range=None,
+    stop_on_exit: bool = False,
 ) -> BatchResult:
     """Integrate every column set ``P[i]`` (parameters) from ``X0[i]`` of ``module``.
 
@@ -83,6 +89,10 @@ def run_batch(
     its seventh-order dense output (three more stages in a step that holds a sample)
     instead of shortening steps to land on them; False shortens the steps (as RK45 and
     the per-point engine always do).
+
+    ``valid_range``: a bound per state (``inf``: none), checked at every accepted step
+    with the crossing located on the step's Hermite interpolant (``exits``);
+    ``stop_on_exit`` stops a point there (status "left the valid range").
     """
     if method not in NATIVE_METHODS:
         raise ValueError(f"unknown native method '{method}'; methods: {', '.join(NATIVE_METHODS)}")
@@ -133,7 +143,13 @@ def run_batch(
         group=group,
         fallback=fallback,
         dense=dense,
+        valid_range=valid_range,
+        stop_on_exit=stop_on_exit,
     )
+    bounds = np.full(n, np.inf) if valid_range is None else np.asarray(valid_range, float)
+    if bounds.shape != (n,):
+        raise ValueError(f"valid_range must hold {n} bounds, one per state")
+    bounds = np.ascontiguousarray(bounds)
     if workers > 1 and P.shape[0] > 1:
         return _parallel(module, P, X0, workers, started, opts)
     try:
@@ -151,6 +167,7 @@ def run_batch(
     nsteps = np.zeros(N, dtype=np.int64)
     status = np.zeros(N, dtype=np.int32)
     t_fail = np.zeros(N)
+    exits = np.full((N, 3), np.nan)
     if lockstep and method != "rk4" and N > 1:
         code = lib.gs_run_lockstep(
             _CODES[method],
@@ -173,6 +190,9 @@ def run_batch(
             nsteps,
             status,
             t_fail,
+            bounds,
+            int(stop_on_exit),
+            exits,
         )
         if code != 0:
             raise MemoryError("the lockstep integrator could not allocate its work arrays")
@@ -197,6 +217,9 @@ def run_batch(
             nsteps,
             status,
             t_fail,
+            bounds,
+            int(stop_on_exit),
+            exits,
         )
     return BatchResult(
         t=t,
@@ -208,6 +231,7 @@ def run_batch(
         backend="native",
         wall_time=time.perf_counter() - started,
         compile_seconds=facts["seconds"],
+        exits=exits,
     )
 
 
@@ -238,6 +262,7 @@ def _parallel(module, P, X0, workers, started, kwargs) -> BatchResult:
         t_fail=np.concatenate([r.t_fail for r in parts]),
         backend=parts[0].backend,
         wall_time=time.perf_counter() - started,
+        exits=None if parts[0].exits is None else np.concatenate([r.exits for r in parts]),
     )
 
 

@@ -180,6 +180,7 @@ def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
         d, d, i, i, i, d, d, i, d, ll,
         ptr(np.float64, flags="C"), ptr(np.int64, flags="C"), ptr(np.int64, flags="C"),
         ptr(np.int32, flags="C"), ptr(np.float64, flags="C"),
+        ptr(np.float64, flags="C"), i, ptr(np.float64, flags="C"),
     ]  # fmt: skip
     lib.gs_run_lockstep.restype = i
     lib.gs_run_lockstep.argtypes = [
@@ -188,6 +189,7 @@ def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
         d, d, i, i, i, i, d, d, d, ll,
         ptr(np.float64, flags="C"), ptr(np.int64, flags="C"), ptr(np.int64, flags="C"),
         ptr(np.int32, flags="C"), ptr(np.float64, flags="C"),
+        ptr(np.float64, flags="C"), i, ptr(np.float64, flags="C"),
     ]  # fmt: skip
     lib.gs_run_phase.restype = i
     lib.gs_run_phase.argtypes = [
@@ -196,6 +198,7 @@ def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
         d, i, i, i, i, i, d, d, d, ll,
         ptr(np.float64, flags="C"), ptr(np.int64, flags="C"), ptr(np.int64, flags="C"),
         ptr(np.int32, flags="C"), ptr(np.float64, flags="C"),
+        ptr(np.float64, flags="C"), i, ptr(np.float64, flags="C"),
     ]  # fmt: skip
     lib.gs_map_lockstep.restype = i
     lib.gs_map_lockstep.argtypes = [

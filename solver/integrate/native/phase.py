@@ -70,11 +70,16 @@ def run_phase(
     nsteps = np.zeros(N, dtype=np.int64)
     status = np.zeros(N, dtype=np.int32)
     t_fail = np.zeros(N)
+    exits = np.full((N, 3), np.nan)
+    bounds = np.full(n, np.inf)
+    for c, b in (contract.valid_range or {}).items():
+        bounds[contract.states.index(c)] = b
     code = lib.gs_run_phase(
         _CODES[method], N, int(group), P, X0, 0.0, iw, int(transient), int(periods), spp, 1,
         float(rtol), float(atol), float(bound), int(max_steps), out, nfev, nsteps, status,
-        t_fail,
+        t_fail, bounds, 0, exits,
     )  # fmt: skip
+    exits[:, 0] /= P[:, iw]  # the phase s = omega tau, back to tau
     if code == -1:
         raise MemoryError("the phase integrator could not allocate its work arrays")
     if code != 0:
@@ -89,6 +94,7 @@ def run_phase(
         backend="native",
         wall_time=time.perf_counter() - started,
         compile_seconds=facts["seconds"],
+        exits=exits,
     )
 
 
