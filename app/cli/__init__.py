@@ -45,6 +45,12 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _one_line_warning(message, category, filename, lineno, file=None, line=None):
+    """Warnings on the command line: one line each, without the source line that
+    raised them (``--debug`` keeps Python's own format)."""
+    print(f"gearsym: warning: {message}", file=file or sys.stderr)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
@@ -54,8 +60,11 @@ def main(argv: list[str] | None = None) -> int:
         args.method = fastest_method(args.rtol)
     if args.debug:
         return args.func(args)
+    import warnings
+
     from gearsym.derive import InputError
 
+    shown, warnings.showwarning = warnings.showwarning, _one_line_warning
     try:
         if getattr(args, "out", None):
             out_folder(args.out)
@@ -81,6 +90,8 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("gearsym: interrupted", file=sys.stderr)
         return 130
+    finally:
+        warnings.showwarning = shown
 
 
 if __name__ == "__main__":
