@@ -189,11 +189,13 @@ _STEEL = Material("steel", 2.06e11, 0.3, 7850.0)
 
 def _gear(t: Table, materials: dict[str, Material]) -> Gear:
     gid = t.identifier("id")
-    teeth = t.integer("teeth", low=5)
-    mn = t.number("normal_module_mm", low=0, low_open=True) * 1e-3
+    # Upper limits far beyond any gear built (marine wheels have a few hundred teeth, a
+    # module up to about 50 mm and a face under 2 m): past them the input is a typo.
+    teeth = t.integer("teeth", low=5, high=10_000)
+    mn = t.number("normal_module_mm", low=0, low_open=True, high=1000.0) * 1e-3
     alpha_n = math.radians(t.number("normal_pressure_angle_deg", 20.0, low=10.0, high=35.0))
     beta = math.radians(t.number("helix_angle_deg", 0.0, low=-45.0, high=45.0))
-    width = t.number("face_width_mm", low=0, low_open=True) * 1e-3
+    width = t.number("face_width_mm", low=0, low_open=True, high=10_000.0) * 1e-3
     shift = t.number("profile_shift", 0.0, low=-1.0, high=1.5)
     mat_name = t.string("material", "steel")
     if mat_name not in materials:

@@ -45,10 +45,10 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _one_line_warning(message, category, filename, lineno, file=None, line=None):
+def _one_line_warning(message, category, filename, lineno, line=None) -> str:
     """Warnings on the command line: one line each, without the source line that
     raised them (``--debug`` keeps Python's own format)."""
-    print(f"gearsym: warning: {message}", file=file or sys.stderr)
+    return f"gearsym: warning: {message}\n"
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -64,7 +64,7 @@ def main(argv: list[str] | None = None) -> int:
 
     from gearsym.derive import InputError
 
-    shown, warnings.showwarning = warnings.showwarning, _one_line_warning
+    shown, warnings.formatwarning = warnings.formatwarning, _one_line_warning
     try:
         if getattr(args, "out", None):
             out_folder(args.out)
@@ -91,7 +91,7 @@ def main(argv: list[str] | None = None) -> int:
         print("gearsym: interrupted", file=sys.stderr)
         return 130
     finally:
-        warnings.showwarning = shown
+        warnings.formatwarning = shown
 
 
 if __name__ == "__main__":

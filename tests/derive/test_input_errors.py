@@ -32,6 +32,19 @@ TOPOLOGY_CASES = [
         "mesh[1].driver: names unknown gear 'qq' (did you mean 'q'?)",
     ),
     ("negative teeth", "teeth = 100", "teeth = -100", "gear[2].teeth: must be >= 5, got -100"),
+    ("a billion teeth", "teeth = 100", "teeth = 1000000000", "gear[2].teeth: must be <= 10000"),
+    (
+        "face width of a million km",
+        "face_width_mm = 50",
+        "face_width_mm = 1e12",
+        "].face_width_mm: must be <= 10000",
+    ),
+    (
+        "module of a metre",
+        "normal_module_mm = 4\n",
+        "normal_module_mm = 4e3\n",
+        "gear[0].normal_module_mm: must be <= 1000",
+    ),  # fmt: skip
     (
         "unknown key",
         "teeth = 100",
