@@ -33,6 +33,37 @@ def _bad_input_cases() -> list[tuple[str, str]]:
     return [(w.replace("|", "\\|"), e.replace("|", "\\|")) for w, e in cases]
 
 
+def _cell(text: str) -> str:
+    return text.replace("|", "\\|")
+
+
+def _command_table() -> list[tuple[str, int, str]]:
+    """Every case of the bad-input table (``tests/bad_inputs.py``) run as the test runs
+    it: (command line, exit code, the one line on stderr), temporary paths shortened."""
+    import os
+    import sys
+
+    sys.path.insert(0, str(project_root()))
+    from tests.bad_inputs import CASES, make_files
+    from tests.test_bad_inputs import run_case
+
+    rows = []
+    here = os.getcwd()
+    with tempfile.TemporaryDirectory() as tmp:
+        files = make_files(Path(tmp), project_root())
+        for argv, _ in CASES:
+            with tempfile.TemporaryDirectory() as cwd:
+                os.chdir(cwd)
+                try:
+                    code, _, err = run_case(argv, files)
+                finally:
+                    os.chdir(here)
+            lines = [ln for ln in err.splitlines() if ln.strip()]
+            text = " / ".join(lines).replace(tmp, "TMP").replace(str(project_root()), ".")
+            rows.append((argv, code, text))
+    return rows
+
+
 def main() -> None:
     out = output_folder(checkout_docs(), (REPORT,)) / REPORT
     with tempfile.TemporaryDirectory() as tmp:
@@ -73,6 +104,24 @@ def main() -> None:
         "| input | the message contains |",
         "|---|---|",
         *(f"| {what} | `{fragment}` |" for what, fragment in _bad_input_cases()),
+        "",
+    ]
+    table = _command_table()
+    clean = sum(code == 2 and " / " not in text for _, code, text in table)
+    lines += [
+        "## Bad input on every command",
+        "",
+        f"The {len(table)} cases of `tests/bad_inputs.py`, run by `tests/test_bad_inputs.py`",
+        "(each must exit with code 2 and one line naming the input, before computing) and",
+        f"here: **{clean} of {len(table)} end that way**. `TMP` stands for the test's",
+        "temporary folder (placeholders in the command: `{tmp}` a folder, `{file}` a regular",
+        "file, `{bad_utf8}` a TOML file that is not UTF-8, `{brace}` a JSON file holding",
+        "`{}`, `{torn}` a truncated JSON file, `{scene:KEY}` a scene with one line changed).",
+        "Exit codes: 0 ok, 2 bad input, 3 a run that ended invalid, divergent or failed.",
+        "",
+        "| command line | exit | stderr |",
+        "|---|---|---|",
+        *(f"| `{_cell(argv)}` | {code} | {_cell(text)} |" for argv, code, text in table),
         "",
     ]
     out.write_text("\n".join(lines), encoding="utf-8")

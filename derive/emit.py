@@ -111,6 +111,32 @@ def _stiffness_terms(names) -> dict:
     return {c: tuple(t) for c, t in out.items()}
 
 
+def _stiffness_check_lines(terms) -> list[str]:
+    """The generated check that each mesh's stiffness stays positive over its cycle
+    (nothing when the model has no stiffness harmonics)."""
+    if not terms:
+        return [""]
+    return [
+        "",
+        "def _check_stiffness(p):",
+        '    """A mesh stiffness k_hat(tau) that is negative somewhere in its cycle is not',
+        '    physical: refuse it with the value (721 phases per mesh period)."""',
+        "    theta = np.linspace(0.0, 2.0 * np.pi, 721)",
+        "    for c, terms in STIFFNESS_TERMS.items():",
+        "        k = 1.0 + sum(p[i] * np.cos(n * theta) + p[j] * np.sin(n * theta)",
+        "                      for i, j, n in terms)",
+        "        if np.min(k) <= 0.0:",
+        "            m = int(np.argmin(k))",
+        "            raise ValueError(",
+        "                f'the stiffness of mesh {c} falls to {k[m]:.3g} times its mean at mesh '",
+        "                f'phase {np.degrees(theta[m]):.0f} deg (harmonics '",
+        "                + ', '.join(PARAMETERS[i][3:] for i, _, _ in terms)",
+        "                + '): a negative stiffness is not physical; use smaller harmonics')",
+        "",
+        "",
+    ]
+
+
 def _docstring(model: Model, command: str) -> str:
     scene = model.scene
     feats = model.features
@@ -184,6 +210,7 @@ def emit_module(model: Model, command: str) -> str:
         return repr(float(f"{v:.15g}"))
 
     defaults = ",\n    ".join(fmt(p.value) for p in model.parameters)
+    stiffness_terms = _stiffness_terms(model.parameter_names)
     scales = model.scales
     valid = model.valid_range
     jac_rows = ",\n        ".join(
@@ -219,7 +246,7 @@ def emit_module(model: Model, command: str) -> str:
         )  # fmt: skip
         + "}",
         "# mesh coordinate: ((cos index, sin index, harmonic), ...) of k_hat = 1 + sum ...",
-        f"STIFFNESS_TERMS = {_stiffness_terms(model.parameter_names)!r}",
+        f"STIFFNESS_TERMS = {stiffness_terms!r}",
         f"OPERATIONS = {model.operations!r}",
         "",
         "# What a solver needs to know about this model, as plain data (Model.contract in",
@@ -278,26 +305,10 @@ def emit_module(model: Model, command: str) -> str:
         "    for k, v in values.items():",
         "        if k in PARAMETERS and k not in SCENE_PARAMETERS:",
         "            p[PARAMETERS.index(k)] = float(v)",
-        "    _check_stiffness(p)",
+        *(["    _check_stiffness(p)"] if stiffness_terms else []),
         "    return np.array(p, dtype=float)",
         "",
-        "",
-        "def _check_stiffness(p):",
-        '    """A mesh stiffness k_hat(tau) that is negative somewhere in its cycle is not',
-        '    physical: refuse it with the value (721 phases per mesh period)."""',
-        "    theta = np.linspace(0.0, 2.0 * np.pi, 721)",
-        "    for c, terms in STIFFNESS_TERMS.items():",
-        "        k = 1.0 + sum(p[i] * np.cos(n * theta) + p[j] * np.sin(n * theta)",
-        "                      for i, j, n in terms)",
-        "        if np.min(k) <= 0.0:",
-        "            m = int(np.argmin(k))",
-        "            raise ValueError(",
-        "                f'the stiffness of mesh {c} falls to {k[m]:.3g} times its mean at mesh '",
-        "                f'phase {np.degrees(theta[m]):.0f} deg (harmonics '",
-        "                + ', '.join(PARAMETERS[i][3:] for i, _, _ in terms)",
-        "                + '): a negative stiffness is not physical; use smaller harmonics')",
-        "",
-        "",
+        *_stiffness_check_lines(stiffness_terms),
         "def jacobian(tau, x, p):",
         '    """d rhs / d X, shape (n, n) or (n, n, N)."""',
         *jac_lines,

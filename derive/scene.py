@@ -313,6 +313,21 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
                     "its sign comes from the reading; drop the sign",
                 )
         lt.finish()
+        import re
+
+        used = {w for e in expressions.values() if isinstance(e, str)
+                for w in re.findall(r"[A-Za-z_]\w*", e)}  # fmt: skip
+        for key in parameters:
+            if key not in PARAMETER_LIMITS and key not in used:
+                raise InputError(
+                    source,
+                    f"parameters.{key}",
+                    "is not used by any load ([loads]: "
+                    + ", ".join(f"{c} = {e}" for c, e in expressions.items())
+                    + ")"
+                    + nearest(key, sorted(used))
+                    + "; use it in a load or remove it",
+                )
     elif not topology.torques:
         raise InputError(
             source,

@@ -269,24 +269,7 @@ def parameters(**values):
     for k, v in values.items():
         if k in PARAMETERS and k not in SCENE_PARAMETERS:
             p[PARAMETERS.index(k)] = float(v)
-    _check_stiffness(p)
     return np.array(p, dtype=float)
-
-
-def _check_stiffness(p):
-    """A mesh stiffness k_hat(tau) that is negative somewhere in its cycle is not
-    physical: refuse it with the value (721 phases per mesh period)."""
-    theta = np.linspace(0.0, 2.0 * np.pi, 721)
-    for c, terms in STIFFNESS_TERMS.items():
-        k = 1.0 + sum(p[i] * np.cos(n * theta) + p[j] * np.sin(n * theta)
-                      for i, j, n in terms)
-        if np.min(k) <= 0.0:
-            m = int(np.argmin(k))
-            raise ValueError(
-                f'the stiffness of mesh {c} falls to {k[m]:.3g} times its mean at mesh '
-                f'phase {np.degrees(theta[m]):.0f} deg (harmonics '
-                + ', '.join(PARAMETERS[i][3:] for i, _, _ in terms)
-                + '): a negative stiffness is not physical; use smaller harmonics')
 
 
 def jacobian(tau, x, p):

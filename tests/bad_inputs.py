@@ -28,6 +28,7 @@ SCENE_EDITS = {
     "backlash": ('backlash = "polynomial"', 'backlash = "polynominal"'),
     "unknown": ("mesh_phase = true", "mesh_phase = true\nmesh_phaze = true"),
     "syntax": ("f1 = 0.1 ", "f1 = = 0.1 "),
+    "unused": ("lambda = 0.1 ", "lambda = 0.1\nlamda = 0.2 "),
     "reading": ('load_reading = "q-braking"', 'load_reading = "q-breaking"'),
     "flywheel": (
         'damping_normalisation = "mesh"',
@@ -75,6 +76,7 @@ CASES += [
     ("simulate {scene:unknown}", "mesh_phaze"),
     ("simulate {scene:syntax}", "line"),
     ("simulate {scene:reading}", "q-breaking"),
+    ("simulate {scene:unused}", "parameters.lamda: is not used by any load"),
     ("simulate {scene:flywheel}", "flywheel_inertia_kg_m2"),
     ("derive {bad_utf8}", "UTF-8"),
     ("derive {scene:syntax}", "line"),

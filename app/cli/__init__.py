@@ -66,7 +66,7 @@ def main(argv: list[str] | None = None) -> int:
 
     shown, warnings.formatwarning = warnings.formatwarning, _one_line_warning
     try:
-        if getattr(args, "out", None):
+        if getattr(args, "out", None) and args.command != "bench":  # bench checks its own
             out_folder(args.out)
         return args.func(args)
     except (InputError, Fail) as err:
