@@ -59,7 +59,7 @@ def _command_table() -> list[tuple[str, int, str]]:
                 finally:
                     os.chdir(here)
             lines = [ln for ln in err.splitlines() if ln.strip()]
-            text = " / ".join(lines).replace(tmp, "TMP").replace(str(project_root()), ".")
+            text = " ⏎ ".join(lines).replace(tmp, "TMP").replace(str(project_root()), ".")
             rows.append((argv, code, text))
     return rows
 
@@ -107,7 +107,8 @@ def main() -> None:
         "",
     ]
     table = _command_table()
-    clean = sum(code == 2 and " / " not in text for _, code, text in table)
+    clean = sum(code == 2 and " ⏎ " not in text and "Traceback" not in text
+                for _, code, text in table)  # fmt: skip
     lines += [
         "## Bad input on every command",
         "",
