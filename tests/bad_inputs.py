@@ -49,7 +49,7 @@ OUT_COMMANDS = [
 ]
 BAD_OUT = [
     ("/dev/null", "/dev/null"),
-    ("{file}", "is a file"),
+    ("{file}", "afile.txt"),
     ("/proc/gearsym-out", "/proc/gearsym-out"),
     ("{file}/sub", "sub"),
 ]

@@ -7,7 +7,7 @@ import json
 import math
 import sys
 
-from ._common import Fail, out_folder, parse_set, refuse_conflicts, require, system_of
+from ._common import Fail, RunFailed, out_folder, parse_set, refuse_conflicts, require, system_of
 
 __all__ = ["register"]
 
@@ -135,7 +135,7 @@ def _cmd_response(args) -> int:
             tail=args.tail,
         )  # fmt: skip
     except (HarmonicBalanceError, ShootingError) as err:
-        raise Fail(f"frequency-response: {err}") from None
+        raise RunFailed(f"frequency-response: {err}") from None
     (out / "frequency_response.json").write_text(dumps(resp.to_dict(), indent=1),
                                                  encoding="utf-8")  # fmt: skip
     resp.save(out / "frequency_response.csv")
