@@ -92,7 +92,8 @@ def _cmd_simulate(args) -> int:
     except SimulationError as err:
         raise RunFailed(f"simulate: {err}") from None
     except ValueError as err:
-        raise Fail(f"simulate: {err}") from None
+        raise Fail(f"simulate from {start.source}: {err}" if start.x0 is not None
+                   else f"simulate: {err}") from None  # fmt: skip
     data = result.describe()
     data["initial_state"] = start.describe()
     if args.out:

@@ -31,18 +31,22 @@ def check_start(system: System, x0=None) -> None:
     given = x0 is not None
     x0 = default_initial_state(system) if x0 is None else np.asarray(x0, dtype=float)
     for i, bound in system.contract.valid_bounds():
-        if abs(x0[i]) > bound:
-            state = system.states[i]
-            why = (
-                "the initial state"
-                if given
-                else f"the start pressed in by the static load ({state} = 1 + load)"
-            )
+        if abs(x0[i]) <= bound:
+            continue
+        state = system.states[i]
+        where = f"|{state}| <= {bound:g}"
+        if given:
             raise ValueError(
-                f"{why} {state} = {x0[i]:.6g} is outside the backlash model's valid range "
-                f"|{state}| <= {bound:g}; lower the load, start inside the range, or use "
-                "backlash = 'dead-zone' (valid everywhere)"
+                f"the initial state {state} = {x0[i]:.6g} is outside the backlash model's "
+                f"valid range {where}; start inside it"
             )
+        load = system.contract.loads.get(state)
+        f = system.parameter(load) if load else float("nan")
+        raise ValueError(
+            f"the static load {load} = {f:.6g} presses {state} to {x0[i]:.6g}, outside the "
+            f"backlash model's valid range {where}; lower the load, or use a scene with "
+            "backlash = 'dead-zone' (valid everywhere)"
+        )
 
 
 SAMPLE_BUDGET = 1 << 20  # samples per state a command keeps of one run (8 MiB each)
