@@ -3,12 +3,18 @@ dask.distributed cluster, and hand back their results in the order of the tasks.
 
 Sweeps, studies and the native batch runner all go through :func:`map_tasks`; each task
 is a picklable value and ``fn`` a module-level function, so nothing unpicklable crosses
-processes.
+processes.  Local workers end with the process that started them, however it ends
+(SIGKILL, SIGTERM, Ctrl-C): none is left behind to finish its tasks alone.
 """
 
 from __future__ import annotations
 
+import ctypes
 import os
+import signal
+import sys
+import threading
+import time
 from collections.abc import Callable, Sequence
 
 __all__ = ["EXECUTORS", "map_tasks"]
@@ -48,15 +54,91 @@ def map_tasks(
             if on_result is not None:
                 on_result(results[-1])
         return results
+    return _pool(fn, tasks, workers, on_result)
+
+
+def _pool(fn, tasks, workers, on_result) -> list:
+    """The local process pool; its workers end with this process however it ends."""
+    import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
+    context = multiprocessing.get_context()
+    # A worker's parent is this process (fork, spawn), or under forkserver the server,
+    # whose pid is not known here (it ends when this process does, and its workers then).
+    parent = None if context.get_start_method() == "forkserver" else os.getpid()
+    pool = ProcessPoolExecutor(
+        max_workers=workers or os.cpu_count(),
+        mp_context=context,
+        initializer=_bind_to_parent,
+        initargs=(parent,),
+    )
     results = []
-    with ProcessPoolExecutor(max_workers=workers or os.cpu_count()) as pool:
+    try:
         for result in pool.map(fn, tasks):
             results.append(result)
             if on_result is not None:
                 on_result(result)
+    except BaseException as err:
+        if not isinstance(err, Exception):
+            # Ctrl-C or an exit: stop now, not after the running tasks (a chain of a sweep
+            # can take minutes); what they stored so far stays.
+            _kill_workers(pool)
+        raise
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
     return results
+
+
+def _kill_workers(pool) -> None:
+    # Python 3.14 has ProcessPoolExecutor.kill_workers; before it, the pool's own table.
+    kill = getattr(pool, "kill_workers", None)
+    if kill is not None:
+        kill()
+        return
+    for process in list((getattr(pool, "_processes", None) or {}).values()):
+        try:
+            process.kill()
+        except (OSError, ValueError):
+            pass  # already gone or already reaped
+
+
+_PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
+
+
+def _bind_to_parent(parent: int | None) -> None:
+    """Pool initializer: make this worker die with its parent, on any signal.
+
+    On Linux the kernel sends SIGKILL to the worker when its parent ends
+    (``prctl(PR_SET_PDEATHSIG)``); elsewhere a daemon thread polls the parent's pid.
+    SIGKILL or SIGTERM of the parent would otherwise leave the workers under PID 1,
+    finishing their tasks and then waiting forever for more.  Ctrl-C reaches the
+    whole process group; only the parent acts on it (it kills the workers), so that a
+    worker does not print a traceback of its own.
+    """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    watched = os.getppid() if parent is None else parent
+    if not _death_signal(signal.SIGKILL):
+        threading.Thread(target=_watch_parent, args=(watched,), daemon=True).start()
+    # The parent may have ended between the fork and the prctl: then nothing would come.
+    if os.getppid() != watched:
+        os._exit(1)
+
+
+def _death_signal(signum: int) -> bool:
+    """Ask the kernel for ``signum`` when the parent ends; False where it cannot."""
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        return libc.prctl(_PR_SET_PDEATHSIG, int(signum), 0, 0, 0) == 0
+    except (OSError, AttributeError):
+        return False
+
+
+def _watch_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(0.5)
+    os._exit(1)
 
 
 def _dask(fn, tasks, workers, scheduler, on_result) -> list:
