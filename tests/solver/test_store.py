@@ -6,10 +6,12 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 
 import numpy as np
 import pytest
 from gearsym.solver.sweep import SweepStoreError, sweep
+from gearsym.solver.sweep.store import close_store, open_store
 from gearsym.solver.system import System
 
 SETTINGS = dict(method="cvodes", transient=40, periods=8, lyapunov_periods=20)
@@ -116,11 +118,122 @@ def test_a_sweep_killed_with_sigkill_resumes_and_matches(tmp_path):
     assert [_strip(p) for p in a] == [_strip(p) for p in b]
 
 
-def test_a_stored_point_of_another_format_is_refused_not_deleted(tmp_path):
+def _damage_a_point(store, kind):
+    """Damage one stored file as a crash, a full disk or a stray edit may; its name."""
+    points = store / "points"
+    if kind == "truncated-chunk":
+        f = points / "chunk-00002-2.json"
+        f.write_text(f.read_text()[: f.stat().st_size // 2])
+        return f
+    f = points / "00001.json"
+    f.write_text({"empty-object": "{}", "not-json": "not json", "no-keys": '{"value": 0.5}'}[kind])
+    return f
+
+
+def _sweep_warnings(*args, **kw):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = sweep(*args, **kw)
+    return result, [str(w.message) for w in caught if "damaged" in str(w.message)]
+
+
+@pytest.mark.parametrize("kind", ["empty-object", "not-json", "no-keys", "truncated-chunk"])
+def test_a_damaged_point_file_is_set_aside_and_its_points_recomputed(tmp_path, kind):
+    # A point file that holds no valid point is moved to store/damaged (never deleted),
+    # named in one warning, and the resumed sweep recomputes its points: the result is
+    # the uninterrupted one, bit for bit.  A continuation chain recomputes from there on.
     system = System.load("reference_light")
-    sweep(system, "lambda", [0.0, 0.5], store=tmp_path, **SETTINGS)
-    stray = tmp_path / "points" / "00001.json"
-    stray.write_text(json.dumps({"value": 0.5}))  # valid JSON, not a point
-    with pytest.raises(SweepStoreError, match="00001.json is not a sweep point"):
-        sweep(system, "lambda", [0.0, 0.5], store=tmp_path, **SETTINGS)
-    assert stray.exists()
+    if kind == "truncated-chunk":  # compiled: lockstep chunks of two points in one file
+        lam, kw = np.linspace(0.0, 1.0, 8), dict(transient=20, periods=6, lyapunov_periods=0)
+        kw |= dict(method="dop853", continuation=False)
+    else:
+        lam, kw = np.linspace(0.0, 1.0, 3), dict(SETTINGS, continuation=kind != "not-json")
+    store = tmp_path / "store"
+    full = sweep(system, "lambda", lam, store=store, **kw)
+    f = _damage_a_point(store, kind)
+    text = f.read_text()
+    resumed, said = _sweep_warnings(system, "lambda", lam, store=store, **kw)
+    assert len(said) == 1 and said[0].startswith(f"{f} is damaged"), said
+    assert said[0].endswith("its points will be recomputed"), said
+    assert (store / "damaged" / f.name).read_text() == text  # kept as it was
+    assert [_strip(p) for p in resumed.points] == [_strip(p) for p in full.points]
+    again, said = _sweep_warnings(system, "lambda", lam, store=store, **kw)
+    assert said == [] and [_strip(p) for p in again.points] == [_strip(p) for p in full.points]
+
+
+@pytest.mark.parametrize(
+    "text, why",
+    [
+        ('{"format": 1, "model": "refer', "damaged"),
+        ("[1, 2]", "damaged"),
+        ("{}", "damaged or incomplete"),
+    ],
+    ids=["truncated", "not-a-dict", "no-keys"],
+)
+def test_a_damaged_manifest_is_refused_in_one_line(tmp_path, text, why):
+    manifest = tmp_path / "store" / "manifest.json"
+    manifest.parent.mkdir()
+    manifest.write_text(text)
+    system = System.load("reference_light")
+    with pytest.raises(SweepStoreError, match=f"manifest.json is {why}"):
+        sweep(system, "lambda", [0.0, 0.5], store=tmp_path / "store", **SETTINGS)
+    assert manifest.read_text() == text  # nothing overwritten
+
+
+# a sweep on the command line into the folder that follows
+SHORT_SWEEP = [sys.executable, "-m", "gearsym.cli", "sweep", "reference-light", "--param",
+               "lambda", "--range", "0:1:3", "--quiet", "--no-figure", "--out"]  # fmt: skip
+
+
+def test_the_cli_refuses_a_truncated_manifest_in_one_line(tmp_path):
+    manifest = tmp_path / "store" / "manifest.json"
+    manifest.parent.mkdir()
+    manifest.write_text('{"format": 1, "model": "refer')
+    done = subprocess.run([*SHORT_SWEEP, str(tmp_path)], capture_output=True, text=True)
+    assert done.returncode == 2, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in done.stderr, done.stderr
+    assert lines[0].startswith(f"gearsym: error: sweep: {manifest} is damaged"), lines[0]
+    assert "choose another --out" in lines[0]
+
+
+_HOLD = (
+    "import json, sys; from pathlib import Path; "
+    "from gearsym.solver.sweep.store import open_store; "
+    "open_store(Path(sys.argv[1]), json.loads(sys.argv[2])); "
+    "print('locked', flush=True); sys.stdin.read()"
+)
+
+
+def test_a_store_has_one_writer_at_a_time(tmp_path):
+    # Another process writing into the folder (a sweep still running, or its workers)
+    # makes a second writer stop at once, in one line naming the holder's pid; the lock
+    # goes with its holder, even when that is killed with SIGKILL.
+    store = tmp_path / "store"
+    manifest = dict(format=1, model="m", model_hash="0" * 12, parameter="lambda",
+                    values=[0.0], direction="independent", base_values={}, settings={},
+                    x0=None)  # fmt: skip
+    holder = subprocess.Popen(
+        [sys.executable, "-c", _HOLD, str(store), json.dumps(manifest)],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        assert (store / "lock").read_text().strip() == str(holder.pid)
+        with pytest.raises(SweepStoreError, match=f"in use by another sweep .process {holder.pid}"):
+            open_store(store, manifest)
+        done = subprocess.run([*SHORT_SWEEP, str(tmp_path)], capture_output=True, text=True)
+        lines = done.stderr.strip().splitlines()
+        assert done.returncode == 2 and len(lines) == 1, done.stderr
+        assert lines[0] == (
+            f"gearsym: error: sweep: {store} is in use by another sweep (process "
+            f"{holder.pid}); wait for it to finish or choose another --out"
+        )
+    finally:
+        holder.kill()
+        holder.wait()
+    assert open_store(store, manifest) == {}  # the kernel freed the lock with its holder
+    assert (store / "lock").read_text().strip() == str(os.getpid())
+    close_store(store)
