@@ -51,7 +51,7 @@ class OneLineParser(argparse.ArgumentParser):
             known = sorted(self._options())
             for word in message.split(": ", 1)[1].split():
                 near = difflib.get_close_matches(word.split("=")[0], known, n=1)
-                if near:
+                if near and near[0] != word.split("=")[0]:  # an option of another command
                     message += f" (did you mean {near[0]}?)"
                     break
         self.exit(2, f"{self.prog}: error: {message}; see `{self.prog} --help`\n")

@@ -38,6 +38,7 @@ from .attractors import RunOutcome, group_runs, outcome
 from .executor import map_tasks
 from .maps_result import Cell, RegimeMap, outcome_from_dict, outcome_to_dict
 from .progress import Progress
+from .store import lock_store
 
 __all__ = ["default_box", "regime_map"]
 
@@ -154,6 +155,7 @@ def _task(task) -> list[tuple[str, int, list[RunOutcome]]]:
 
 def _check_store(store: Path, manifest: dict) -> None:
     store.mkdir(parents=True, exist_ok=True)
+    lock_store(store)  # one writer at a time, as for sweeps
     path = store / "manifest.json"
     if path.exists():
         old = json.loads(path.read_text(encoding="utf-8"))

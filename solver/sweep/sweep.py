@@ -30,7 +30,7 @@ from .executor import EXECUTORS, map_tasks
 from .points import SweepPoint
 from .progress import Progress
 from .result import SweepResult
-from .store import STORE_FORMAT, SweepStoreError, open_store
+from .store import STORE_FORMAT, SweepStoreError, close_store, open_store
 
 __all__ = [
     "Progress",
@@ -125,33 +125,37 @@ def sweep(
             "x0": x0_list,
         }
         done = open_store(Path(store), manifest, texts)
-    chains = plan(
-        system,
-        parameter,
-        values,
-        continuation=continuation,
-        backward=backward,
-        x0=x0,
-        settings=settings,
-        done=done,
-        store=store,
-    )
-    if progress is not None:
-        for _ in done:
-            progress.step("(stored)")
-    found = dict(done)
-    for chain, ran in zip(
-        chains, _execute(chains, executor, workers, progress, scheduler), strict=True
-    ):
-        found.update(zip(chain.indices, ran.points, strict=True))
-        texts.update(zip(chain.indices, ran.texts, strict=True))
-    order = range(values.size)[::-1] if backward else range(values.size)
-    points = [found[i] for i in order]
-    stored = [texts.get(i) for i in order]
-    result = _result(system, parameter, values, direction, dict(settings, x0=x0_list), points)
-    if store is None or None in stored:
-        return result
-    return replace(result, texts=stored)
+    try:
+        chains = plan(
+            system,
+            parameter,
+            values,
+            continuation=continuation,
+            backward=backward,
+            x0=x0,
+            settings=settings,
+            done=done,
+            store=store,
+        )
+        if progress is not None:
+            for _ in done:
+                progress.step("(stored)")
+        found = dict(done)
+        for chain, ran in zip(
+            chains, _execute(chains, executor, workers, progress, scheduler), strict=True
+        ):
+            found.update(zip(chain.indices, ran.points, strict=True))
+            texts.update(zip(chain.indices, ran.texts, strict=True))
+        order = range(values.size)[::-1] if backward else range(values.size)
+        points = [found[i] for i in order]
+        stored = [texts.get(i) for i in order]
+        result = _result(system, parameter, values, direction, dict(settings, x0=x0_list), points)
+        if store is None or None in stored:
+            return result
+        return replace(result, texts=stored)
+    finally:
+        if store is not None:
+            close_store(Path(store))  # the lock, for the next writer
 
 
 @dataclass(frozen=True)

@@ -66,7 +66,7 @@ def test_a_warned_exit_is_recorded_and_the_run_goes_on(fast, reference_exit):
 
 def test_a_start_outside_the_range_is_an_input_error_naming_the_state():
     far = System.load("reference_light", f1=5.0)  # the static start u = 1 + 5 > 3
-    with pytest.raises(ValueError, match=r"load f_u = 5 presses u to 6, outside the backlash model's valid range"):
+    with pytest.raises(ValueError, match=r"load f_u = 5 presses u to 6, outside the backlash"):
         simulate(far)
     with pytest.raises(ValueError, match=r"the initial state v = -4"):
         simulate(System.load("reference_light"), x0=[1.0, -4.0, 0.0, 0.0])
