@@ -118,9 +118,15 @@ def _stiffness_check_lines(terms) -> list[str]:
         return [""]
     return [
         "",
+        "_STIFFNESS_CHECKED = set()  # harmonics already found positive: sweeps repeat them",
+        "",
+        "",
         "def _check_stiffness(p):",
         '    """A mesh stiffness k_hat(tau) that is negative somewhere in its cycle is not',
         '    physical: refuse it with the value (721 phases per mesh period)."""',
+        "    key = tuple(p[k] for t in STIFFNESS_TERMS.values() for i, j, _ in t for k in (i, j))",
+        "    if key in _STIFFNESS_CHECKED:",
+        "        return",
         "    theta = np.linspace(0.0, 2.0 * np.pi, 721)",
         "    for c, terms in STIFFNESS_TERMS.items():",
         "        k = 1.0 + sum(p[i] * np.cos(n * theta) + p[j] * np.sin(n * theta)",
@@ -132,6 +138,7 @@ def _stiffness_check_lines(terms) -> list[str]:
         "                f'phase {np.degrees(theta[m]):.0f} deg (harmonics '",
         "                + ', '.join(PARAMETERS[i][3:] for i, _, _ in terms)",
         "                + '): a negative stiffness is not physical; use smaller harmonics')",
+        "    _STIFFNESS_CHECKED.add(key)",
         "",
         "",
     ]
