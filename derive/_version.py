@@ -5,5 +5,6 @@ __version__ = "0.1.0"
 # The emitted module's format: bump it whenever the generated code changes for the same
 # inputs (a new table, a new check), so that models derived into the cache before the
 # change are derived again instead of being loaded stale.  2: parameter limits and the
-# stiffness-sign check in parameters() (issue 14); 3: that check done once per harmonics.
-EMITTED_FORMAT = 3
+# stiffness-sign check in parameters() (issue 14); 3: that check done once per harmonics;
+# 4: STRUCTURE (the physical matrices for the modal analysis) and models on bearings.
+EMITTED_FORMAT = 4

@@ -14,6 +14,7 @@ import math
 import sympy as sp
 
 from ._paths import display_path
+from .audit_structure import structure_sections
 from .backlash import fit_dead_zone
 from .model import Model
 from .nondim import DAMPING_TEXT
@@ -46,9 +47,10 @@ def _closed(nd, expr) -> str:
 
 def _names(model: Model) -> dict:
     names = {s: p.latex for s, p in zip(model.parameter_symbols, model.parameters, strict=True)}
-    for c, s in zip(model.coordinates, model.state_symbols, strict=False):
+    disp = model.displacements
+    for c, s in zip(disp, model.state_symbols, strict=False):
         names[s] = c
-    for c, s in zip(model.coordinates, model.state_symbols[len(model.coordinates) :], strict=True):
+    for c, s in zip(disp, model.state_symbols[len(disp) :], strict=True):
         names[s] = f"{c}'"
     names[model.tau] = r"\tau"
     return names
@@ -57,7 +59,6 @@ def _names(model: Model) -> dict:
 def audit_page(model: Model, command: str) -> str:
     """``docs/derivation/<name>.md`` for ``model``."""
     scene, topo, nd = model.scene, model.scene.topology, model.nondim
-    eq = nd.equations
     names = _names(model)
     out: list[str] = []
     w = out.append
@@ -109,6 +110,127 @@ def audit_page(model: Model, command: str) -> str:
         )
     w("")
 
+    if model.structure is not None:
+        w(structure_sections(model))
+    else:
+        _torsional_sections(model, w)
+
+    w("## 7. Non-dimensional equations\n")
+    lhs = []
+    disp, m = model.displacements, len(model.coordinates)
+
+    def gof(j: int, c: str) -> str:
+        return f"g({c})" if j < m else c
+
+    for i, c in enumerate(disp):
+        terms = [f"{c}''"]
+        for cj in disp:
+            xi = sp.Symbol(f"xi_{c}_{cj}", real=True)
+            if xi in model.parameter_symbols:
+                terms.append(f"2{names[xi]}\\,{cj}'")
+        for j, cj in enumerate(disp):
+            if model.kappa_t[i, j] != 0:
+                terms.append(f"\\kappa_{{{c}{cj}}}(\\tau)\\,{gof(j, cj)}")
+        rhs = f"f_{{{c}}}" if model.loads[i] != 0 else "0"
+        if model.ebar[i] != 0:
+            rhs += f" + \\bar e_{{{c}}}''(\\tau)"
+        lhs.append(" + ".join(terms) + " &= " + rhs + r" \\")
+    w(_math(r"\begin{aligned}", *lhs, r"\end{aligned}"))
+    w("with the time-varying stiffness coefficients, transmission errors and backlash function")
+    defs = []
+    for i, c in enumerate(disp):
+        for j, cj in enumerate(disp):
+            if model.kappa_t[i, j] != 0 and j < m:
+                defs.append(
+                    f"\\kappa_{{{c}{cj}}}(\\tau) &= " + _latex(model.kappa_t[i, j], names) + r" \\"
+                )
+    for i, c in enumerate(model.coordinates):
+        if model.ebar[i] != 0:
+            defs.append(f"\\bar e_{{{c}}}(\\tau) &= " + _latex(model.ebar[i], names) + r" \\")
+    x = sp.Symbol("x", real=True)
+    defs.append("g(x) &= " + _latex(scene.features.backlash.expression(x), names) + r" \\")
+    w(_math(r"\begin{aligned}", *defs, r"\end{aligned}"))
+    if model.valid_range is not None:
+        w(f"The backlash model is valid for $|x| \\le {_num(model.valid_range)}$ only.\n")
+    w(
+        "The dynamic force of each mesh over its $k_m b$ (`mesh_force` of the generated "
+        "module; the dynamic factor is its peak over the static force, `static_mesh_force`, "
+        "the solution of $\\bar\\kappa F = f$ at the mean stiffness):"
+    )
+    w(
+        _math(
+            r"\begin{aligned}",
+            *(
+                f"F_{{{c}}} &= " + _latex(model.mesh_forces[i], names) + r" \\"
+                for i, c in enumerate(model.coordinates)
+            ),
+            r"\end{aligned}",
+        )
+    )
+
+    w("## 8. Coefficients: closed form and value\n")
+    rows = []
+    for i, c in enumerate(disp):
+        for j, cj in enumerate(disp):
+            if nd.kappa[i, j] != 0:
+                rows.append(f"K_{{{c}{cj}}} &= " + _closed(nd, nd.kappa[i, j]) + r" \\")
+    for i, c in enumerate(disp):
+        for j, cj in enumerate(disp):
+            if nd.xi[i, j] != 0:
+                used = (
+                    ""
+                    if sp.Symbol(f"xi_{c}_{cj}", real=True) in model.parameter_symbols
+                    else r"\quad(\text{dropped: damping coupling off})"
+                )
+                rows.append(f"\\xi_{{{c}{cj}}} &= " + _closed(nd, nd.xi[i, j]) + used + r" \\")
+    for i, c in enumerate(disp):
+        rows.append(f"f_{{{c}}}^{{\\mathrm{{torques}}}} &= " + _closed(nd, nd.load[i]) + r" \\")
+    w(_math(r"\begin{aligned}", *rows, r"\end{aligned}"))
+    if scene.loads is not None:
+        w(
+            "The scene sets the loads directly: "
+            + ", ".join(
+                f"$f_{{{c}}}$ = `{scene.load_expressions[c]}` = {_num(scene.loads[c])}"
+                for c in model.coordinates
+            )
+            + " (the torque form above converts torques to loads).\n"
+        )
+    section = reading_section(model)
+    if section:
+        w(section)
+    w("Parameter values of the emitted model, in the order of the generated code:\n")
+    w("| # | name | symbol | value | meaning |")
+    w("|---|---|---|---|---|")
+    for k, p in enumerate(model.parameters):
+        w(f"| {k} | `{p.name}` | ${p.latex}$ | {p.value:.10g} | {p.meaning} |")
+    w("")
+
+    w("## 9. Emitted model\n")
+    ops_rhs, ops_all = model.operations["rhs"], model.operations["rhs_and_jacobian"]
+    feats = scene.features
+    w(
+        f"States, in order: {', '.join(f'`{s}`' for s in model.states)}. "
+        f"{len(model.parameters)} parameters. Features: {feats.stiffness_harmonics} stiffness "
+        f"harmonics; backlash `{feats.backlash.kind}`; transmission error "
+        f"{'on' if feats.transmission_error else 'off'}; mesh phase "
+        f"{'on' if feats.mesh_phase else 'off'}; damping coupling "
+        f"{'on' if feats.damping_coupling else 'off'}. After common-subexpression "
+        f"elimination the right-hand side takes {ops_rhs} operations and the right-hand side "
+        f"with its Jacobian {ops_all} (SymPy `count_ops`). Mesh frequency ratios to the "
+        f"reference mesh: "
+        + ", ".join(
+            f"{c}: {r}" for c, r in zip(model.coordinates, model.frequency_ratios, strict=True)
+        )
+        + ".\n"
+    )
+    w(_contract_paragraph(model))
+    return "\n".join(out)
+
+
+def _torsional_sections(model: Model, w) -> None:
+    """Sections 2-6 of a torsional model's page."""
+    scene, nd = model.scene, model.nondim
+    eq = nd.equations
     w("## 2. Newton's second law for each gear\n")
     w(
         "Rotations $\\theta_k$ are positive in each gear's operating direction; "
@@ -204,112 +326,6 @@ def audit_page(model: Model, command: str) -> str:
         f"with $\\zeta = {_num(scene.damping_ratio)}$. "
         f"One unit of $\\tau$ is {_num(model.scales['time_unit_s'])} s.\n"
     )
-
-    w("## 7. Non-dimensional equations\n")
-    lhs = []
-    for i, c in enumerate(model.coordinates):
-        terms = [f"{c}''"]
-        for cj in model.coordinates:
-            xi = sp.Symbol(f"xi_{c}_{cj}", real=True)
-            if xi in model.parameter_symbols:
-                terms.append(f"2{names[xi]}\\,{cj}'")
-        for j, cj in enumerate(model.coordinates):
-            if model.kappa_t[i, j] != 0:
-                terms.append(f"\\kappa_{{{c}{cj}}}(\\tau)\\,g({cj})")
-        rhs = f"f_{{{c}}}"
-        if model.ebar[i] != 0:
-            rhs += f" + \\bar e_{{{c}}}''(\\tau)"
-        lhs.append(" + ".join(terms) + " &= " + rhs + r" \\")
-    w(_math(r"\begin{aligned}", *lhs, r"\end{aligned}"))
-    w("with the time-varying stiffness coefficients, transmission errors and backlash function")
-    defs = []
-    for i, c in enumerate(model.coordinates):
-        for j, cj in enumerate(model.coordinates):
-            if model.kappa_t[i, j] != 0:
-                defs.append(
-                    f"\\kappa_{{{c}{cj}}}(\\tau) &= " + _latex(model.kappa_t[i, j], names) + r" \\"
-                )
-    for i, c in enumerate(model.coordinates):
-        if model.ebar[i] != 0:
-            defs.append(f"\\bar e_{{{c}}}(\\tau) &= " + _latex(model.ebar[i], names) + r" \\")
-    x = sp.Symbol("x", real=True)
-    defs.append("g(x) &= " + _latex(scene.features.backlash.expression(x), names) + r" \\")
-    w(_math(r"\begin{aligned}", *defs, r"\end{aligned}"))
-    if model.valid_range is not None:
-        w(f"The backlash model is valid for $|x| \\le {_num(model.valid_range)}$ only.\n")
-    w(
-        "The dynamic force of each mesh over its $k_m b$ (`mesh_force` of the generated "
-        "module; the dynamic factor is its peak over the static force, `static_mesh_force`, "
-        "the solution of $\\bar\\kappa F = f$ at the mean stiffness):"
-    )
-    w(
-        _math(
-            r"\begin{aligned}",
-            *(
-                f"F_{{{c}}} &= " + _latex(model.mesh_forces[i], names) + r" \\"
-                for i, c in enumerate(model.coordinates)
-            ),
-            r"\end{aligned}",
-        )
-    )
-
-    w("## 8. Coefficients: closed form and value\n")
-    rows = []
-    for i, c in enumerate(model.coordinates):
-        for j, cj in enumerate(model.coordinates):
-            if nd.kappa[i, j] != 0:
-                rows.append(f"K_{{{c}{cj}}} &= " + _closed(nd, nd.kappa[i, j]) + r" \\")
-    for i, c in enumerate(model.coordinates):
-        for j, cj in enumerate(model.coordinates):
-            if nd.xi[i, j] != 0:
-                used = (
-                    ""
-                    if sp.Symbol(f"xi_{c}_{cj}", real=True) in model.parameter_symbols
-                    else r"\quad(\text{dropped: damping coupling off})"
-                )
-                rows.append(f"\\xi_{{{c}{cj}}} &= " + _closed(nd, nd.xi[i, j]) + used + r" \\")
-    for i, c in enumerate(model.coordinates):
-        rows.append(f"f_{{{c}}}^{{\\mathrm{{torques}}}} &= " + _closed(nd, nd.load[i]) + r" \\")
-    w(_math(r"\begin{aligned}", *rows, r"\end{aligned}"))
-    if scene.loads is not None:
-        w(
-            "The scene sets the loads directly: "
-            + ", ".join(
-                f"$f_{{{c}}}$ = `{scene.load_expressions[c]}` = {_num(scene.loads[c])}"
-                for c in model.coordinates
-            )
-            + " (the torque form above converts torques to loads).\n"
-        )
-    section = reading_section(model)
-    if section:
-        w(section)
-    w("Parameter values of the emitted model, in the order of the generated code:\n")
-    w("| # | name | symbol | value | meaning |")
-    w("|---|---|---|---|---|")
-    for k, p in enumerate(model.parameters):
-        w(f"| {k} | `{p.name}` | ${p.latex}$ | {p.value:.10g} | {p.meaning} |")
-    w("")
-
-    w("## 9. Emitted model\n")
-    ops_rhs, ops_all = model.operations["rhs"], model.operations["rhs_and_jacobian"]
-    feats = scene.features
-    w(
-        f"States, in order: {', '.join(f'`{s}`' for s in model.states)}. "
-        f"{len(model.parameters)} parameters. Features: {feats.stiffness_harmonics} stiffness "
-        f"harmonics; backlash `{feats.backlash.kind}`; transmission error "
-        f"{'on' if feats.transmission_error else 'off'}; mesh phase "
-        f"{'on' if feats.mesh_phase else 'off'}; damping coupling "
-        f"{'on' if feats.damping_coupling else 'off'}. After common-subexpression "
-        f"elimination the right-hand side takes {ops_rhs} operations and the right-hand side "
-        f"with its Jacobian {ops_all} (SymPy `count_ops`). Mesh frequency ratios to the "
-        f"reference mesh: "
-        + ", ".join(
-            f"{c}: {r}" for c, r in zip(model.coordinates, model.frequency_ratios, strict=True)
-        )
-        + ".\n"
-    )
-    w(_contract_paragraph(model))
-    return "\n".join(out)
 
 
 def _contract_paragraph(model: Model) -> str:

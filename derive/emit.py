@@ -23,6 +23,7 @@ from sympy.printing.str import StrPrinter
 from .emit_c import c_source
 from .model import Model, operation_count  # operation_count re-exported
 from .scene import PARAMETER_LIMITS
+from .structure import physical_data
 
 __all__ = ["CodePrinter", "emit_module", "operation_count", "write_atomic"]
 
@@ -158,6 +159,7 @@ def _docstring(model: Model, command: str) -> str:
         "",
         "States (in order):",
     ]
+    n_disp = len(model.displacements)
     for k, s in enumerate(model.states):
         if k < len(model.coordinates):
             mesh = scene.topology.meshes[k]
@@ -165,8 +167,15 @@ def _docstring(model: Model, command: str) -> str:
                 f"mesh {mesh.id} ({mesh.driver} -> {mesh.driven}) deflection along the "
                 "line of action / half backlash"
             )
+        elif k < n_disp:
+            c = model.structure.coordinates[k]
+            what = (
+                f"shaft {c.owner}: twist / (b_1 / r_b)"
+                if c.kind == "shaft"
+                else f"gear {c.owner}: {c.kind} translation / b_1"
+            )
         else:
-            what = f"d({model.coordinates[k - len(model.coordinates)]})/dtau"
+            what = f"d({model.displacements[k - n_disp]})/dtau"
         lines.append(f"    {k:2d}  {s:<6} {what}")
     lines += ["", "Parameters (in order; default = the scene's value):"]
     for k, p in enumerate(model.parameters):
@@ -179,7 +188,13 @@ def _docstring(model: Model, command: str) -> str:
         + (f" (valid for |u| <= {b.valid_range:g})" if b.valid_range is not None else "")
         + f"; transmission error {'on' if feats.transmission_error else 'off'}"
         f"; mesh phase {'on' if feats.mesh_phase else 'off'}"
-        f"; damping coupling {'on' if feats.damping_coupling else 'off'}.",
+        f"; damping coupling {'on' if feats.damping_coupling else 'off'}"
+        + (
+            ""
+            if feats.degrees_of_freedom == "torsional"
+            else f"; degrees of freedom {feats.degrees_of_freedom}"
+        )
+        + ".",
         f"Time: tau = omega_n t, omega_n = {model.scales['omega_n_rad_per_s']:.10g} rad/s.",
         "",
         "CONTRACT states as data what a solver needs: velocity indices, forcing frequency,",
@@ -198,7 +213,7 @@ def emit_module(model: Model, command: str) -> str:
     jac_lines, jac_out = _body(model, jac, np_printer)
     ca_lines, ca_out = _body(model, rhs, ca_printer)
     force_lines, force_out = _body(model, list(model.mesh_forces), np_printer)
-    m_mesh = len(model.coordinates)
+    m_mesh = len(model.displacements)
     static_lines, static_out = _body(
         model, list(model.static_kappa) + list(model.loads), np_printer
     )
@@ -260,6 +275,12 @@ def emit_module(model: Model, command: str) -> str:
         "# derive/model.py); solvers read this, never the source or the names.",
         "CONTRACT = {",
         *(f"    {k!r}: {v!r}," for k, v in model.contract.items()),
+        "}",
+        "",
+        "# The linear, time-averaged model in physical coordinates, for the modal analysis",
+        "# (derive/structure.py physical_data; solver/analysis/modes.py).",
+        "STRUCTURE = {",
+        *(f"    {k!r}: {v!r}," for k, v in physical_data(model).items()),
         "}",
         "",
         "# The right-hand side in C for the compiled integrators (solver/integrate/native/).",
@@ -337,7 +358,8 @@ def emit_module(model: Model, command: str) -> str:
         *static_lines,
         f"    K = np.array([{static_rows}], dtype=float)",
         f"    f = np.array([{static_loads}], dtype=float)",
-        "    return np.linalg.solve(K, f)",
+        "    return np.linalg.solve(K, f)"
+        + ("" if m_mesh == len(model.coordinates) else f"[:{len(model.coordinates)}]"),
         "",
         "",
         "def _broadcast(*rows):",

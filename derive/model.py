@@ -38,6 +38,7 @@ from .contract import CONTRACT_FORMAT, model_contract
 from .equations import derive_equations
 from .nondim import NonDim, nondimensionalise
 from .scene import Features, Scene
+from .structure import derive_structure
 
 __all__ = ["CONTRACT_FORMAT", "Model", "Parameter", "derive_model", "operation_count"]
 
@@ -79,6 +80,8 @@ class Model:
     static_kappa: sp.ImmutableMatrix  # kappa at the mean stiffness: kappa F_static = f
     loads: tuple[sp.Symbol, ...]  # f of each coordinate
     kappa_t: sp.ImmutableMatrix  # kappa_ij(tau) in parameter symbols
+    displacements: tuple[str, ...]  # every coordinate: the meshes', then shafts, translations
+    structure: object  # derive.structure.Structure of a model beyond torsion, else None
     ebar: tuple[sp.Expr, ...]
     nondim: NonDim
     scales: dict
@@ -134,8 +137,10 @@ def inputs_hash(scene: Scene) -> str:
     }
     if scene.variations:  # a variant of the files (derive.scene.variant)
         payload["variant"] = {"name": scene.name, "features": scene.variations}
-    for key, path in (("scene", scene.source), ("topology", scene.topology.source)):
-        payload[key] = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    from .supports import load_topology_data
+
+    payload["scene"] = tomllib.loads(Path(scene.source).read_text(encoding="utf-8"))
+    payload["topology"] = load_topology_data(scene.topology.source)
     text = json.dumps(payload, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()
 
@@ -144,14 +149,27 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
     """Derive the non-dimensional model of ``scene`` (see module docstring)."""
     topo = scene.topology
     feats = scene.features
-    eq = derive_equations(topo)
-    nd = nondimensionalise(topo, scene.damping_ratio, eq, scene.damping_normalisation)
     meshes = topo.meshes
     m = len(meshes)
     coords = tuple(me.coordinate for me in meshes)
+    structure = None
+    if feats.degrees_of_freedom == "torsional" and not topo.shafts:
+        eq = derive_equations(topo)
+        nd = nondimensionalise(topo, scene.damping_ratio, eq, scene.damping_normalisation)
+        orientation = eq.orientation
+        disp = coords
+    else:  # bearings or shafts: derive/structure.py
+        structure = derive_structure(
+            topo, feats.degrees_of_freedom, scene.damping_ratio, scene.source
+        )
+        _check_structural_scene(scene)
+        nd = structure
+        orientation = tuple(me.orientation for me in meshes)
+        disp = structure.names
+    N = len(disp)
     tau = sp.Symbol("tau", real=True)
-    u = tuple(sp.Symbol(c, real=True) for c in coords)
-    du = tuple(sp.Symbol(f"d{c}", real=True) for c in coords)
+    u = tuple(sp.Symbol(c, real=True) for c in disp)
+    du = tuple(sp.Symbol(f"d{c}", real=True) for c in disp)
     ratios = topo.mesh_frequency_ratios()
     freq = tuple(sp.Rational(ratios[me.id].numerator, ratios[me.id].denominator) for me in meshes)
 
@@ -192,29 +210,40 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
     else:
         f_values = [nd.value(nd.load[i]) for i in range(m)]
         f_meaning = "static load (from the topology's torques)"
-    f = tuple(param(f"f_{c}", f_values[i], f_meaning, f"f_{{{c}}}") for i, c in enumerate(coords))
+    # Beyond the meshes: a shaft's load from the torques; none on a translation.
+    f_values += [nd.value(nd.load[i]) for i in range(m, N)]
+    f = tuple(
+        param(f"f_{c}", f_values[i], f_meaning if i < m else "static load (from the topology's "
+              "torques)", f"f_{{{c}}}")
+        if i < m or f_values[i] != 0
+        else sp.Integer(0)
+        for i, c in enumerate(disp)
+    )  # fmt: skip
+
+    def what(j: int) -> str:
+        return f"g({disp[j]})" if j < m else disp[j]
 
     xi = {}
-    for i in range(m):
-        for j in range(m):
+    for i in range(N):
+        for j in range(N):
             if nd.xi[i, j] == 0 or (i != j and not feats.damping_coupling):
                 continue
             xi[i, j] = param(
-                f"xi_{coords[i]}_{coords[j]}",
+                f"xi_{disp[i]}_{disp[j]}",
                 nd.value(nd.xi[i, j]),
-                f"damping coefficient of d{coords[j]} in the {coords[i]} equation",
-                rf"\xi_{{{coords[i]}{coords[j]}}}",
+                f"damping coefficient of d{disp[j]} in the {disp[i]} equation",
+                rf"\xi_{{{disp[i]}{disp[j]}}}",
             )
     kappa = {}
-    for i in range(m):
-        for j in range(m):
+    for i in range(N):
+        for j in range(N):
             if nd.kappa[i, j] == 0:
                 continue
             kappa[i, j] = param(
-                f"kappa_{coords[i]}_{coords[j]}",
+                f"kappa_{disp[i]}_{disp[j]}",
                 nd.value(nd.kappa[i, j]),
-                f"mean stiffness coefficient of g({coords[j]}) in the {coords[i]} equation",
-                rf"K_{{{coords[i]}{coords[j]}}}",
+                f"mean stiffness coefficient of {what(j)} in the {disp[i]} equation",
+                rf"K_{{{disp[i]}{disp[j]}}}",
             )
     H = feats.stiffness_harmonics
     kc, ks = {}, {}
@@ -283,7 +312,7 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
         for j in range(m)
     ]
     ebar = tuple(
-        eq.orientation[j]
+        orientation[j]
         * sum(
             (
                 te_amp[j, h] * sp.cos(h * phase_arg[j] + te_phase[j, h])
@@ -293,15 +322,16 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
             sp.Integer(0),
         )
         for j in range(m)
-    )
-    gexpr = [feats.backlash.expression(u[j]) for j in range(m)]
-    kappa_t = sp.ImmutableMatrix(m, m, lambda i, j: kappa[i, j] * khat[j] if (i, j) in kappa else 0)
+    ) + (sp.Integer(0),) * (N - m)
+    khat += [sp.Integer(1)] * (N - m)
+    gexpr = [feats.backlash.expression(u[j]) for j in range(m)] + list(u[m:])
+    kappa_t = sp.ImmutableMatrix(N, N, lambda i, j: kappa[i, j] * khat[j] if (i, j) in kappa else 0)
     acc = tuple(
         f[i]
         + sp.diff(ebar[i], tau, 2)
-        - sum(2 * xi[i, j] * du[j] for j in range(m) if (i, j) in xi)
-        - sum(kappa_t[i, j] * gexpr[j] for j in range(m) if (i, j) in kappa)
-        for i in range(m)
+        - sum(2 * xi[i, j] * du[j] for j in range(N) if (i, j) in xi)
+        - sum(kappa_t[i, j] * gexpr[j] for j in range(N) if (i, j) in kappa)
+        for i in range(N)
     )
     # The dynamic mesh force of each mesh over its k_m b: the elastic part k_hat g(u) and,
     # with one damper per mesh ("mesh" damping), the viscous part c u', whose ratio to the
@@ -316,8 +346,8 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
         )
         for j in range(m)
     )
-    static_kappa = sp.ImmutableMatrix(m, m, lambda i, j: kappa.get((i, j), 0))
-    states = coords + tuple(f"d{c}" for c in coords)
+    static_kappa = sp.ImmutableMatrix(N, N, lambda i, j: kappa.get((i, j), 0))
+    states = disp + tuple(f"d{c}" for c in disp)
     state_symbols = u + du
     rhs = du + acc
     jac = sp.ImmutableMatrix(rhs).jacobian(state_symbols)
@@ -343,8 +373,10 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
             source = expression_source(scene.load_expressions[c])
             sources[f"f_{c}"] = source if signs[c] > 0 else f"-({source})"
     for i, j in xi:
+        if j >= m:  # a bearing's or shaft's own damper: not set by the damping ratio
+            continue
         unit = nd.value(nd.xi[i, j].subs(nd.zeta, 1))
-        sources[f"xi_{coords[i]}_{coords[j]}"] = f"{float(f'{unit:.15g}')!r} * s['damping_ratio']"
+        sources[f"xi_{disp[i]}_{disp[j]}"] = f"{float(f'{unit:.15g}')!r} * s['damping_ratio']"
 
     om = nd.value(nd.omega_n_expr)
     scales = {
@@ -364,7 +396,7 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
         states=states,
         parameters=tuple(params),
         forcing_frequency=omega.name,
-        load_parameters={c: s.name for c, s in zip(coords, f, strict=True)},
+        load_parameters={c: s.name for c, s in zip(coords, f[:m], strict=True)},
         tau=tau,
         state_symbols=state_symbols,
         parameter_symbols=tuple(sp.Symbol(n, real=True) for n in names),
@@ -375,6 +407,8 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
         static_kappa=static_kappa,
         loads=f,
         kappa_t=kappa_t,
+        displacements=disp,
+        structure=structure,
         ebar=ebar,
         nondim=nd,
         scales=scales,
@@ -383,6 +417,25 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
         parameter_sources={k: v for k, v in sources.items() if k in names},
         inputs_hash=inputs_hash(scene),
     )
+
+
+def _check_structural_scene(scene: Scene) -> None:
+    """What a model with bearings or shafts does not take (one line each)."""
+    where = f"{scene.source} [open]"
+    if scene.damping_normalisation != "mesh":
+        raise InputError(
+            where,
+            "damping_normalisation",
+            f"'{scene.damping_normalisation}' applies to torsional models only; bearings and "
+            "shafts bring their own dampers, so use 'mesh'",
+        )
+    if scene.loads is not None and scene.topology.shafts:
+        raise InputError(
+            scene.source,
+            "loads",
+            "a train with shafts takes its loads from the topology's torques (a shaft's "
+            "twist needs them too); remove [loads]",
+        )
 
 
 def _latex_backlash(name: str) -> str:

@@ -175,6 +175,7 @@ def with_open_values(scene, **values):
     import json
 
     from ._input import load_toml
+    from .supports import load_topology_data
     from .topology import parse_topology
 
     where = f"{scene.source} (open values)"
@@ -191,7 +192,7 @@ def with_open_values(scene, **values):
         opened = load_toml(scene.source).get("open", {})
         before = {k: v for k, v in opened.items() if k not in CHOICES} | before
     before = {k: v for k, v in before.items() if k not in CHOICES}
-    data = load_toml(source)
+    data = load_topology_data(source)
     old = apply_open_values(data, before, where)
     new = apply_open_values(data, before | numbers, where)
     if new == old:

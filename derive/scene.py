@@ -39,6 +39,7 @@ from .backlash import (
     SmoothDeadZone,
     fit_dead_zone,
 )
+from .supports import load_topology_data
 from .topology import Topology, load_topology, parse_topology
 
 __all__ = [
@@ -68,16 +69,22 @@ class Features:
     transmission_error: bool = True
     mesh_phase: bool = True
     damping_coupling: bool = True
+    # Which degrees of freedom each gear has (derive/structure.py DEGREES_OF_FREEDOM).
+    degrees_of_freedom: str = "torsional"
 
     def flags(self) -> dict:
-        """The feature switches, with the backlash by kind only."""
-        return {
+        """The feature switches, with the backlash by kind only (the degrees of freedom
+        only when they go beyond torsion, so that torsional models keep their files)."""
+        flags = {
             "stiffness_harmonics": self.stiffness_harmonics,
             "backlash": self.backlash.kind,
             "transmission_error": self.transmission_error,
             "mesh_phase": self.mesh_phase,
             "damping_coupling": self.damping_coupling,
         }
+        if self.degrees_of_freedom != "torsional":
+            flags["degrees_of_freedom"] = self.degrees_of_freedom
+        return flags
 
     def describe(self) -> dict:
         """The feature switches with the backlash model's full description."""
@@ -161,9 +168,33 @@ def _features(t: Table | None) -> Features:
         transmission_error=t.boolean("transmission_error", True),
         mesh_phase=t.boolean("mesh_phase", True),
         damping_coupling=t.boolean("damping_coupling", True),
+        degrees_of_freedom=_degrees_of_freedom(t),
     )
     t.finish()
     return features
+
+
+def _degrees_of_freedom(t: Table) -> str:
+    from .structure import DEGREES_OF_FREEDOM
+
+    dofs = t.string(
+        "degrees_of_freedom",
+        "torsional",
+        choices=(*DEGREES_OF_FREEDOM, "lateral-torsional-axial-tilting"),
+    )
+    if dofs.endswith("tilting"):
+        raise t.error(
+            "degrees_of_freedom",
+            "tilting is not modelled yet (the axial force's moments go to the bearings); use "
+            "'lateral-torsional-axial'",
+        )
+    if dofs != "torsional" and not t.data.get("damping_coupling", True):
+        raise t.error(
+            "damping_coupling",
+            f"must stay true with degrees_of_freedom = '{dofs}': a mesh's damper acts on a "
+            "deflection its gears' translations share",
+        )
+    return dofs
 
 
 def variant(scene: Scene, name: str, **features) -> Scene:
@@ -256,7 +287,7 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
                 choices[key] = open_t.string(key)
         values = {key: open_t.number(key) for key in open_t.data if key not in CHOICES}
         open_t.finish()
-        data = apply_open_values(load_toml(topo_path), values, f"{source} [open]")
+        data = apply_open_values(load_topology_data(topo_path), values, f"{source} [open]")
         topology = parse_topology(data, str(topo_path))
     reading = choices.get("load_reading")
     if reading is not None:
@@ -382,7 +413,7 @@ def load_target(path: Path | str, overrides: dict[str, float] | None = None) -> 
     path = Path(path)
     data = load_toml(path)
     if "topology" in data and "scene" not in data:
-        topology = parse_topology(data, str(path))
+        topology = parse_topology(load_topology_data(path), str(path))
         if topology.operating is None:
             raise InputError(
                 str(path),
@@ -408,11 +439,14 @@ def load_target(path: Path | str, overrides: dict[str, float] | None = None) -> 
                 )
             parameters[key] = float(value)
         _check_parameters(Table({}, str(path), "operating"), parameters)
+        # Every feature on: a topology whose gears all sit on bearings moves them.
+        supported = topology.bearings and set(topology.bearings) == {g.id for g in topology.gears}
+        dofs = "lateral-torsional-axial" if supported else "torsional"
         return Scene(
             topology.name,
             topology.description,
             topology,
-            Features(),
+            Features(degrees_of_freedom=dofs),
             parameters,
             None,
             None,

@@ -20,11 +20,12 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
 
-from ._input import Table, load_toml, nearest
+from ._input import Table, nearest
 from .geometry import GearGeometry, PairGeometry, gear_geometry, pair_geometry
 from .pem import pem_stiffness
 from .readings import ORIENTATIONS, parse_readings
 from .stiffness import MeshStiffness, contact_line_stiffness
+from .supports import Bearing, Shaft, load_topology_data, parse_bearings, parse_shafts
 
 __all__ = [
     "Gear",
@@ -66,6 +67,8 @@ class Gear:
     inertia_given: float | None
     attached_inertia: float
     geometry: GearGeometry
+    mass_given: float | None = None
+    attached_mass: float = 0.0
 
     @property
     def blank_inertia(self) -> float:
@@ -81,6 +84,17 @@ class Gear:
     def inertia(self) -> float:
         """Total polar moment of inertia of the body, kg m^2."""
         return self.gear_inertia + self.attached_inertia
+
+    @property
+    def mass(self) -> float:
+        """Total mass of the body, kg: given, or the blank ``rho pi b (r^2 - r_bore^2)``
+        (the same cylinder as the inertia), plus any attached mass."""
+        if self.mass_given is not None:
+            return self.mass_given + self.attached_mass
+        r, rb = self.geometry.pitch_radius, self.bore_radius
+        return self.material.density * math.pi * self.face_width * (r**2 - rb**2) + (
+            self.attached_mass
+        )
 
     @property
     def base_radius(self) -> float:
@@ -112,6 +126,9 @@ class Mesh:
     phase_source: str
     pair: PairGeometry
     orientation: int = 1  # +1: coordinate positive on the driver's flank; -1: reversed
+    # Angle of the driver's centre round the driven gear's, from +x, counter-clockwise seen
+    # from +z (the axes' direction), rad: it sets the line of action's direction.
+    driver_position: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -131,9 +148,26 @@ class Topology:
     operating: Operating | None = None
     source: str = ""
     readings: dict = field(default_factory=dict)  # id -> derive.readings.Reading
+    bearings: dict[str, Bearing] = field(default_factory=dict)  # gear id -> its bearing
+    shafts: tuple[Shaft, ...] = ()
 
     def gear(self, gear_id: str) -> Gear:
         return next(g for g in self.gears if g.id == gear_id)
+
+    def senses(self) -> dict[str, int]:
+        """Each gear's turning sense seen from +z: +1 counter-clockwise.  The first mesh's
+        driver turns counter-clockwise (a convention: its mirror image is the same train);
+        an external mesh reverses the sense, a shaft keeps it."""
+        sense = {self.reference.driver: 1}
+        links = [(m.driver, m.driven, -1) for m in self.meshes]
+        links += [(s.gears[0], s.gears[1], 1) for s in self.shafts]
+        while len(sense) < len(self.gears):
+            for a, b, flip in links:
+                if a in sense and b not in sense:
+                    sense[b] = flip * sense[a]
+                elif b in sense and a not in sense:
+                    sense[a] = flip * sense[b]
+        return sense
 
     @property
     def reference(self) -> Mesh:
@@ -147,7 +181,13 @@ class Topology:
         """
         speed = {gear_id: Fraction(1)}
         pending = list(self.meshes)
-        while pending:
+        shafts = list(self.shafts)
+        while pending or shafts:
+            for s in list(shafts):  # gears on one shaft turn together
+                a, b = s.gears
+                if a in speed or b in speed:
+                    speed[b if a in speed else a] = speed[a if a in speed else b]
+                    shafts.remove(s)
             for m in list(pending):
                 zd, zn = self.gear(m.driver).teeth, self.gear(m.driven).teeth
                 if m.driver in speed:
@@ -241,6 +281,8 @@ def _gear(t: Table, materials: dict[str, Material]) -> Gear:
         )
     inertia = t.number("inertia_kg_m2", None, low=0, low_open=True)
     attached = t.number("attached_inertia_kg_m2", 0.0, low=0.0)
+    mass = t.number("mass_kg", None, low=0, low_open=True, high=1e6)
+    attached_mass = t.number("attached_mass_kg", 0.0, low=0.0, high=1e6)
     t.finish()
     return Gear(
         gid,
@@ -255,6 +297,8 @@ def _gear(t: Table, materials: dict[str, Material]) -> Gear:
         inertia,
         attached,
         geometry,
+        mass,
+        attached_mass,
     )
 
 
@@ -495,6 +539,7 @@ def parse_topology(data: dict, source: str) -> Topology:
         te = _transmission_error(mt.table("transmission_error", None))
         phase, phase_source = _phase(mt, meshes, ends, by_id)
         orientation = mt.string("orientation", "forward", choices=ORIENTATIONS)
+        position = math.radians(mt.number("driver_position_deg", 0.0, low=-360.0, high=360.0))
         mt.finish()
         for other in meshes:
             if other.id == mid:
@@ -518,6 +563,7 @@ def parse_topology(data: dict, source: str) -> Topology:
                 phase_source,
                 pair,
                 ORIENTATIONS[orientation],
+                position,
             )
         )
 
@@ -530,7 +576,9 @@ def parse_topology(data: dict, source: str) -> Topology:
                 f"'{m.coordinate}' is named 'd{m.coordinate}'; rename one",
             )
 
-    _check_tree(top, gears, meshes)
+    shafts = parse_shafts(top, by_id)
+    _check_tree(top, gears, meshes, shafts)
+    bearings = parse_bearings(top, by_id)
 
     torques: dict[str, float] = {}
     for tt in top.tables("torque") if top.has("torque") else []:
@@ -555,34 +603,47 @@ def parse_topology(data: dict, source: str) -> Topology:
     readings = parse_readings(top, list(by_id), [m.id for m in meshes])
     top.finish()
     return Topology(
-        name, description, tuple(gears), tuple(meshes), torques, operating, source, readings
+        name,
+        description,
+        tuple(gears),
+        tuple(meshes),
+        torques,
+        operating,
+        source,
+        readings,
+        bearings,
+        shafts,
     )
 
 
-def _check_tree(top: Table, gears: list[Gear], meshes: list[Mesh]) -> None:
-    if len(meshes) != len(gears) - 1:
+def _check_tree(top: Table, gears: list[Gear], meshes: list[Mesh], shafts=()) -> None:
+    links = [(m.driver, m.driven) for m in meshes] + [s.gears for s in shafts]
+    if len(links) != len(gears) - 1:
+        what = "meshes" if not shafts else "meshes and shafts"
         raise top.error(
             "mesh",
-            f"{len(gears)} gears need exactly {len(gears) - 1} meshes "
-            f"(a tree), got {len(meshes)}; closed gear loops are not "
+            f"{len(gears)} gears need exactly {len(gears) - 1} {what} "
+            f"(a tree), got {len(links)}; closed gear loops are not "
             "supported",
         )
     reached = {meshes[0].driver}
     changed = True
     while changed:
         changed = False
-        for m in meshes:
-            if (m.driver in reached) != (m.driven in reached):
-                reached |= {m.driver, m.driven}
+        for a, b in links:
+            if (a in reached) != (b in reached):
+                reached |= {a, b}
                 changed = True
     lost = [g.id for g in gears if g.id not in reached]
     if lost:
         raise top.error(
-            "mesh", f"gear(s) {', '.join(lost)} are not connected to the others by any mesh"
+            "mesh",
+            f"gear(s) {', '.join(lost)} are not connected to the others by any mesh"
+            + (" or shaft" if shafts else ""),
         )
 
 
 def load_topology(path: Path | str) -> Topology:
     """Read and validate a topology TOML file."""
     path = Path(path)
-    return parse_topology(load_toml(path), str(path))
+    return parse_topology(load_topology_data(path), str(path))

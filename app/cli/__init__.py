@@ -1,6 +1,7 @@
 """The ``gearsym`` command line: one module per command group.
 
 * ``derive.py`` -- derive, backlash, stiffness;
+* ``modes.py`` -- modes;
 * ``point.py`` -- simulate, sweep;
 * ``orbits.py`` -- shoot, continue;
 * ``atlas.py`` -- map;
@@ -24,7 +25,7 @@ import sys
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-from . import atlas, derive, orbits, point, response, study  # noqa: E402
+from . import atlas, derive, modes, orbits, point, response, study  # noqa: E402
 from ._common import Fail, OneLineParser, RunFailed, out_folder  # noqa: E402
 
 __all__ = ["main"]
@@ -40,7 +41,7 @@ def _parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(
         dest="command", required=True, metavar="COMMAND", parser_class=OneLineParser
     )
-    for group in (derive, point, orbits, atlas, response, study):
+    for group in (derive, modes, point, orbits, atlas, response, study):
         group.register(sub)
     return parser
 

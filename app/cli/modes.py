@@ -1,0 +1,80 @@
+"""``gearsym modes``: natural frequencies and mode shapes of the linear, time-averaged
+model, with the resonance (Campbell) diagram against the mesh frequency."""
+
+from __future__ import annotations
+
+import json
+import math
+
+from ._common import Fail, figure_file
+
+__all__ = ["register"]
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "modes",
+        help="natural frequencies, mode shapes and the resonance diagram of a model",
+        description="Natural frequencies (Hz and over the mesh frequency) and mode shapes of "
+        "the linear, time-averaged model (mean mesh stiffness, backlash closed, no damping), "
+        "each labelled by where its kinetic energy sits, and the speeds where a mesh-frequency "
+        "harmonic meets one.",
+    )
+    p.add_argument("target", help="built-in scene or topology name, or a .toml path")
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.add_argument(
+        "--speeds",
+        metavar="LO:HI",
+        help="speed range of the reference driver, rpm (default: 0 to twice the scene's)",
+    )
+    p.add_argument("--plot", metavar="FILE", help="write the resonance diagram (PNG, PDF, SVG)")
+    p.set_defaults(func=_cmd_modes)
+
+
+def _speeds(text: str | None, scene_rpm: float) -> tuple[float, float]:
+    if text is None:
+        return 0.0, 2.0 * scene_rpm
+    try:
+        lo, hi = (float(v) for v in text.split(":"))
+    except ValueError:
+        raise Fail(f"--speeds {text}: expected LO:HI in rpm, for example 0:3000") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0 <= lo < hi):
+        raise Fail(f"--speeds {text}: give 0 <= LO < HI, finite, in rpm")
+    return lo, hi
+
+
+def _cmd_modes(args) -> int:
+    from gearsym.resolve import module_for
+    from gearsym.solver.analysis.modes import modes
+
+    if args.plot:
+        figure_file(args.plot, "--plot")
+    module = module_for(args.target)
+    result = modes(module)
+    scene_rpm = 60.0 * result.mesh_frequency_hz / result.reference_teeth
+    speeds = _speeds(args.speeds, scene_rpm)
+    if args.plot:
+        from gearsym.solver.plots_modes import campbell_figure
+
+        campbell_figure(result, speeds, args.plot, scene_rpm=scene_rpm)
+    if args.json:
+        print(json.dumps(result.to_json(speeds), indent=1))
+        return 0
+    print(
+        f"{result.model}: {len(result.modes)} modes of the linear, time-averaged model; "
+        f"mesh frequency {result.mesh_frequency_hz:.1f} Hz at the scene's speed "
+        f"({scene_rpm:.0f} rpm of the reference driver)"
+    )
+    print(f"  {'#':>2}  {'Hz':>10}  {'/ mesh':>7}  {'label':<13}  kinetic energy")
+    for m in result.modes:
+        shares = ", ".join(f"{k} {v:.2f}" for k, v in m.kinetic_shares.items() if v >= 0.005)
+        print(f"  {m.index:2d}  {m.frequency_hz:10.1f}  {result.over_mesh(m):7.3f}  "
+              f"{m.label:<13}  {shares}")  # fmt: skip
+    res = [r for r in result.resonances(speeds) if r["harmonic"] == 1]
+    if res:
+        print(f"  the mesh frequency meets a mode between {speeds[0]:g} and {speeds[1]:g} rpm "
+              "at: " + ", ".join(f"{r['speed_rpm']:.0f} rpm (mode {r['mode']})" for r in res)
+              + " (2x and 3x mesh in --json and --plot)")  # fmt: skip
+    if args.plot:
+        print(f"  resonance diagram: {args.plot}")
+    return 0

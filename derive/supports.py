@@ -1,0 +1,150 @@
+"""Bearings, shafts and topology files that extend another one (issue 15).
+
+A ``[[bearing]]`` holds one gear to the housing: a spring and a viscous damper along each
+transverse axis (``radial_N_per_m``, ``radial_damping_N_s_per_m``, the same along x and y)
+and along the gear's axis (``axial_N_per_m``, ``axial_damping_N_s_per_m``).  A gear's
+translations are modelled only when the scene asks for them (``degrees_of_freedom``); it
+then needs a bearing, or it would float.
+
+A ``[[shaft]]`` joins two gears that turn together (a multi-stage train's intermediate
+shaft): a torsional spring ``torsional_Nm_per_rad`` and damper
+``torsional_damping_Nm_s_per_rad`` between their rotations.  Meshes and shafts together
+must form a tree over the gears.  A shaft carries no lateral coupling here: each gear sits
+on its own bearing (the shaft's bending is lumped into the bearings' radial stiffness).
+
+A topology file may start from another one: ``[topology] extends = "diso.toml"`` (a path
+next to the file) takes that file's tables, then this file's on top: an entry of an array
+of tables (``[[gear]]``, ``[[mesh]]``, ``[[reading]]``) with an ``id`` already there
+updates that entry key by key, any other entry is added, and plain tables merge key by key.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from ._input import InputError, Table, load_toml, nearest
+
+__all__ = ["Bearing", "Shaft", "load_topology_data", "parse_bearings", "parse_shafts"]
+
+
+@dataclass(frozen=True)
+class Bearing:
+    """The support of one gear (SI units: N/m and N s/m)."""
+
+    gear: str
+    radial: float
+    axial: float
+    radial_damping: float = 0.0
+    axial_damping: float = 0.0
+
+
+@dataclass(frozen=True)
+class Shaft:
+    """A torsional spring and damper joining the rotations of two gears (N m/rad, N m s/rad)."""
+
+    id: str
+    gears: tuple[str, str]
+    stiffness: float
+    damping: float = 0.0
+
+
+def parse_bearings(top: Table, gears: dict) -> dict[str, Bearing]:
+    """The ``[[bearing]]`` tables, by gear."""
+    out: dict[str, Bearing] = {}
+    for t in top.tables("bearing") if top.has("bearing") else []:
+        gid = t.string("gear")
+        if gid not in gears:
+            raise t.error("gear", f"names unknown gear '{gid}'" + nearest(gid, gears))
+        if gid in out:
+            raise t.error("gear", f"gear '{gid}' has a bearing already; give one per gear")
+        # Upper limit: far stiffer than any rolling or journal bearing (1e8-1e10 N/m); the
+        # very-stiff limit a test needs stays inside it.
+        out[gid] = Bearing(
+            gid,
+            t.number("radial_N_per_m", low=0, low_open=True, high=1e16),
+            t.number("axial_N_per_m", low=0, low_open=True, high=1e16),
+            t.number("radial_damping_N_s_per_m", 0.0, low=0.0, high=1e12),
+            t.number("axial_damping_N_s_per_m", 0.0, low=0.0, high=1e12),
+        )
+        t.finish()
+    return out
+
+
+def parse_shafts(top: Table, gears: dict) -> tuple[Shaft, ...]:
+    """The ``[[shaft]]`` tables."""
+    out: list[Shaft] = []
+    for t in top.tables("shaft") if top.has("shaft") else []:
+        sid = t.identifier("id")
+        ends = t.raw("gears")
+        if (
+            not isinstance(ends, list)
+            or len(ends) != 2
+            or not all(isinstance(g, str) for g in ends)
+        ):
+            raise t.error("gears", f"must be a list of two gear ids, got {ends!r}")
+        for gid in ends:
+            if gid not in gears:
+                raise t.error("gears", f"names unknown gear '{gid}'" + nearest(gid, gears))
+        if ends[0] == ends[1]:
+            raise t.error("gears", f"a shaft joins two different gears, got '{ends[0]}' twice")
+        if any(s.id == sid for s in out):
+            raise t.error("id", f"shaft '{sid}' is defined twice")
+        out.append(
+            Shaft(
+                sid,
+                (ends[0], ends[1]),
+                t.number("torsional_Nm_per_rad", low=0, low_open=True, high=1e16),
+                t.number("torsional_damping_Nm_s_per_rad", 0.0, low=0.0, high=1e12),
+            )
+        )
+        t.finish()
+    return tuple(out)
+
+
+def load_topology_data(path: Path | str, _seen: tuple[str, ...] = ()) -> dict:
+    """A topology file's tables with ``extends`` resolved (module docstring)."""
+    path = Path(path)
+    data = load_toml(path)
+    head = data.get("topology")
+    if not isinstance(head, dict) or "extends" not in head:
+        return data
+    base_ref = head["extends"]
+    if not isinstance(base_ref, str):
+        raise InputError(str(path), "topology.extends", f"must be a file name, got {base_ref!r}")
+    base_path = path.parent / base_ref
+    if not base_path.exists():
+        raise InputError(
+            str(path), "topology.extends", f"'{base_ref}' is not a file next to {path.name}"
+        )
+    if str(base_path.resolve()) in _seen:
+        raise InputError(str(path), "topology.extends", f"'{base_ref}' extends this file again")
+    base = load_topology_data(base_path, (*_seen, str(path.resolve())))
+    own = dict(data)
+    own["topology"] = {k: v for k, v in head.items() if k != "extends"}
+    return _merge(base, own)
+
+
+def _merge(base: dict, top: dict) -> dict:
+    out = dict(base)
+    for key, value in top.items():
+        old = out.get(key)
+        if isinstance(old, dict) and isinstance(value, dict):
+            out[key] = _merge(old, value)
+        elif isinstance(old, list) and isinstance(value, list):
+            merged = [dict(e) if isinstance(e, dict) else e for e in old]
+            for entry in value:
+                same = [
+                    k
+                    for k, e in enumerate(merged)
+                    if isinstance(e, dict) and isinstance(entry, dict) and "id" in entry
+                    and e.get("id") == entry["id"]
+                ]  # fmt: skip
+                if same:
+                    merged[same[0]] = merged[same[0]] | entry
+                else:
+                    merged.append(entry)
+            out[key] = merged
+        else:
+            out[key] = value
+    return out

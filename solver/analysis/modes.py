@@ -1,0 +1,128 @@
+"""Natural frequencies and mode shapes of the linear, time-averaged model (issue 15).
+
+The generated module's ``STRUCTURE`` gives the model in physical coordinates ``q``
+(rotations, then translations): the diagonal mass matrix ``M`` and, for every coordinate
+of the model (mesh deflections, shaft twists, translations), its row of ``R = d eta/d q``
+and its spring at the mean stiffness.  With the backlash closed (the mesh in contact,
+``g(u) = u``) and the mesh stiffness at its mean, ``K = R^T diag(k) R``, and the modes
+solve ``K v = w^2 M v`` (``scipy.linalg.eigh``).  The rigid-body rotation is the mode with
+``w = 0``.  No damping and no gyroscopic terms: the frequencies do not depend on speed, so
+the resonance (Campbell) diagram is flat lines crossed by the mesh-frequency harmonics.
+
+Each mode is labelled by where its kinetic energy sits, ``m_k v_k^2`` grouped into
+rotations, translations across the axes and along them: a group holding at least
+:data:`DOMINANT` of it names the mode (``torsional``, ``translational``, ``axial``), else
+it is ``coupled``.  The strain energy ``k_j (R v)_j^2`` of each spring is given too.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+
+__all__ = ["DOMINANT", "Mode", "Modes", "modes"]
+
+DOMINANT = 0.8  # kinetic-energy share of one group that names a mode
+_GROUPS = {"theta": "torsional", "x": "translational", "y": "translational", "z": "axial"}
+
+
+@dataclass(frozen=True)
+class Mode:
+    index: int
+    frequency_hz: float
+    label: str
+    kinetic_shares: dict  # rotation / lateral / axial -> share of the kinetic energy
+    strain_shares: dict  # spring (coordinate) -> share of the strain energy
+    shape: dict  # physical coordinate -> amplitude (largest |amplitude| = 1)
+
+
+@dataclass(frozen=True)
+class Modes:
+    model: str
+    modes: tuple[Mode, ...]
+    mesh_frequency_hz: float  # of the reference mesh at the scene's omega
+    reference_teeth: int
+
+    def over_mesh(self, mode: Mode) -> float:
+        return mode.frequency_hz / self.mesh_frequency_hz
+
+    def resonances(self, speeds_rpm: tuple[float, float], harmonics: int = 3) -> list[dict]:
+        """Speeds of the reference driver where a mesh-frequency harmonic meets a mode:
+        ``h z n / 60 = f``."""
+        out = []
+        for mode in self.modes:
+            if mode.label == "rigid-body":
+                continue
+            for h in range(1, harmonics + 1):
+                rpm = 60.0 * mode.frequency_hz / (h * self.reference_teeth)
+                if speeds_rpm[0] <= rpm <= speeds_rpm[1]:
+                    out.append({"mode": mode.index, "harmonic": h, "speed_rpm": rpm})
+        return sorted(out, key=lambda r: r["speed_rpm"])
+
+    def to_json(self, speeds_rpm: tuple[float, float]) -> dict:
+        return {
+            "model": self.model,
+            "mesh_frequency_hz": self.mesh_frequency_hz,
+            "reference_teeth": self.reference_teeth,
+            "modes": [
+                {
+                    "index": m.index,
+                    "frequency_hz": m.frequency_hz,
+                    "over_mesh_frequency": self.over_mesh(m),
+                    "label": m.label,
+                    "kinetic_shares": m.kinetic_shares,
+                    "strain_shares": m.strain_shares,
+                    "shape": m.shape,
+                }
+                for m in self.modes
+            ],
+            "speed_range_rpm": list(speeds_rpm),
+            "resonances": self.resonances(speeds_rpm),
+        }
+
+
+def modes(module, omega: float | None = None) -> Modes:
+    """The modes of a generated module's linear, time-averaged model (module docstring);
+    ``omega`` (the scene's by default) sets the mesh frequency the modes are compared to."""
+    s = module.STRUCTURE
+    mass = np.asarray(s["mass"], dtype=float)
+    R = np.asarray(s["incidence"], dtype=float)
+    k = np.asarray(s["stiffness"], dtype=float)
+    K = R.T @ (k[:, None] * R)
+    w2, vec = scipy.linalg.eigh(K, np.diag(mass))
+    # The rigid-body mode is zero up to round-off of the largest eigenvalue.
+    rigid = np.abs(w2) <= 1e-10 * np.max(np.abs(w2))
+    groups = [_GROUPS[name.split("_")[0]] for name in s["physical"]]
+    out = []
+    for i in range(len(w2)):
+        v = vec[:, i]
+        kinetic = mass * v**2
+        shares = {g: float(sum(e for e, gg in zip(kinetic, groups, strict=True) if gg == g)
+                           / kinetic.sum()) for g in dict.fromkeys(groups)}  # fmt: skip
+        strain = k * (R @ v) ** 2
+        total = strain.sum()
+        strain_shares = {c: float(e / total) if total > 0 else 0.0
+                         for c, e in zip(s["coordinates"], strain, strict=True)}  # fmt: skip
+        if rigid[i]:
+            label = "rigid-body"
+        else:
+            top = max(shares, key=shares.get)
+            label = top if shares[top] >= DOMINANT else "coupled"
+        scale = v[np.argmax(np.abs(v))]
+        out.append(
+            Mode(
+                index=i,
+                frequency_hz=0.0 if rigid[i] else math.sqrt(w2[i]) / (2 * math.pi),
+                label=label,
+                kinetic_shares=shares,
+                strain_shares=strain_shares,
+                shape={n: float(a / scale) for n, a in zip(s["physical"], v, strict=True)},
+            )
+        )
+    if omega is None:
+        omega = module.DEFAULTS[module.PARAMETERS.index(module.CONTRACT["forcing_frequency"])]
+    f_mesh = omega * s["omega_n"] / (2 * math.pi)
+    return Modes(module.NAME, tuple(out), f_mesh, int(s["reference_teeth"]))
