@@ -54,14 +54,20 @@ def hill(
 
 
 def _distinct(order, sigma, nx, period) -> list[int]:
-    """The first ``nx`` of ``order`` with distinct multipliers (shifted copies of one
-    exponent share their multiplier)."""
+    """The first ``nx`` of ``order`` that are not shifted copies of one already chosen.
+    A copy shares the multiplier but sits a multiple of ``i 2 pi / period`` away; an
+    exponent of multiplicity two (two identical pinions on identical bearings, say) shares
+    the multiplier at the same place, and both are kept."""
     mu = np.exp(sigma * period)
+    shift = np.pi / period  # half the spacing of the copies
     chosen: list[int] = []
     for i in order:
         if len(chosen) == nx:
             break
-        if not any(abs(mu[i] - mu[j]) <= 1e-6 * max(1.0, abs(mu[j])) for j in chosen):
+        if not any(
+            abs(mu[i] - mu[j]) <= 1e-6 * max(1.0, abs(mu[j])) and abs(sigma[i] - sigma[j]) > shift
+            for j in chosen
+        ):
             chosen.append(int(i))
     return chosen
 
