@@ -367,8 +367,8 @@ def index_page(models: list[Model], command: str) -> str:
         "same SymPy objects.\n",
         "## Method\n",
         "1. **Bodies.** Each gear (with any inertia lumped with it, such as a flywheel) is "
-        "one rigid body turning about a fixed axis; shafts and bearings are rigid (pure "
-        "torsional model). Newton's second law: "
+        "one rigid body turning about a fixed axis; in a torsional model shafts and "
+        "bearings are rigid (see *Beyond torsion* below). Newton's second law: "
         "$I_k\\ddot\\theta_k = T_k - \\sum_i \\cos\\beta_{b,i} A_{ik} F_i$.",
         "2. **Meshes.** The deflection of mesh $i$ along its normal line of action is "
         "$x_i = \\cos\\beta_{b,i}\\sum_k A_{ik}\\theta_k + e_i(t)$ with $A_{ik} = +r_{b,k}$ "
@@ -384,6 +384,22 @@ def index_page(models: list[Model], command: str) -> str:
         "\\bar e_i''(\\tau)$ with $\\kappa_{ij}(\\tau) = W_{ij} b_j k_j(t)/(b_i\\omega_n^2)$, "
         "$\\xi_{ij} = W_{ij} c_j b_j/(2 b_i\\omega_n)$, "
         "$f_i = (C A I^{-1} T)_i/(b_i\\omega_n^2)$, $\\bar e_i = e_i/b_i$.\n",
+        "## Beyond torsion: bearings and shafts\n",
+        "A scene may ask for lateral-torsional or lateral-torsional-axial models "
+        "(`degrees_of_freedom`), and a topology may join gears by shafts "
+        "(`derive/structure.py`). Each gear then also moves across ($x, y$) and along ($z$) "
+        "its axis on its bearing. The coordinates are $\\eta = R q$: the mesh "
+        "deflections along the normal line of action (now with the translations' "
+        "projections, $\\cos\\beta_b\\,(\\Delta x\\cos\\psi + \\Delta y\\sin\\psi)"
+        " + \\sigma\\sin\\beta_b\\,\\Delta z$), the shafts' twists and the "
+        "translations. The springs and dampers act along $\\eta$, so "
+        "$\\eta'' + W(K g(\\eta) + C\\eta') = R M^{-1} T + S\\ddot e$ with "
+        "$W = R M^{-1} R^T$: the torsional form, with $W$ now coupling rotations and "
+        "translations, and the rigid-body rotation dropping out as before. Translations are "
+        "scaled by the first mesh's half backlash, a shaft's twist by $b_1/r_{b}$, and time "
+        "by the torsional $\\omega_n$, so that $\\bar\\omega$ keeps its meaning. The drive "
+        "flank's line of action serves the back flank too, and tilting is not modelled. "
+        "`gearsym modes` solves $R^T K R\\,v = \\omega^2 M v$ at the mean stiffness.\n",
         "## Backlash polynomial\n",
         "The reference study prints $g(x) = 0.0017x^7 - 0.0366x^5 + 0.2833x^3 - 0.1555x$ "
         "without its set-up. A discrete least-squares fit of the odd powers to the unit dead "
@@ -411,7 +427,8 @@ def index_page(models: list[Model], command: str) -> str:
         "data (the velocity index of each coordinate, the forcing-frequency parameter, the "
         "load parameters, the contact edges, piecewise or smooth with its switching surfaces "
         "$x_i = c$, the valid range); `rhs(tau, x, p)`, `jacobian(tau, x, p)`, "
-        "`parameters(**values)`, `casadi_functions()`, and the C right-hand side `C_SOURCE` "
+        "`parameters(**values)`, `casadi_functions()`, `STRUCTURE` (the physical mass "
+        "matrix, $R$ and the springs, for `gearsym modes`), and the C right-hand side `C_SOURCE` "
         "(with its variational form `C_SOURCE_VARIATIONAL`). A solver reads `CONTRACT`, "
         "never the source or a naming pattern.\n",
         "## Targets\n",

@@ -14,8 +14,9 @@ on its own bearing (the shaft's bending is lumped into the bearings' radial stif
 
 A topology file may start from another one: ``[topology] extends = "diso.toml"`` (a path
 next to the file) takes that file's tables, then this file's on top: an entry of an array
-of tables (``[[gear]]``, ``[[mesh]]``, ``[[reading]]``) with an ``id`` already there
-updates that entry key by key, any other entry is added, and plain tables merge key by key.
+of tables (``[[gear]]``, ``[[mesh]]``, ``[[shaft]]``, ``[[reading]]``) with an ``id``
+already there, or a ``[[bearing]]`` of a gear that has one, updates that entry key by key;
+any other entry is added, and plain tables merge key by key.
 """
 
 from __future__ import annotations
@@ -125,6 +126,9 @@ def load_topology_data(path: Path | str, _seen: tuple[str, ...] = ()) -> dict:
     return _merge(base, own)
 
 
+_ENTRY_KEYS = {"bearing": "gear"}  # what names an entry of an array of tables (else "id")
+
+
 def _merge(base: dict, top: dict) -> dict:
     out = dict(base)
     for key, value in top.items():
@@ -133,12 +137,13 @@ def _merge(base: dict, top: dict) -> dict:
             out[key] = _merge(old, value)
         elif isinstance(old, list) and isinstance(value, list):
             merged = [dict(e) if isinstance(e, dict) else e for e in old]
+            name = _ENTRY_KEYS.get(key, "id")
             for entry in value:
                 same = [
                     k
                     for k, e in enumerate(merged)
-                    if isinstance(e, dict) and isinstance(entry, dict) and "id" in entry
-                    and e.get("id") == entry["id"]
+                    if isinstance(e, dict) and isinstance(entry, dict) and name in entry
+                    and e.get(name) == entry[name]
                 ]  # fmt: skip
                 if same:
                     merged[same[0]] = merged[same[0]] | entry

@@ -104,7 +104,8 @@ def modes(module, omega: float | None = None) -> Modes:
                            / kinetic.sum()) for g in dict.fromkeys(groups)}  # fmt: skip
         strain = k * (R @ v) ** 2
         total = strain.sum()
-        strain_shares = {c: float(e / total) if total > 0 else 0.0
+        # A rigid-body mode strains nothing: its shares would be round-off normalised.
+        strain_shares = {c: 0.0 if rigid[i] else float(e / total)
                          for c, e in zip(s["coordinates"], strain, strict=True)}  # fmt: skip
         if rigid[i]:
             label = "rigid-body"

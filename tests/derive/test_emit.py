@@ -17,6 +17,10 @@ NAMES = [
     "diso",
     "siso",
     "tiso",
+    "diso_bearings_light",
+    "diso_bearings",
+    "helical_pair_bearings",
+    "two_stage",
 ]
 
 
