@@ -808,10 +808,23 @@ def _response_lines(res: dict) -> list[str]:
     return response_section(res["response"])
 
 
+def _dofs(quick: bool, res: dict) -> dict:
+    from gearsym.benchmarks.dofs import dof_cost
+
+    return {"rows": dof_cost(quick)}
+
+
+def _dofs_lines(res: dict) -> list[str]:
+    from gearsym.benchmarks.dofs import dof_section
+
+    return dof_section(res["dofs"]["rows"])
+
+
 SECTIONS: list[Section] = [
     Section("cli_sweep", cli_sweep, cli_sweep_lines),
     Section("maps", _maps, _maps_lines),
     Section("response", _response, _response_lines),
+    Section("dofs", _dofs, _dofs_lines),
 ]
 
 

@@ -34,6 +34,11 @@ SCENE_EDITS = {
         'damping_normalisation = "mesh"',
         'damping_normalisation = "mesh"\nflywheel_inertia_kg_m2 = -1',
     ),  # fmt: skip
+    "dofs": ("mesh_phase = true", 'mesh_phase = true\ndegrees_of_freedom = "lateral"'),
+    "tilting": (
+        "mesh_phase = true",
+        'mesh_phase = true\ndegrees_of_freedom = "lateral-torsional-axial-tilting"',
+    ),  # fmt: skip
 }
 
 OUT_COMMANDS = [
@@ -78,6 +83,14 @@ CASES += [
     ("simulate {scene:reading}", "q-breaking"),
     ("simulate {scene:unused}", "parameters.lamda: is not used by any load"),
     ("simulate {scene:flywheel}", "flywheel_inertia_kg_m2"),
+    ("simulate {scene:dofs}", "degrees_of_freedom"),
+    ("simulate {scene:tilting}", "tilting is not modelled"),
+    # modes (issue 15)
+    ("modes reference-lite", "reference-light"),
+    ("modes diso --speeds 3000", "--speeds"),
+    ("modes diso --speeds 2000:1000", "--speeds"),
+    ("modes diso --speeds=-5:100", "--speeds"),
+    ("modes diso --plot {tmp}/c.xyz", "xyz"),
     ("derive {bad_utf8}", "UTF-8"),
     ("derive {scene:syntax}", "line"),
     ("stiffness {bad_utf8}", "UTF-8"),

@@ -39,7 +39,9 @@ def test_load_accepts_hyphens_underscores_and_overrides():
 
 
 def test_a_missing_name_fails_listing_the_built_in_ones():
-    with pytest.raises(gearsym.InputError, match="built-in: diso-bearings-light, reference-dead-zone") as err:
+    with pytest.raises(
+        gearsym.InputError, match="built-in: diso-bearings-light, reference-dead-zone"
+    ) as err:
         gearsym.load("no-such-scene")
     assert "neither a file nor a built-in scene or topology" in str(err.value)
     with pytest.raises(gearsym.InputError, match="did you mean 'reference-light'"):

@@ -84,6 +84,14 @@ def main(argv: list[str] | None = None) -> int:
               "free space or choose another folder, and run again (finished work is kept)",
               file=sys.stderr)  # fmt: skip
         return 2
+    except ValueError as err:
+        from gearsym.solver.sweep.store import SweepStoreError
+
+        if not isinstance(err, SweepStoreError):
+            raise
+        # An output folder whose store holds another sweep or map (reproduce's, say).
+        print(f"gearsym: error: {err}", file=sys.stderr)
+        return 2
     except MemoryError:
         print("gearsym: error: out of memory; ask for fewer periods, points or harmonics",
               file=sys.stderr)  # fmt: skip

@@ -23,6 +23,7 @@ from gearsym.solver.periodic import ShootingError, continue_orbit
 from gearsym.solver.sweep import Progress, SweepJob, map_tasks, sweep_many
 from gearsym.solver.system import System
 
+from .bearings import bearing_jobs, bearings_section
 from .cases import CASES, RESOLUTIONS, TOLERANCES
 from .report import report
 
@@ -70,10 +71,13 @@ def reproduce(
         jobs.append(
             SweepJob(systems["light"].with_values(f1=f1), "lambda", map_lam, settings=settings)
         )
+    on_bearings = bearing_jobs(lam, settings)  # the same sweeps on bearings (issue 15)
+    jobs += on_bearings
     bar = Progress(sum(len(j.values) for j in jobs), "sweeps", enabled=progress)
     sweeps = sweep_many(jobs, executor=executor, workers=workers, progress=bar)
     by_case = {case: sweeps[2 * k : 2 * k + 2] for k, (case, _, _) in enumerate(CASES)}
-    maps = sweeps[2 * len(CASES) :]
+    bearing_sweeps = sweeps[len(sweeps) - len(on_bearings) :]
+    maps = sweeps[2 * len(CASES) : len(sweeps) - len(on_bearings)]
     for sw in sweeps:
         tag = f"{sw.model}_{sw.direction}_f1_{sw.base_values.get('f1', 'scene')}"
         sw.save(out / "data" / f"sweep_{tag}.json")
@@ -171,7 +175,13 @@ def reproduce(
         res, lam, by_case, points, maps, map_lam, elapsed, quick, systems, branches, method
     )
     head, sep, tail = text.partition("## Figures")
-    text = head + response_section(response_rows) + "\n" + section + "\n" + sep + tail
+    stage("the lambda sweeps on bearings: report")
+    forward = [by_case[case][0] for case, _, _ in CASES]
+    bearings = bearings_section(forward, bearing_sweeps, out)
+    text = (
+        head + response_section(response_rows) + "\n" + section + "\n" + bearings + "\n"
+        + sep + tail
+    )  # fmt: skip
     path = out / "report.md"
     path.write_text(text, encoding="utf-8")
     return path

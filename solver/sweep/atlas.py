@@ -38,7 +38,7 @@ from .attractors import RunOutcome, group_runs, outcome
 from .executor import map_tasks
 from .maps_result import Cell, RegimeMap, outcome_from_dict, outcome_to_dict
 from .progress import Progress
-from .store import lock_store
+from .store import SweepStoreError, lock_store
 
 __all__ = ["default_box", "regime_map"]
 
@@ -161,7 +161,7 @@ def _check_store(store: Path, manifest: dict) -> None:
         old = json.loads(path.read_text(encoding="utf-8"))
         differs = [k for k in manifest if old.get(k) != json.loads(dumps(manifest[k]))]
         if differs:
-            raise ValueError(
+            raise SweepStoreError(
                 f"{store} holds another map ({', '.join(differs)} differ); choose another "
                 "output folder or delete it"
             )

@@ -221,6 +221,50 @@ TOPOLOGY_CASES = [
         'coordinate = "v"\norientation = "reverse"',
         "mesh[1].orientation: 'reverse' is not one of 'forward', 'reversed' (did you mean",
     ),
+    # bearings, shafts, positions, masses (issue 15)
+    (
+        "bearing on an unknown gear",
+        "[operating]",
+        '[[bearing]]\ngear = "pp"\nradial_N_per_m = 1e9\naxial_N_per_m = 1e9\n[operating]',
+        "bearing[0].gear: names unknown gear 'pp' (did you mean 'p'?)",
+    ),
+    (
+        "two bearings on one gear",
+        "[operating]",
+        '[[bearing]]\ngear = "p"\nradial_N_per_m = 1e9\naxial_N_per_m = 1e9\n'
+        '[[bearing]]\ngear = "p"\nradial_N_per_m = 1e9\naxial_N_per_m = 1e9\n[operating]',
+        "bearing[1].gear: gear 'p' has a bearing already",
+    ),
+    (
+        "negative bearing stiffness",
+        "[operating]",
+        '[[bearing]]\ngear = "p"\nradial_N_per_m = -1e9\naxial_N_per_m = 1e9\n[operating]',
+        "bearing[0].radial_N_per_m: must be > 0",
+    ),
+    (
+        "a shaft closes a loop",
+        "[operating]",
+        '[[shaft]]\nid = "w"\ngears = ["p", "q"]\ntorsional_Nm_per_rad = 1e5\n[operating]',
+        "3 gears need exactly 2 meshes and shafts (a tree), got 3",
+    ),
+    (
+        "a shaft with one gear",
+        "[operating]",
+        '[[shaft]]\nid = "w"\ngears = ["p"]\ntorsional_Nm_per_rad = 1e5\n[operating]',
+        "shaft[0].gears: must be a list of two gear ids",
+    ),
+    (
+        "driver position beyond a turn",
+        "layout_angle_deg = 120",
+        "layout_angle_deg = 120\ndriver_position_deg = 400",
+        "mesh[1].driver_position_deg: must be <= 360",
+    ),
+    (
+        "negative attached mass",
+        "attached_inertia_kg_m2 = 10.0",
+        "attached_inertia_kg_m2 = 10.0\nattached_mass_kg = -5",
+        "gear[2].attached_mass_kg: must be >= 0",
+    ),
 ]
 
 
@@ -541,3 +585,24 @@ def test_negative_tip_clearance_is_refused(tmp_path, capsys):
     )
     code, err = derive(capsys, path)
     assert_one_line_error(code, err, path, "negative tip clearance")
+
+
+def test_extends_names_a_missing_file(tmp_path, capsys):
+    path = tmp_path / "topo.toml"
+    path.write_text('[topology]\nextends = "nowhere.toml"\nname = "x"\n')
+    assert_one_line_error(
+        *derive(capsys, path), path, "topology.extends: 'nowhere.toml' is not a file next to"
+    )
+
+
+def test_lateral_freedom_without_bearings_is_refused(files, capsys):
+    """reference-light on diso.toml (no bearings) asked for lateral freedom."""
+    tmp, _, scene = files
+    path = tmp / "scene.toml"
+    text = scene.replace('topology = "topologies/diso.toml"', 'topology = "diso"')
+    path.write_text(
+        text.replace("[features]", '[features]\ndegrees_of_freedom = "lateral-torsional"')
+    )
+    code, err = derive(capsys, path)
+    assert code == 2 and err.count("\n") == 1
+    assert "features.degrees_of_freedom" in err and "have no [[bearing]]" in err, err
