@@ -50,7 +50,7 @@ def _models(tmp: Path) -> list[tuple[str, object, str]]:
     ]
 
 
-def dof_cost(quick: bool) -> list[dict]:
+def dof_cost(quick: bool) -> dict:
     from gearsym.solver.integrate import default_initial_state
     from gearsym.solver.integrate.native import run_batch
     from gearsym.solver.system import System
@@ -92,10 +92,12 @@ def dof_cost(quick: bool) -> list[dict]:
                     base = x
                 row["change_u_v"] = float(np.nanmax(np.abs(x - base)))
             rows.append(row)
-    return rows
+    return {"rows": rows, "transient": tr, "periods": per, "points": points}
 
 
-def dof_section(rows: list[dict]) -> list[str]:
+def dof_section(res: dict) -> list[str]:
+    rows = res["rows"]
+
     def fmt(v):
         return "—" if v is None else f"{v:.3g}"
 
@@ -105,8 +107,9 @@ def dof_section(rows: list[dict]) -> list[str]:
         "Each model's coordinates (mesh deflections, shaft twists, translations; the state "
         "holds them and their rates), the emitted operations after common-subexpression "
         "elimination (SymPy `count_ops`), and compiled batched DOP853 over a sweep "
-        "(the DI-SO over λ ∈ [0, 1], the others over the damping ratio 0.01–0.1), 300 + 100 "
-        "periods per point, median of repeats. The change is the largest difference of the "
+        f"({res['points']} points: the DI-SO over λ ∈ [0, 1], the others over the damping "
+        f"ratio 0.01–0.1), {res['transient']} + {res['periods']} periods per point, median "
+        "of repeats. The change is the largest difference of the "
         "DI-SO's Poincaré points of u and v from the torsional model's at the same λ (a "
         "modelling effect, not an integration error). The bearing modes are stiffer than the "
         "mesh, so an explicit method takes more steps per period as well as more work per "

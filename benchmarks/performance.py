@@ -811,13 +811,13 @@ def _response_lines(res: dict) -> list[str]:
 def _dofs(quick: bool, res: dict) -> dict:
     from gearsym.benchmarks.dofs import dof_cost
 
-    return {"rows": dof_cost(quick)}
+    return dof_cost(quick)
 
 
 def _dofs_lines(res: dict) -> list[str]:
     from gearsym.benchmarks.dofs import dof_section
 
-    return dof_section(res["dofs"]["rows"])
+    return dof_section(res["dofs"])
 
 
 SECTIONS: list[Section] = [
