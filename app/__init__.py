@@ -9,6 +9,7 @@ The public API (see ``docs/api.md``)::
     orbit = gearsym.shoot(system, point.trajectory.poincare[:, 0])  # periodic orbit
     branch = gearsym.continue_orbit(system, "lambda", 0.8, 1.0, orbit.x0)
     bif = gearsym.sweep(system, "lambda", [0.1, 0.5, 0.9])           # bifurcation sweep
+    modal = gearsym.modes(gearsym.load("diso-bearings-light"))       # natural frequencies
 
 Rooms: ``gearsym.derive`` (SymPy, SI), ``gearsym.solver`` (non-dimensional numerics),
 ``gearsym.generated`` (emitted code), and this application layer: the scene resolver
@@ -30,6 +31,7 @@ _EXPORTS = {
     "harmonic_balance": "gearsym.solver.periodic.harmonic_balance",
     "continue_hb": "gearsym.solver.periodic.hb_continuation",
     "frequency_response": "gearsym.solver.sweep.frequency",
+    "modes": "gearsym.solver.analysis.modes",
     **{
         name: "gearsym.solver"
         for name in (
@@ -81,6 +83,7 @@ __all__ = [
     "harmonic_balance",
     "load",
     "load_target",
+    "modes",
     "save",
     "shoot",
     "simulate",

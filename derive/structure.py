@@ -304,7 +304,7 @@ def physical_data(model) -> dict:
     then translations ``<axis>_<gear>``), the diagonal mass matrix (kg, kg m^2), the rows
     ``d eta / d q`` of each coordinate of the model (mesh deflections, shaft twists,
     translations), each one's spring at the mean stiffness (N/m, N m/rad), its kind, its
-    scale (``u = eta / scale``), the time unit and the reference driver's teeth."""
+    scale (``u = eta / scale``), the time unit and the reference driver and its teeth."""
     topo = model.scene.topology
     st = model.structure
     if st is None:
@@ -326,5 +326,6 @@ def physical_data(model) -> dict:
         "stiffness": tuple(r15(st.value(c.stiffness)) for c in st.coordinates),
         "scale": tuple(r15(st.value(c.scale)) for c in st.coordinates),
         "omega_n": r15(model.scales["omega_n_rad_per_s"]),
+        "reference_driver": topo.reference.driver,
         "reference_teeth": topo.gear(topo.reference.driver).teeth,
     }

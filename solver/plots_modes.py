@@ -51,7 +51,8 @@ def campbell_figure(
         ax.axvline(scene_rpm, color="grey", lw=0.8, ls="--", label="the scene's speed")
     ax.set_xlim(speeds_rpm)
     ax.set_ylim(0, 1.05 * top)
-    ax.set_xlabel(f"speed of the reference driver (rpm, {z} teeth)")
+    ax.set_xlabel(f"speed of gear {result.reference_driver}, the first mesh's driver "
+                  f"(rpm, {z} teeth)")  # fmt: skip
     ax.set_ylabel("frequency (Hz)")
     ax.set_title(f"{result.model}: natural frequencies and mesh-frequency harmonics")
     ax.legend(title="mode (kinetic energy)", loc="upper left", fontsize=8)

@@ -25,7 +25,7 @@ def register(sub) -> None:
     p.add_argument(
         "--speeds",
         metavar="LO:HI",
-        help="speed range of the reference driver, rpm (default: 0 to twice the scene's)",
+        help="speed range of the first mesh's driver, rpm (default: 0 to twice the scene's)",
     )
     p.add_argument("--plot", metavar="FILE", help="write the resonance diagram (PNG, PDF, SVG)")
     p.set_defaults(func=_cmd_modes)
@@ -63,7 +63,7 @@ def _cmd_modes(args) -> int:
     print(
         f"{result.model}: {len(result.modes)} modes of the linear, time-averaged model; "
         f"mesh frequency {result.mesh_frequency_hz:.1f} Hz at the scene's speed "
-        f"({scene_rpm:.0f} rpm of the reference driver)"
+        f"({scene_rpm:.0f} rpm of gear {result.reference_driver}, the first mesh's driver)"
     )
     print(f"  {'#':>2}  {'Hz':>10}  {'/ mesh':>7}  {'label':<13}  kinetic energy")
     for m in result.modes:

@@ -45,6 +45,7 @@ class Modes:
     modes: tuple[Mode, ...]
     mesh_frequency_hz: float  # of the reference mesh at the scene's omega
     reference_teeth: int
+    reference_driver: str = ""  # the first mesh's driver, whose speed the diagram uses
 
     def over_mesh(self, mode: Mode) -> float:
         return mode.frequency_hz / self.mesh_frequency_hz
@@ -66,6 +67,7 @@ class Modes:
         return {
             "model": self.model,
             "mesh_frequency_hz": self.mesh_frequency_hz,
+            "reference_driver": self.reference_driver,
             "reference_teeth": self.reference_teeth,
             "modes": [
                 {
@@ -84,9 +86,14 @@ class Modes:
         }
 
 
-def modes(module, omega: float | None = None) -> Modes:
-    """The modes of a generated module's linear, time-averaged model (module docstring);
-    ``omega`` (the scene's by default) sets the mesh frequency the modes are compared to."""
+def modes(model, omega: float | None = None) -> Modes:
+    """The modes of the linear, time-averaged model of ``model`` (a :class:`System` or a
+    generated module; module docstring).  ``omega`` (the system's, else the scene's) sets
+    the mesh frequency the modes are compared to."""
+    module = getattr(model, "module", model)
+    forcing = module.CONTRACT["forcing_frequency"]
+    if omega is None and hasattr(model, "parameter"):
+        omega = model.parameter(forcing)
     s = module.STRUCTURE
     mass = np.asarray(s["mass"], dtype=float)
     R = np.asarray(s["incidence"], dtype=float)
@@ -124,6 +131,7 @@ def modes(module, omega: float | None = None) -> Modes:
             )
         )
     if omega is None:
-        omega = module.DEFAULTS[module.PARAMETERS.index(module.CONTRACT["forcing_frequency"])]
+        omega = module.DEFAULTS[module.PARAMETERS.index(forcing)]
     f_mesh = omega * s["omega_n"] / (2 * math.pi)
-    return Modes(module.NAME, tuple(out), f_mesh, int(s["reference_teeth"]))
+    return Modes(module.NAME, tuple(out), f_mesh, int(s["reference_teeth"]),
+                 str(s["reference_driver"]))  # fmt: skip
