@@ -1,6 +1,7 @@
 """Helical geometry against the reference study's Table 1 and closed forms (ISO 21771)."""
 
 import math
+import tomllib
 
 import pytest
 from gearsym.derive.geometry import (
@@ -10,6 +11,8 @@ from gearsym.derive.geometry import (
     pair_geometry,
     with_tip_radius,
 )
+from gearsym.derive.stiffness import contact_line_stiffness
+from gearsym.derive.topology import parse_topology
 
 
 def study_pair(shift=(0.0, 0.0)):
@@ -117,3 +120,23 @@ def test_the_pointed_tip_diameter_the_message_names_is_where_the_tooth_ends():
     with pytest.raises(ValueError, match="give a tip diameter below 47.897 mm"):
         with_tip_radius(g, 0.050 / 2)
     assert with_tip_radius(g, 0.047896 / 2).tip_thickness == pytest.approx(0.0, abs=1e-5)
+
+
+def test_topology_keys_reach_the_pair(root):
+    # tip_diameter_mm and centre_distance_mm give the same pair as the geometry functions,
+    # and the stiffness (here from the contact-line length) is computed on that pair.
+    text = (root / "scenes" / "topologies" / "siso.toml").read_text()
+    text = text.replace('id = "p"\n', 'id = "p"\ntip_diameter_mm = 210.8\n', 1)
+    text = text.replace('coordinate = "u"\n', 'coordinate = "u"\ncentre_distance_mm = 304.9\n')
+    text = text.replace(
+        '{ source = "potential-energy", slices = 200, harmonics = 10 }',
+        '{ source = "contact-line", mean_N_per_m = 1.0e9, harmonics = 4 }',
+    )
+    mesh = parse_topology(tomllib.loads(text), "siso-drawn").meshes[0]
+    ref = study_pair()
+    tipped = with_tip_radius(ref.driver, 210.8 * 0.5e-3)  # mm to m as the loader does
+    expected = pair_geometry(tipped, ref.driven, 50e-3, 304.9 * 1e-3)
+    assert mesh.pair == expected
+    assert mesh.stiffness == contact_line_stiffness(
+        1.0e9, expected.transverse_contact_ratio, expected.axial_contact_ratio, 4
+    )
