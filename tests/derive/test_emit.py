@@ -17,6 +17,10 @@ NAMES = [
     "diso",
     "siso",
     "tiso",
+    "diso_bearings",
+    "diso_bearings_light",
+    "helical_pair_bearings",
+    "two_stage",
 ]
 
 
