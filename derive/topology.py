@@ -21,7 +21,14 @@ from fractions import Fraction
 from pathlib import Path
 
 from ._input import Table, nearest
-from .geometry import GearGeometry, PairGeometry, gear_geometry, pair_geometry
+from .geometry import (
+    CentreDistanceError,
+    GearGeometry,
+    PairGeometry,
+    gear_geometry,
+    pair_geometry,
+    with_tip_radius,
+)
 from .pem import pem_stiffness
 from .readings import ORIENTATIONS, parse_readings
 from .stiffness import MeshStiffness, contact_line_stiffness
@@ -251,6 +258,12 @@ def _gear(t: Table, materials: dict[str, Material]) -> Gear:
         geometry = gear_geometry(teeth, mn, alpha_n, beta, shift, 1.0, dedendum, rack_root)
     except ValueError as err:
         raise t.error("rack_root_radius", str(err)) from None
+    tip_diameter = t.number("tip_diameter_mm", None, low=0, low_open=True)
+    if tip_diameter is not None:
+        try:
+            geometry = with_tip_radius(geometry, tip_diameter * 0.5e-3)
+        except ValueError as err:
+            raise t.error("tip_diameter_mm", str(err)) from None
     sa = geometry.tip_thickness
     if sa <= 0.0:
         raise t.error(
@@ -523,8 +536,16 @@ def parse_topology(data: dict, source: str) -> Topology:
         if ends[0] == ends[1]:
             raise mt.error("driven", f"a gear cannot mesh with itself ('{ends[0]}')")
         g1, g2 = by_id[ends[0]], by_id[ends[1]]
+        a_w = mt.number("centre_distance_mm", None, low=0, low_open=True)
         try:
-            pair = pair_geometry(g1.geometry, g2.geometry, min(g1.face_width, g2.face_width))
+            pair = pair_geometry(
+                g1.geometry,
+                g2.geometry,
+                min(g1.face_width, g2.face_width),
+                None if a_w is None else a_w * 1e-3,
+            )
+        except CentreDistanceError as err:
+            raise mt.error("centre_distance_mm", str(err)) from None
         except ValueError as err:
             raise mt.error("driven", f"'{ends[0]}' and '{ends[1]}' cannot mesh: {err}") from None
         _check_contact(mt, pair, ends)

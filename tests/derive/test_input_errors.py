@@ -216,6 +216,40 @@ TOPOLOGY_CASES = [
         "reading[0].braking: gear 'p' cannot both drive and brake",
     ),
     (
+        "tip radius where the diameter belongs",
+        'id = "p"\nteeth = 50',
+        'id = "p"\nteeth = 50\ntip_diameter_mm = 105.5',
+        "gear[0].tip_diameter_mm: 105.5 mm must exceed both the root circle (193.085 mm) and "
+        "the base circle (190.492 mm); give the tip diameter (not the radius) in mm",
+    ),
+    (
+        "tip diameter above the standard tip",
+        'id = "p"\nteeth = 50',
+        'id = "p"\nteeth = 50\ntip_diameter_mm = 215',
+        "gear[0].tip_diameter_mm: 215 mm is more than 0.8 mm (0.2 mn) above the standard tip "
+        "diameter d + 2 (1 + x) mn = 211.085 mm",
+    ),
+    (
+        "centre distance inside the base circles",
+        'coordinate = "u"',
+        'coordinate = "u"\ncentre_distance_mm = 280',
+        "mesh[0].centre_distance_mm: 280 mm is not above the sum of the base radii (285.738 mm)",
+    ),
+    (
+        "centre distance far beyond the reference",
+        'coordinate = "u"',
+        'coordinate = "u"\ncentre_distance_mm = 320',
+        "mesh[0].centre_distance_mm: 320 mm is more than 2 mn beyond the reference centre "
+        "distance 304.628 mm (at most 312.628 mm)",
+    ),
+    (
+        "centre distance too close for the profile shifts",
+        'coordinate = "u"',
+        'coordinate = "u"\ncentre_distance_mm = 304.5',
+        "mesh[0].centre_distance_mm: 304.5 mm fits profile shifts summing to -0.0319 without "
+        "backlash, but x1 + x2 = 0: the teeth would jam; give at least 304.628 mm",
+    ),
+    (
         "orientation typo",
         'coordinate = "v"',
         'coordinate = "v"\norientation = "reverse"',
@@ -606,3 +640,19 @@ def test_lateral_freedom_without_bearings_is_refused(files, capsys):
     code, err = derive(capsys, path)
     assert code == 2 and err.count("\n") == 1
     assert "features.degrees_of_freedom" in err and "have no [[bearing]]" in err, err
+
+
+def test_pointed_teeth_at_the_given_tip_are_refused(tmp_path, capsys):
+    # 8 teeth with x = 1.5 end in a point at d_a = 47.897 mm (see test_geometry): a drawn tip
+    # of 50 mm, below the standard 52 mm, is still pointed.
+    path = _pair_file(
+        tmp_path, "teeth = 8\nprofile_shift = 1.5\ntip_diameter_mm = 50", "teeth = 60"
+    )
+    code, err = derive(capsys, path)
+    assert_one_line_error(
+        code,
+        err,
+        path,
+        "gear[0].tip_diameter_mm: the teeth are pointed at 50 mm (tip thickness -2.759 mm); "
+        "give a tip diameter below 47.897 mm",
+    )
