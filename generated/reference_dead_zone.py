@@ -128,6 +128,7 @@ STRUCTURE = {
     'stiffness': (881730641.0, 881730641.0),
     'scale': (5e-05, 5e-05),
     'omega_n': 11068.6287249826,
+    'reference_driver': 'p',
     'reference_teeth': 50,
 }
 

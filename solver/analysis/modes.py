@@ -134,4 +134,4 @@ def modes(model, omega: float | None = None) -> Modes:
         omega = module.DEFAULTS[module.PARAMETERS.index(forcing)]
     f_mesh = omega * s["omega_n"] / (2 * math.pi)
     return Modes(module.NAME, tuple(out), f_mesh, int(s["reference_teeth"]),
-                 str(s["reference_driver"]))  # fmt: skip
+                 str(s.get("reference_driver", "")))  # fmt: skip
