@@ -136,6 +136,15 @@ def _case_lines(case: str, f1: float, tor, bea) -> list[str]:
                         for a, b in zip(tor.points, bea.points, strict=True)
                         if len(a.poincare["u"]) and len(b.poincare["u"])])  # fmt: skip
     n = len(tor.points)
+    jumps = [_jump(tor), _jump(bea)]
+    backward = [_fully_backward(tor), _fully_backward(bea)]
+    keep = {
+        k
+        for k, a in enumerate(tor.points)
+        if n <= 11 or abs(a.value * 10 - round(a.value * 10)) < 1e-9
+    }
+    keep |= {k for j in jumps if j for k in (j[0], j[0] + 1)}
+    rows = [r for k, r in enumerate(rows) if k in keep]
     worst = int(np.nanargmax(dv)) if np.isfinite(dv).any() else 0
     summary = (
         f"**{case.capitalize()} load, f1 = {f1}.** The motion of v differs at {len(changed)} of "
@@ -152,13 +161,55 @@ def _case_lines(case: str, f1: float, tor, bea) -> list[str]:
         f"{np.nanmax(dv):.3g} in v (at lambda = {tor.points[worst].value:g}); the distance is "
         "each point's to the nearest point of the other model. On average u's Poincaré "
         f"points sit {abs(shift):.3g} half backlashes {'higher' if shift > 0 else 'lower'} "
-        "on bearings.\n"
-    )
+        "on bearings. "
+        + "Largest jump of v between neighbouring lambda values: "
+        + "; ".join(
+            f"{what}, " + (f"{j[1]:.3g} half backlashes from lambda = {j[2]:g} to {j[3]:g}"
+                           if j else "none above 0.2")
+            for what, j in zip(("torsional", "on bearings"), jumps, strict=True)
+        )
+        + ". v meshes backward throughout the window "
+        + (
+            "at no lambda in either model"
+            if backward == [None, None]
+            else "from lambda = " + " and ".join(
+                f"{'no lambda' if b is None else f'{b:g}'} on ({what})"
+                for what, b in zip(("torsional", "on bearings"), backward, strict=True)
+            )
+        )
+        + ".\n"
+    )  # fmt: skip
     head = (
         "| lambda | v torsional | v on bearings | v backward, torsional | v backward, on "
         "bearings | Δu | Δv | pinion p across its axis | p along its axis |\n"
         "|---|---|---|---|---|---|---|---|---|"
     )
+    note = (
+        "" if n <= 11 else "rows at every 0.1 and either side of each jump; all points in data/; "
+    )
     return [summary, head, *rows, "",
-            "(Δ in half backlashes; p's displacements in half backlashes of 50 µm, over the "
-            "sampled window.)\n"]  # fmt: skip
+            f"({note}Δ in half backlashes; p's displacements in half backlashes of 50 µm, "
+            "over the sampled window.)\n"]  # fmt: skip
+
+
+def _jump(sweep):
+    """(index, size, lambda before, lambda after) of the largest change of v's first
+    Poincare point between neighbouring values, or None when it is below 0.2 half
+    backlashes (a branch switch, not the steady drift of the points)."""
+    v = np.array([p.poincare["v"][0] if len(p.poincare["v"]) else np.nan for p in sweep.points])
+    if len(v) < 2 or not np.isfinite(np.diff(v)).any():
+        return None
+    k = int(np.nanargmax(np.abs(np.diff(v))))
+    size = float(abs(v[k + 1] - v[k]))
+    if size < 0.2:
+        return None
+    return k, size, sweep.points[k].value, sweep.points[k + 1].value
+
+
+def _fully_backward(sweep):
+    """The first lambda from which v meshes backward the whole window, or None."""
+    shares = [p.meshing_states.get("v", {}).get("backward", 0.0) for p in sweep.points]
+    for k in range(len(shares)):
+        if all(s >= 0.995 for s in shares[k:]):
+            return sweep.points[k].value
+    return None
