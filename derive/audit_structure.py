@@ -46,6 +46,9 @@ def structure_sections(model) -> str:
     for g in topo.gears:
         b = topo.bearings.get(g.id)
         radial = f"{_num(b.radial)}, {_num(b.radial_damping)}" if b else "none"
+        if b and b.transverse("y")[2]:
+            ky, cy, _ = b.transverse("y")
+            radial = f"x: {radial}; y: {_num(ky)}, {_num(cy)}"
         axial = f"{_num(b.axial)}, {_num(b.axial_damping)}" if b else "none"
         sense = "counter-clockwise" if senses[g.id] > 0 else "clockwise"
         w(f"| {g.id} | {sense} | {_num(g.mass)} | {_num(g.inertia)} | {radial} | {axial} |")

@@ -233,12 +233,11 @@ def derive_structure(
         else:
             row[tcol[owner, kind]] = 1
             bearing = topo.bearings[owner]
-            stiff, damp = (
-                (bearing.axial, bearing.axial_damping)
-                if kind == "z"
-                else (bearing.radial, bearing.radial_damping)
-            )
-            tag = "a" if kind == "z" else "r"
+            if kind == "z":
+                stiff, damp, tag = bearing.axial, bearing.axial_damping, "a"
+            else:
+                stiff, damp, own = bearing.transverse(kind)
+                tag = "y" if own else "r"
             k = sym(f"k_{{{tag},{owner}}}", stiff, positive=True)
             c = sym(f"c_{{{tag},{owner}}}", damp, nonnegative=True)
             coords.append(Coordinate(name, kind, owner, b1, k, c))

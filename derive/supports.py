@@ -1,8 +1,9 @@
 """Bearings, shafts and topology files that extend another one (issue 15).
 
 A ``[[bearing]]`` holds one gear to the housing: a spring and a viscous damper along each
-transverse axis (``radial_N_per_m``, ``radial_damping_N_s_per_m``, the same along x and y)
-and along the gear's axis (``axial_N_per_m``, ``axial_damping_N_s_per_m``).  A gear's
+transverse axis (``radial_N_per_m``, ``radial_damping_N_s_per_m``, the same along x and y
+unless ``radial_y_N_per_m`` or ``radial_y_damping_N_s_per_m`` set y's: an anisotropic
+support) and along the gear's axis (``axial_N_per_m``, ``axial_damping_N_s_per_m``).  A gear's
 translations are modelled only when the scene asks for them (``degrees_of_freedom``); it
 then needs a bearing, or it would float.
 
@@ -38,6 +39,19 @@ class Bearing:
     axial: float
     radial_damping: float = 0.0
     axial_damping: float = 0.0
+    # Along y when it differs from x (an anisotropic support); None: the radial values.
+    radial_y: float | None = None
+    radial_y_damping: float | None = None
+
+    def transverse(self, axis: str) -> tuple[float, float, bool]:
+        """(stiffness, damping, own) along ``x`` or ``y``: ``own`` when y has its own."""
+        if axis == "y" and self.radial_y is not None:
+            damping = self.radial_damping if self.radial_y_damping is None else (
+                self.radial_y_damping)  # fmt: skip
+            return self.radial_y, damping, True
+        if axis == "y" and self.radial_y_damping is not None:
+            return self.radial, self.radial_y_damping, True
+        return self.radial, self.radial_damping, False
 
 
 @dataclass(frozen=True)
@@ -67,6 +81,8 @@ def parse_bearings(top: Table, gears: dict) -> dict[str, Bearing]:
             t.number("axial_N_per_m", low=0, low_open=True, high=1e16),
             t.number("radial_damping_N_s_per_m", 0.0, low=0.0, high=1e12),
             t.number("axial_damping_N_s_per_m", 0.0, low=0.0, high=1e12),
+            t.number("radial_y_N_per_m", None, low=0, low_open=True, high=1e16),
+            t.number("radial_y_damping_N_s_per_m", None, low=0.0, high=1e12),
         )
         t.finish()
     return out

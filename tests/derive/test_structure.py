@@ -164,3 +164,39 @@ def test_hill_stability_of_the_model_on_bearings_matches_shooting():
     hill_mu = np.sort(np.abs(hb.floquet.multipliers))
     shot_mu = np.sort(np.abs(orbit.floquet.multipliers))
     assert hill_mu == pytest.approx(shot_mu, abs=1e-6)
+
+
+def test_an_anisotropic_bearing_across_the_line_of_action_rings_alone(tmp_path):
+    """The helical pair with its transverse line of action along x (driver_position
+    = 90 deg + alpha_wt puts psi at 0) and stiffer bearings along y: each gear's y motion
+    is then free of the mesh, so two modes are the closed forms sqrt(k_y/m)/(2 pi) of a
+    mass on a spring, and the x motions stay coupled to the mesh."""
+    import math
+
+    from gearsym.derive.topology import load_topology
+    from gearsym.solver.analysis.modes import modes
+
+    base = load_topology(TOPOLOGIES / "helical-pair-bearings.toml")
+    alpha = math.degrees(base.meshes[0].pair.working_pressure_angle)
+    ky = {"p": 3e9, "g": 4e9}
+    lines = [
+        "[topology]",
+        f'extends = "{TOPOLOGIES / "helical-pair-bearings.toml"}"',
+        'name = "aniso"',
+        "[[mesh]]",
+        'id = "pg"',
+        f"driver_position_deg = {90 + alpha!r}",
+    ]
+    for gear, k in ky.items():
+        lines += ["[[bearing]]", f'gear = "{gear}"', f"radial_y_N_per_m = {k:g}"]
+    path = tmp_path / "aniso.toml"
+    path.write_text("\n".join(lines) + "\n")  # fmt: skip
+    result = modes(module_for(path))
+    freqs = [m.frequency_hz for m in result.modes]
+    for gear, k in ky.items():
+        closed = math.sqrt(k / base.gear(gear).mass) / (2 * math.pi)
+        near = min(freqs, key=lambda f, c=closed: abs(f - c))
+        assert near == pytest.approx(closed, rel=1e-10), (gear, closed, freqs)
+        mode = next(m for m in result.modes if m.frequency_hz == near)
+        assert mode.shape[f"y_{gear}"] == pytest.approx(1.0)
+        assert mode.kinetic_shares["translational"] == pytest.approx(1.0, abs=1e-12)
