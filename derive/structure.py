@@ -137,8 +137,17 @@ def _names(topo: Topology, axes: tuple[str, ...], source: str) -> list[tuple[str
     out = [(m.coordinate, "mesh", m.id) for m in topo.meshes]
     out += [(s.id, "shaft", s.id) for s in topo.shafts]
     out += [(f"{a}{g.id}", a, g.id) for g in topo.gears for a in axes]
+    from .topology import _BACKLASH_NAME, _RESERVED
+
     seen: set[str] = set()
     for name, kind, owner in out:
+        if kind == "shaft" and (name in _RESERVED or _BACKLASH_NAME.match(name)):
+            raise InputError(
+                topo.source,
+                "shaft",
+                f"shaft id '{name}' is reserved (it names the twist coordinate); avoid "
+                f"{', '.join(sorted(_RESERVED))} and g1, g3, ...",
+            )
         if name in seen or f"d{name}" in seen:
             raise InputError(
                 source,

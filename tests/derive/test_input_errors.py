@@ -656,3 +656,12 @@ def test_pointed_teeth_at_the_given_tip_are_refused(tmp_path, capsys):
         "gear[0].tip_diameter_mm: the teeth are pointed at 50 mm (tip thickness -2.759 mm); "
         "give a tip diameter below 47.897 mm",
     )
+
+
+def test_a_shaft_may_not_take_a_reserved_name(tmp_path, root, capsys):
+    text = (root / "scenes" / "topologies" / "two-stage.toml").read_text()
+    path = tmp_path / "two.toml"
+    path.write_text(text.replace('id = "w"', 'id = "tau"'))
+    code, err = derive(capsys, path)
+    assert code == 2 and err.count("\n") == 1
+    assert "shaft id 'tau' is reserved" in err, err
