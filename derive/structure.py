@@ -272,8 +272,18 @@ def derive_structure(
         return Structure(topo, dofs, tuple(coords), q, masses, forces, R, W, Wt, zeta,
                          omega_n, tuple(damping), None, None, (), values, angles)  # fmt: skip
 
+    # W is symmetric and mostly zero: simplify each distinct entry once (cos^2 + sin^2 of
+    # the line of action and the helix), then only factor the coefficients built on it;
+    # simplifying every coefficient afresh took 10 s a model.
+    Ws: dict[tuple[int, int], sp.Expr] = {}
+    for i in range(N):
+        for j in range(i, N):
+            Ws[i, j] = Ws[j, i] = sp.simplify(W[i, j]) if W[i, j] != 0 else sp.Integer(0)
+    W = sp.ImmutableMatrix(N, N, lambda i, j: Ws[i, j])
+
     def simplify(expr):
-        expr = sp.factor(sp.simplify(expr))
+        # Every factor is positive, so absolute values that sqrt() leaves behind can go.
+        expr = sp.factor(expr)
         return expr.replace(lambda e: isinstance(e, sp.Abs), lambda e: e.args[0])
 
     L = [c.scale for c in coords]
