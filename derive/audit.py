@@ -398,7 +398,10 @@ def index_page(models: list[Model], command: str) -> str:
         "translations, and the rigid-body rotation dropping out as before. Translations are "
         "scaled by the first mesh's half backlash, a shaft's twist by $b_1/r_{b}$, and time "
         "by the torsional $\\omega_n$, so that $\\bar\\omega$ keeps its meaning. The drive "
-        "flank's line of action serves the back flank too, and tilting is not modelled. "
+        "flank's line of action serves the back flank too. With tilting "
+        "(`lateral-torsional-axial-tilting`) each gear also turns about $x$ and $y$ on its "
+        "bearing's tilting spring, and the axial force's moments about the contact point "
+        "(lumped at the pitch point, face centre) tilt it. "
         "`gearsym modes` solves $R^T K R\\,v = \\omega^2 M v$ at the mean stiffness.\n",
         "## Backlash polynomial\n",
         "The reference study prints $g(x) = 0.0017x^7 - 0.0366x^5 + 0.2833x^3 - 0.1555x$ "

@@ -29,7 +29,9 @@ def structure_sections(model) -> str:
         f"Degrees of freedom: `{st.dofs}`. Each gear turns ($\\theta_k$, positive in its "
         "operating direction)"
         + (
-            " and moves across and along its axis on its bearing"
+            " and moves across and along its axis on its bearing and tilts about x and y"
+            if "tx" in {c.kind for c in st.coordinates}
+            else " and moves across and along its axis on its bearing"
             if "z" in {c.kind for c in st.coordinates}
             else " and moves across its axis on its bearing"
             if "x" in {c.kind for c in st.coordinates}
@@ -37,7 +39,20 @@ def structure_sections(model) -> str:
         )
         + "; $z$ is along the axes, the first mesh's driver turns counter-clockwise seen "
         "from $+z$. Masses: a cylinder of the pitch radius with the bore removed, "
-        "$m = \\rho\\pi b_w (r^2 - r_{bore}^2)$, plus any attached mass.\n"
+        "$m = \\rho\\pi b_w (r^2 - r_{bore}^2)$, plus any attached mass"
+        + (
+            "; diametral inertia $J = m(3(r^2 + r_{bore}^2) + b_w^2)/12$ plus half the "
+            "attached inertia: "
+            + ", ".join(f"$J_{{{g.id}}}$ = {_num(g.diametral_inertia)} kg m²" for g in topo.gears)
+            + "; tilting bearings: "
+            + ", ".join(
+                f"{g} {_num(b.tilt)} N m/rad, {_num(b.tilt_damping)} N m s/rad"
+                for g, b in topo.bearings.items()
+            )
+            if "tx" in {c.kind for c in st.coordinates}
+            else ""
+        )
+        + ".\n"
     )
     w("| gear | turning sense | $m$ (kg) | $I$ (kg m²) | radial bearing (N/m, N s/m) | "
       "axial bearing (N/m, N s/m) |")  # fmt: skip
@@ -66,7 +81,8 @@ def structure_sections(model) -> str:
         "action adds $\\sigma\\sin\\beta_b$ along $z$ with "
         "$\\sigma = \\mathrm{sign}(\\beta_{driver})\\,\\epsilon_{driver}$. The drive flank's "
         "line serves the back flank too (its radial component keeps the drive flank's "
-        "sign); tilting is not modelled.\n"
+        "sign). The contact is lumped at the pitch point in the face's centre plane; with "
+        "tilting, a tilt moves it along $z$, so the axial force tilts the gears.\n"
     )
     w("| mesh | $\\phi$ (deg) | $\\alpha_{wt}$ (deg) | $\\psi$ (deg) | $\\sigma$ | "
       "$\\beta_b$ (deg) | orientation $s$ |")  # fmt: skip

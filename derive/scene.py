@@ -177,17 +177,7 @@ def _features(t: Table | None) -> Features:
 def _degrees_of_freedom(t: Table) -> str:
     from .structure import DEGREES_OF_FREEDOM
 
-    dofs = t.string(
-        "degrees_of_freedom",
-        "torsional",
-        choices=(*DEGREES_OF_FREEDOM, "lateral-torsional-axial-tilting"),
-    )
-    if dofs.endswith("tilting"):
-        raise t.error(
-            "degrees_of_freedom",
-            "tilting is not modelled yet (the axial force's moments go to the bearings); use "
-            "'lateral-torsional-axial'",
-        )
+    dofs = t.string("degrees_of_freedom", "torsional", choices=tuple(DEGREES_OF_FREEDOM))
     if dofs != "torsional" and not t.data.get("damping_coupling", True):
         raise t.error(
             "damping_coupling",

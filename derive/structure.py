@@ -1,10 +1,12 @@
-"""Lateral-torsional(-axial) equations: gears on bearings, shafts, helical meshes in 3-D.
+"""Lateral-torsional(-axial, -tilting) equations: gears on bearings, shafts, helical meshes in 3-D.
 
 Each gear ``k`` has its rotation ``theta_k`` (positive in its operating direction) and, as
 the scene asks (``degrees_of_freedom``), its translations ``x_k, y_k`` across its axis and
-``z_k`` along it, held by its bearing.  Global frame: ``z`` along the (parallel) axes; the
-first mesh's driver turns counter-clockwise seen from ``+z``, an external mesh reverses the
-sense (``Topology.senses``, ``epsilon_k = +-1``).
+``z_k`` along it, held by its bearing, and with tilting its rotations ``tx_k, ty_k`` about
+the transverse axes x and y (diametral inertia ``J_k``, the bearing's tilting stiffness).
+Global frame: ``z`` along the (parallel) axes; the first mesh's driver turns
+counter-clockwise seen from ``+z``, an external mesh reverses the sense
+(``Topology.senses``, ``epsilon_k = +-1``).
 
 **Mesh.**  The driver's centre lies at the angle ``phi`` round the driven gear's
 (``driver_position_deg``).  The transverse line of action, the direction of the force on
@@ -25,8 +27,10 @@ pushes its mate towards ``+z``).  The deflection along ``n`` (compression positi
 and the mesh force ``F = k(t) b g(delta / b) + c delta'`` acts along ``n``.  The drive
 flank's line of action serves the back flank too (as in the lumped models of Kahraman
 1994): after a reversal the tangential and axial components are exact, the radial one
-keeps the drive flank's sign.  Tilting is not modelled: the axial force's moment about
-the transverse axes goes to the bearings.
+keeps the drive flank's sign.  The contact is lumped at the pitch point in the face's
+centre plane: a tilt moves it along z by ``tx py - ty px``, so the axial component of the
+mesh force tilts the gears (its moments about the transverse axes, as in Kahraman 1994);
+without tilting those moments go straight to the bearings.
 
 **Coordinates.**  ``eta = R q + (s e, 0, 0)`` with ``q`` the physical coordinates
 (rotations, then translations) and ``R``'s rows the mesh deflections, the shafts' twists
@@ -67,7 +71,9 @@ DEGREES_OF_FREEDOM = {
     "torsional": (),
     "lateral-torsional": ("x", "y"),
     "lateral-torsional-axial": ("x", "y", "z"),
+    "lateral-torsional-axial-tilting": ("x", "y", "z", "tx", "ty"),
 }
+_TILTS = ("tx", "ty")  # rotations about the transverse axes x and y
 
 
 @dataclass(frozen=True)
@@ -179,6 +185,16 @@ def derive_structure(
                 f"'{dofs}' moves every gear across its axis, but gear(s) {', '.join(bare)} of "
                 f"{topo.source} have no [[bearing]]; give each gear a bearing",
             )
+    if "tx" in axes:
+        loose = [g for g, b in topo.bearings.items() if b.tilt is None]
+        if loose:
+            raise InputError(
+                source,
+                "features.degrees_of_freedom",
+                f"'{dofs}' tilts every gear, but the [[bearing]] of gear(s) {', '.join(loose)} "
+                f"of {topo.source} has no tilt_Nm_per_rad; give each bearing its tilting "
+                "stiffness",
+            )
     gears = [g.id for g in topo.gears]
     col = {g: k for k, g in enumerate(gears)}
     names = _names(topo, axes, source)
@@ -199,7 +215,9 @@ def derive_structure(
     mass = [sym(f"m_{{{g.id}}}", g.mass, positive=True) for g in topo.gears]
     radius = [sym(f"r_{{b,{g.id}}}", g.base_radius, positive=True) for g in topo.gears]
     torque = [sym(f"T_{{{g}}}", topo.torques.get(g, 0.0), real=True) for g in gears]
-    masses = tuple(inertia + [mass[col[g]] for g in gears for _ in axes])
+    tilt_inertia = [sym(f"J_{{{g.id}}}", g.diametral_inertia, positive=True) for g in topo.gears]
+    masses = tuple(inertia + [(tilt_inertia if a in _TILTS else mass)[col[g]]
+                              for g in gears for a in axes])  # fmt: skip
     forces = tuple(torque + [sp.Integer(0)] * len(trans))
 
     b1 = sym(f"b_{{{topo.meshes[0].id}}}", topo.meshes[0].half_backlash, positive=True)
@@ -227,6 +245,18 @@ def derive_structure(
                 part = s * cb * proj if proj is not None else s * sigma * sb
                 row[tcol[me.driver, a]] += part
                 row[tcol[me.driven, a]] -= part
+            if "tx" in axes:
+                # A tilt (a about x, b about y) moves the contact point (px, py) at the face
+                # centre along z by a py - b px; the contact is taken at the pitch point,
+                # r_w = r_b / cos(alpha_wt) from each centre along the centre line.
+                phi = sym(rf"\phi_{{{owner}}}", me.driver_position, real=True)
+                awt = sym(rf"\alpha_{{wt,{owner}}}", me.pair.working_pressure_angle,
+                          positive=True)  # fmt: skip
+                for gear, sign, side in ((me.driver, 1, -1), (me.driven, -1, 1)):
+                    rw = radius[col[gear]] / sp.cos(awt)
+                    px, py = side * rw * sp.cos(phi), side * rw * sp.sin(phi)
+                    row[tcol[gear, "tx"]] += sign * s * sigma * sb * py
+                    row[tcol[gear, "ty"]] -= sign * s * sigma * sb * px
             b = b1 if me is topo.meshes[0] else sym(f"b_{{{owner}}}", me.half_backlash,
                                                      positive=True)  # fmt: skip
             k = sym(f"k_{{m,{owner}}}", me.stiffness.mean, positive=True)
@@ -239,6 +269,12 @@ def derive_structure(
             k = sym(f"k_{{{owner}}}", sh.stiffness, positive=True)
             c = sym(f"c_{{{owner}}}", sh.damping, nonnegative=True)
             coords.append(Coordinate(name, kind, owner, b1 / radius[a_], k, c))
+        elif kind in _TILTS:
+            row[tcol[owner, kind]] = 1
+            bearing = topo.bearings[owner]
+            k = sym(f"k_{{t,{owner}}}", bearing.tilt, positive=True)
+            c = sym(f"c_{{t,{owner}}}", bearing.tilt_damping, nonnegative=True)
+            coords.append(Coordinate(name, kind, owner, b1 / radius[col[owner]], k, c))
         else:
             row[tcol[owner, kind]] = 1
             bearing = topo.bearings[owner]

@@ -42,6 +42,9 @@ class Bearing:
     # Along y when it differs from x (an anisotropic support); None: the radial values.
     radial_y: float | None = None
     radial_y_damping: float | None = None
+    # Tilting about the transverse axes (N m/rad, N m s/rad): needed by tilting models only.
+    tilt: float | None = None
+    tilt_damping: float = 0.0
 
     def transverse(self, axis: str) -> tuple[float, float, bool]:
         """(stiffness, damping, own) along ``x`` or ``y``: ``own`` when y has its own."""
@@ -83,6 +86,8 @@ def parse_bearings(top: Table, gears: dict) -> dict[str, Bearing]:
             t.number("axial_damping_N_s_per_m", 0.0, low=0.0, high=1e12),
             t.number("radial_y_N_per_m", None, low=0, low_open=True, high=1e16),
             t.number("radial_y_damping_N_s_per_m", None, low=0.0, high=1e12),
+            t.number("tilt_Nm_per_rad", None, low=0, low_open=True, high=1e16),
+            t.number("tilt_damping_Nm_s_per_rad", 0.0, low=0.0, high=1e12),
         )
         t.finish()
     return out

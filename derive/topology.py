@@ -76,6 +76,7 @@ class Gear:
     geometry: GearGeometry
     mass_given: float | None = None
     attached_mass: float = 0.0
+    diametral_inertia_given: float | None = None
 
     @property
     def blank_inertia(self) -> float:
@@ -102,6 +103,17 @@ class Gear:
         return self.material.density * math.pi * self.face_width * (r**2 - rb**2) + (
             self.attached_mass
         )
+
+    @property
+    def diametral_inertia(self) -> float:
+        """Moment of inertia about a diameter through the face centre, kg m^2 (tilting
+        models): given, or the blank's ``m (3 (r^2 + r_bore^2) + b^2) / 12`` plus half the
+        attached inertia (a thin disc's)."""
+        if self.diametral_inertia_given is not None:
+            return self.diametral_inertia_given
+        r, rb, b = self.geometry.pitch_radius, self.bore_radius, self.face_width
+        blank = self.material.density * math.pi * b * (r**2 - rb**2)
+        return blank * (3 * (r**2 + rb**2) + b**2) / 12 + self.attached_inertia / 2
 
     @property
     def base_radius(self) -> float:
@@ -296,6 +308,7 @@ def _gear(t: Table, materials: dict[str, Material]) -> Gear:
     attached = t.number("attached_inertia_kg_m2", 0.0, low=0.0)
     mass = t.number("mass_kg", None, low=0, low_open=True, high=1e6)
     attached_mass = t.number("attached_mass_kg", 0.0, low=0.0, high=1e6)
+    diametral = t.number("diametral_inertia_kg_m2", None, low=0, low_open=True)
     t.finish()
     return Gear(
         gid,
@@ -312,6 +325,7 @@ def _gear(t: Table, materials: dict[str, Material]) -> Gear:
         geometry,
         mass,
         attached_mass,
+        diametral,
     )
 
 

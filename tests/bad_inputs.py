@@ -84,7 +84,7 @@ CASES += [
     ("simulate {scene:unused}", "parameters.lamda: is not used by any load"),
     ("simulate {scene:flywheel}", "flywheel_inertia_kg_m2"),
     ("simulate {scene:dofs}", "degrees_of_freedom"),
-    ("simulate {scene:tilting}", "tilting is not modelled"),
+    ("simulate {scene:tilting}", "have no [[bearing]]"),
     # modes (issue 15)
     ("modes reference-lite", "reference-light"),
     ("modes diso --speeds 3000", "--speeds"),

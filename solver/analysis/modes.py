@@ -10,9 +10,10 @@ solve ``K v = w^2 M v`` (``scipy.linalg.eigh``).  The rigid-body rotation is the
 the resonance (Campbell) diagram is flat lines crossed by the mesh-frequency harmonics.
 
 Each mode is labelled by where its kinetic energy sits, ``m_k v_k^2`` grouped into
-rotations, translations across the axes and along them: a group holding at least
-:data:`DOMINANT` of it names the mode (``torsional``, ``translational``, ``axial``), else
-it is ``coupled``.  The strain energy ``k_j (R v)_j^2`` of each spring is given too.
+rotations, translations across the axes and along them, and tilts: a group holding at
+least :data:`DOMINANT` of it names the mode (``torsional``, ``translational``, ``axial``,
+``tilting``), else it is ``coupled``.  The strain energy ``k_j (R v)_j^2`` of each spring
+is given too.
 """
 
 from __future__ import annotations
@@ -26,7 +27,8 @@ import scipy.linalg
 __all__ = ["DOMINANT", "Mode", "Modes", "modes"]
 
 DOMINANT = 0.8  # kinetic-energy share of one group that names a mode
-_GROUPS = {"theta": "torsional", "x": "translational", "y": "translational", "z": "axial"}
+_GROUPS = {"theta": "torsional", "x": "translational", "y": "translational", "z": "axial",
+           "tx": "tilting", "ty": "tilting"}  # fmt: skip
 
 
 @dataclass(frozen=True)

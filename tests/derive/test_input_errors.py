@@ -665,3 +665,23 @@ def test_a_shaft_may_not_take_a_reserved_name(tmp_path, root, capsys):
     code, err = derive(capsys, path)
     assert code == 2 and err.count("\n") == 1
     assert "shaft id 'tau' is reserved" in err, err
+
+
+def test_tilting_needs_the_tilting_stiffness_of_every_bearing(tmp_path, root, capsys):
+    topo = tmp_path / "pair.toml"
+    topo.write_text(
+        f'[topology]\nextends = "{root / "scenes" / "topologies" / "siso.toml"}"\n'
+        'name = "pair"\n'
+        '[[bearing]]\ngear = "p"\nradial_N_per_m = 1e9\naxial_N_per_m = 1e9\n'
+        "tilt_Nm_per_rad = 1e7\n"
+        '[[bearing]]\ngear = "g"\nradial_N_per_m = 1e9\naxial_N_per_m = 1e9\n'
+    )
+    scene = tmp_path / "scene.toml"
+    scene.write_text(
+        f'[scene]\nname = "tilted"\ntopology = "{topo}"\n'
+        '[features]\ndegrees_of_freedom = "lateral-torsional-axial-tilting"\n'
+        "[parameters]\nomega = 0.5\ndamping_ratio = 0.03\n"
+    )
+    code, err = derive(capsys, scene)
+    assert code == 2 and err.count("\n") == 1
+    assert "gear(s) g" in err and "tilt_Nm_per_rad" in err, err
