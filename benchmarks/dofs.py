@@ -1,5 +1,5 @@
 """What degrees of freedom cost (issue 15): the reference light-load scene as a torsional,
-lateral-torsional and lateral-torsional-axial model, the single helical pair with and
+lateral-torsional, lateral-torsional-axial and tilting model, the single helical pair with and
 without bearings, and the two-stage train; per model the coordinates, the emitted
 operations, the time and evaluations per sweep point (compiled batched DOP853 over a
 lambda or damping sweep, 300 + 100 periods, median of repeats) and, for the DI-SO, how far
@@ -37,13 +37,17 @@ def _models(tmp: Path) -> list[tuple[str, object, str]]:
     from gearsym.solver import load_generated
 
     scene = load_target(builtin_root() / "diso-bearings-light.toml")
-    lateral = derive_model(variant(scene, "dofs-lateral", degrees_of_freedom="lateral-torsional"))
-    path = tmp / f"{lateral.name}.py"
-    write_atomic(path, emit_module(lateral, "gearsym bench"))
+    paths = {}
+    for tag, dofs in (("lateral", "lateral-torsional"),
+                      ("tilting", "lateral-torsional-axial-tilting")):  # fmt: skip
+        model = derive_model(variant(scene, f"dofs-{tag}", degrees_of_freedom=dofs))
+        paths[tag] = tmp / f"{model.name}.py"
+        write_atomic(paths[tag], emit_module(model, "gearsym bench"))
     return [
         ("DI-SO light, torsional (reference-light)", module_for("reference-light"), "lambda"),
-        ("DI-SO light, lateral-torsional", load_generated(path), "lambda"),
+        ("DI-SO light, lateral-torsional", load_generated(paths["lateral"]), "lambda"),
         ("DI-SO light, lateral-torsional-axial", module_for("diso-bearings-light"), "lambda"),
+        ("DI-SO light, with tilting", load_generated(paths["tilting"]), "lambda"),
         ("helical pair, torsional (siso)", module_for("siso"), "damping_ratio"),
         ("helical pair on bearings", module_for("helical-pair-bearings"), "damping_ratio"),
         ("two-stage train on bearings", module_for("two-stage"), "damping_ratio"),
