@@ -7,25 +7,12 @@ its Poincare points of u and v move from the torsional model's."""
 
 from __future__ import annotations
 
-import statistics
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
 
 __all__ = ["dof_cost", "dof_section"]
-
-
-def _median(fn, repeats: int):
-    times, out = [], None
-    for _ in range(repeats):
-        started = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - started)
-        if times[0] > 5.0:
-            break
-    return statistics.median(times), out
 
 
 def _models(tmp: Path) -> list[tuple[str, object, str]]:
@@ -55,6 +42,7 @@ def _models(tmp: Path) -> list[tuple[str, object, str]]:
 
 
 def dof_cost(quick: bool) -> dict:
+    from gearsym.benchmarks.performance import _median_time
     from gearsym.solver.integrate import default_initial_state
     from gearsym.solver.integrate.native import run_batch
     from gearsym.solver.system import System
@@ -73,11 +61,12 @@ def dof_cost(quick: bool) -> dict:
             P = np.array([module.parameters(**{param: v}) for v in values])
             X0 = np.repeat(default_initial_state(system)[None, :], points, axis=0)
             run_batch(module, P[:1], X0[:1], transient=1, periods=1)  # compile once, untimed
-            t, res = _median(
+            t, res = _median_time(
                 lambda m=module, P=P, X0=X0: run_batch(
                     m, P, X0, method="dop853", transient=tr, periods=per
                 ),
                 3,
+                long=5.0,
             )
             coords = len(module.STRUCTURE["coordinates"])
             row = {

@@ -13,6 +13,8 @@ import math
 
 import sympy as sp
 
+from ._markdown import math_block as _math
+from ._markdown import number as _num
 from ._paths import display_path
 from .audit_structure import structure_sections
 from .backlash import fit_dead_zone
@@ -21,16 +23,6 @@ from .nondim import DAMPING_TEXT
 from .readings import reading_section
 
 __all__ = ["audit_page", "index_page"]
-
-
-def _math(*lines: str) -> str:
-    return "```math\n" + "\n".join(lines) + "\n```\n"
-
-
-def _num(v: float, digits: int = 6) -> str:
-    if v == 0:
-        return "0"
-    return f"{v:.{digits}g}"
 
 
 def _latex(expr, names: dict | None = None) -> str:

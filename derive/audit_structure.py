@@ -8,15 +8,10 @@ import math
 
 import sympy as sp
 
+from ._markdown import math_block as _math
+from ._markdown import number as _num
+
 __all__ = ["structure_sections"]
-
-
-def _math(*lines: str) -> str:
-    return "```math\n" + "\n".join(lines) + "\n```\n"
-
-
-def _num(v: float, digits: int = 6) -> str:
-    return "0" if v == 0 else f"{v:.{digits}g}"
 
 
 def structure_sections(model) -> str:

@@ -210,15 +210,15 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
     else:
         f_values = [nd.value(nd.load[i]) for i in range(m)]
         f_meaning = "static load (from the topology's torques)"
+    f = [param(f"f_{c}", f_values[i], f_meaning, f"f_{{{c}}}") for i, c in enumerate(coords)]
     # Beyond the meshes: a shaft's load from the torques; none on a translation.
-    f_values += [nd.value(nd.load[i]) for i in range(m, N)]
-    f = tuple(
-        param(f"f_{c}", f_values[i], f_meaning if i < m else "static load (from the topology's "
-              "torques)", f"f_{{{c}}}")
-        if i < m or f_values[i] != 0
-        else sp.Integer(0)
-        for i, c in enumerate(disp)
-    )  # fmt: skip
+    for i in range(m, N):
+        load = nd.value(nd.load[i])
+        meaning = "static load (from the topology's torques)"
+        f.append(
+            param(f"f_{disp[i]}", load, meaning, f"f_{{{disp[i]}}}") if load else sp.Integer(0)
+        )
+    f = tuple(f)
 
     def what(j: int) -> str:
         return f"g({disp[j]})" if j < m else disp[j]

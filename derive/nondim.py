@@ -68,6 +68,11 @@ class NonDim:
         """Numeric value of a closed-form expression for this topology and scene."""
         return float(sp.sympify(expr).subs(self.values).evalf(17))
 
+    def torque_symbol(self, gear: str) -> sp.Symbol:
+        """The symbol of the external torque on ``gear`` (the reading of the loads)."""
+        eq = self.equations
+        return eq.torque[eq.gears.index(gear)]
+
 
 def nondimensionalise(
     topology: Topology,

@@ -106,7 +106,6 @@ def load_signs(nd, topology, reading_id: str, where: str) -> dict[str, tuple[str
     """coordinate -> (input gear, sign of d f_i/d T_gear from the derivation, sigma of the
     gear); the load sign of the coordinate is the product of the last two."""
     reading = topology.readings[reading_id]
-    eq = nd.equations
     out = {}
     for i, mesh in enumerate(topology.meshes):
         inputs = [g for g in (mesh.driver, mesh.driven) if reading.role(g)]
@@ -115,8 +114,7 @@ def load_signs(nd, topology, reading_id: str, where: str) -> dict[str, tuple[str
                              f"one input gear of mesh '{mesh.id}' in driving or braking, "
                              f"names {len(inputs)}")  # fmt: skip
         gear = inputs[0]
-        torque = eq.torque[eq.gears.index(gear)]
-        slope = nd.value(nd.load[i].diff(torque))
+        slope = nd.value(nd.load[i].diff(nd.torque_symbol(gear)))
         out[mesh.coordinate] = (gear, 1 if slope > 0 else -1, reading.role(gear))
     return out
 

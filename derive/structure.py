@@ -121,11 +121,9 @@ class Structure:
     def gears(self) -> tuple[str, ...]:
         return tuple(g.id for g in self.topology.gears)
 
-    @property
-    def equations(self) -> Structure:
-        """Itself: the reading of the loads asks ``nd.equations`` for ``gears`` and
-        ``torque`` (``derive/readings.py``), which a structure states in the same order."""
-        return self
+    def torque_symbol(self, gear: str) -> sp.Symbol:
+        """The symbol of the external torque on ``gear`` (the reading of the loads)."""
+        return self.torque[self.gears.index(gear)]
 
     @property
     def names(self) -> tuple[str, ...]:
