@@ -263,6 +263,23 @@ CASES += [
     ("bench --quik", "--quick"),
 ]
 
+# -- issue 23: hostile and careless inputs (each block is one class of docs/robustness.md) --
+
+# files of the wrong shape: wrong TOML types at any key, arrays for tables, deep nesting
+CASES += []
+
+# the derivation cache: a corrupted module or digest is derived again (tests/test_cache_trust.py)
+CASES += []
+
+# continuation parameters and their valid ranges
+CASES += []
+
+# bounded work: every size that sets the cost
+CASES += []
+
+# strict JSON and Unix manners (tests/test_unix_manners.py)
+CASES += []
+
 
 def make_files(folder, root) -> dict:
     """The files the placeholders name, made in ``folder``; returns placeholder -> path."""
