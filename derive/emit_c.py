@@ -17,12 +17,26 @@ from __future__ import annotations
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
+from .escape import code_names, text
 from .model import Model
 
 __all__ = ["c_source"]
 
 
 class _Printer(C99CodePrinter):
+    """C99 with each model symbol as its namespaced identifier (``escape.code_names``):
+    a coordinate called ``int``, ``q`` or ``NAN`` cannot collide with C or with the host
+    file's own names."""
+
+    def __init__(self, names: dict | None = None):
+        super().__init__()
+        self.names = names or {}
+
+    def _print_Symbol(self, expr):
+        if expr in self.names:
+            return self.names[expr]
+        return super()._print_Symbol(expr)
+
     def _print_Pow(self, expr):
         base, exp = expr.args
         if exp.is_Integer and 2 <= int(exp) <= 8:
@@ -123,7 +137,7 @@ def _harmonic_lines(bases, printer, substitute=None) -> list[str]:
 def c_source(model: Model, variational: bool = False) -> str:
     """C text of ``gs_prep`` and ``gs_rhs`` for ``model``; with ``variational`` for the
     state extended by a tangent vector ``w``: ``(x, w)' = (F(tau, x), J(tau, x) w)``."""
-    printer = _Printer()
+    printer = _Printer(code_names((*model.state_symbols, *model.parameter_symbols)))
     tau = (
         next(s for e in model.rhs for s in e.free_symbols if s.name == "tau")
         if any(s.name == "tau" for e in model.rhs for s in e.free_symbols)
@@ -143,12 +157,17 @@ def c_source(model: Model, variational: bool = False) -> str:
     params = {s: k for k, s in enumerate(model.parameter_symbols)}
 
     def unpack(symbols, used, indent="    "):
-        return [f"{indent}const double {s.name} = p[{params[s]}];" for s in symbols if s in used]
+        return [
+            f"{indent}const double {printer.doprint(s)} = p[{params[s]}];"
+            for s in symbols
+            if s in used
+        ]
 
     prep_used = set().union(*(e.free_symbols for e in q_defs)) if q_defs else set()
     what = " with the variational equations" if variational else ""
     lines = [
-        f"/* {model.name}: right-hand side{what} for the compiled integrators (gearsym derive). */",
+        f"/* {text(model.name)}: right-hand side{what} for the compiled integrators "
+        "(gearsym derive). */",
         f"#define GS_NX {n}",
         f"#define GS_NP {m}",
         f"#define GS_NQ {max(len(q_defs), 1)}",
@@ -170,7 +189,7 @@ def c_source(model: Model, variational: bool = False) -> str:
     )
     for k, s in enumerate(states):
         if s in used:
-            lines.append(f"    const double {s.name} = x[{k}];")
+            lines.append(f"    const double {printer.doprint(s)} = x[{k}];")
     base_used = set()
     for w in bases:
         base_used |= w.free_symbols
@@ -197,10 +216,10 @@ def c_source(model: Model, variational: bool = False) -> str:
         lines.append("        for (int k = 0; k < GS_NQ; ++k) q[k] = Q[k*n + j];")
     for k, s in enumerate(states):
         if s in used:
-            lines.append(f"        const double {s.name} = X[{k}*n + j];")
+            lines.append(f"        const double {printer.doprint(s)} = X[{k}*n + j];")
     for s in model.parameter_symbols:
         if s in used:
-            lines.append(f"        const double {s.name} = P[{params[s]}*n + j];")
+            lines.append(f"        const double {printer.doprint(s)} = P[{params[s]}*n + j];")
     for sym, e in replacements:
         lines.append(f"        const double {sym.name} = {printer.doprint(e)};")
     for k, e in enumerate(reduced):

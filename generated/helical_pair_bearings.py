@@ -83,6 +83,8 @@ Time: tau = omega_n t, omega_n = 11068.62872 rad/s.
 
 CONTRACT states as data what a solver needs: velocity indices, forcing frequency,
 loads, contact edges, piecewise or smooth, switching surfaces, valid range.
+
+Model symbols are namespaced in the code: state or parameter NAME is m_NAME.
 """
 
 import numpy as np
@@ -199,108 +201,108 @@ C_SOURCE = r"""
 
 static void gs_prep(const double *p, double *q)
 {
-    const double psi_u_1 = p[47];
-    q[0] = cos(psi_u_1);
-    q[1] = sin(psi_u_1);
+    const double m_psi_u_1 = p[47];
+    q[0] = cos(m_psi_u_1);
+    q[1] = sin(m_psi_u_1);
     (void)p; (void)q;
 }
 
 static inline void gs_rhs(double tau, const double *x, const double *p, const double *q, double *dx)
 {
-    const double u = x[0];
-    const double xp = x[1];
-    const double yp = x[2];
-    const double zp = x[3];
-    const double xg = x[4];
-    const double yg = x[5];
-    const double zg = x[6];
-    const double du = x[7];
-    const double dxp = x[8];
-    const double dyp = x[9];
-    const double dzp = x[10];
-    const double dxg = x[11];
-    const double dyg = x[12];
-    const double dzg = x[13];
-    const double omega = p[0];
-    const double f_u = p[1];
-    const double xi_u_u = p[2];
-    const double xi_u_xp = p[3];
-    const double xi_u_yp = p[4];
-    const double xi_u_zp = p[5];
-    const double xi_u_xg = p[6];
-    const double xi_u_yg = p[7];
-    const double xi_u_zg = p[8];
-    const double xi_xp_u = p[9];
-    const double xi_xp_xp = p[10];
-    const double xi_yp_u = p[11];
-    const double xi_yp_yp = p[12];
-    const double xi_zp_u = p[13];
-    const double xi_zp_zp = p[14];
-    const double xi_xg_u = p[15];
-    const double xi_xg_xg = p[16];
-    const double xi_yg_u = p[17];
-    const double xi_yg_yg = p[18];
-    const double xi_zg_u = p[19];
-    const double xi_zg_zg = p[20];
-    const double kappa_u_u = p[21];
-    const double kappa_u_xp = p[22];
-    const double kappa_u_yp = p[23];
-    const double kappa_u_zp = p[24];
-    const double kappa_u_xg = p[25];
-    const double kappa_u_yg = p[26];
-    const double kappa_u_zg = p[27];
-    const double kappa_xp_u = p[28];
-    const double kappa_xp_xp = p[29];
-    const double kappa_yp_u = p[30];
-    const double kappa_yp_yp = p[31];
-    const double kappa_zp_u = p[32];
-    const double kappa_zp_zp = p[33];
-    const double kappa_xg_u = p[34];
-    const double kappa_xg_xg = p[35];
-    const double kappa_yg_u = p[36];
-    const double kappa_yg_yg = p[37];
-    const double kappa_zg_u = p[38];
-    const double kappa_zg_zg = p[39];
-    const double kc_u_1 = p[40];
-    const double ks_u_1 = p[41];
-    const double kc_u_2 = p[42];
-    const double ks_u_2 = p[43];
-    const double kc_u_3 = p[44];
-    const double ks_u_3 = p[45];
-    const double E_u_1 = p[46];
-    const double g1 = p[48];
-    const double g3 = p[49];
-    const double g5 = p[50];
-    const double g7 = p[51];
-    const double th0 = (omega)*tau;
+    const double m_u = x[0];
+    const double m_xp = x[1];
+    const double m_yp = x[2];
+    const double m_zp = x[3];
+    const double m_xg = x[4];
+    const double m_yg = x[5];
+    const double m_zg = x[6];
+    const double m_du = x[7];
+    const double m_dxp = x[8];
+    const double m_dyp = x[9];
+    const double m_dzp = x[10];
+    const double m_dxg = x[11];
+    const double m_dyg = x[12];
+    const double m_dzg = x[13];
+    const double m_omega = p[0];
+    const double m_f_u = p[1];
+    const double m_xi_u_u = p[2];
+    const double m_xi_u_xp = p[3];
+    const double m_xi_u_yp = p[4];
+    const double m_xi_u_zp = p[5];
+    const double m_xi_u_xg = p[6];
+    const double m_xi_u_yg = p[7];
+    const double m_xi_u_zg = p[8];
+    const double m_xi_xp_u = p[9];
+    const double m_xi_xp_xp = p[10];
+    const double m_xi_yp_u = p[11];
+    const double m_xi_yp_yp = p[12];
+    const double m_xi_zp_u = p[13];
+    const double m_xi_zp_zp = p[14];
+    const double m_xi_xg_u = p[15];
+    const double m_xi_xg_xg = p[16];
+    const double m_xi_yg_u = p[17];
+    const double m_xi_yg_yg = p[18];
+    const double m_xi_zg_u = p[19];
+    const double m_xi_zg_zg = p[20];
+    const double m_kappa_u_u = p[21];
+    const double m_kappa_u_xp = p[22];
+    const double m_kappa_u_yp = p[23];
+    const double m_kappa_u_zp = p[24];
+    const double m_kappa_u_xg = p[25];
+    const double m_kappa_u_yg = p[26];
+    const double m_kappa_u_zg = p[27];
+    const double m_kappa_xp_u = p[28];
+    const double m_kappa_xp_xp = p[29];
+    const double m_kappa_yp_u = p[30];
+    const double m_kappa_yp_yp = p[31];
+    const double m_kappa_zp_u = p[32];
+    const double m_kappa_zp_zp = p[33];
+    const double m_kappa_xg_u = p[34];
+    const double m_kappa_xg_xg = p[35];
+    const double m_kappa_yg_u = p[36];
+    const double m_kappa_yg_yg = p[37];
+    const double m_kappa_zg_u = p[38];
+    const double m_kappa_zg_zg = p[39];
+    const double m_kc_u_1 = p[40];
+    const double m_ks_u_1 = p[41];
+    const double m_kc_u_2 = p[42];
+    const double m_ks_u_2 = p[43];
+    const double m_kc_u_3 = p[44];
+    const double m_ks_u_3 = p[45];
+    const double m_E_u_1 = p[46];
+    const double m_g1 = p[48];
+    const double m_g3 = p[49];
+    const double m_g5 = p[50];
+    const double m_g7 = p[51];
+    const double th0 = (m_omega)*tau;
     const double C0_1 = cos(th0), S0_1 = sin(th0);
     const double C0_2 = C0_1*C0_1 - S0_1*S0_1;
     const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
     const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
     const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
-    const double t_0 = 2*du;
-    const double t_1 = 2*dxg;
-    const double t_2 = 2*dxp;
-    const double t_3 = 2*dyg;
-    const double t_4 = 2*dyp;
-    const double t_5 = 2*dzg;
-    const double t_6 = 2*dzp;
-    const double t_7 = ((u)*(u));
-    const double t_8 = u*(g1 + t_7*(g3 + t_7*(g5 + g7*t_7)))*(C0_1*kc_u_1 + C0_2*kc_u_2 + C0_3*kc_u_3 + S0_1*ks_u_1 + S0_2*ks_u_2 + S0_3*ks_u_3 + 1);
-    dx[0] = du;
-    dx[1] = dxp;
-    dx[2] = dyp;
-    dx[3] = dzp;
-    dx[4] = dxg;
-    dx[5] = dyg;
-    dx[6] = dzg;
-    dx[7] = -E_u_1*((omega)*(omega))*(C0_1*q[0] - S0_1*q[1]) + f_u - kappa_u_u*t_8 - kappa_u_xg*xg - kappa_u_xp*xp - kappa_u_yg*yg - kappa_u_yp*yp - kappa_u_zg*zg - kappa_u_zp*zp - t_0*xi_u_u - t_1*xi_u_xg - t_2*xi_u_xp - t_3*xi_u_yg - t_4*xi_u_yp - t_5*xi_u_zg - t_6*xi_u_zp;
-    dx[8] = -kappa_xp_u*t_8 - kappa_xp_xp*xp - t_0*xi_xp_u - t_2*xi_xp_xp;
-    dx[9] = -kappa_yp_u*t_8 - kappa_yp_yp*yp - t_0*xi_yp_u - t_4*xi_yp_yp;
-    dx[10] = -kappa_zp_u*t_8 - kappa_zp_zp*zp - t_0*xi_zp_u - t_6*xi_zp_zp;
-    dx[11] = -kappa_xg_u*t_8 - kappa_xg_xg*xg - t_0*xi_xg_u - t_1*xi_xg_xg;
-    dx[12] = -kappa_yg_u*t_8 - kappa_yg_yg*yg - t_0*xi_yg_u - t_3*xi_yg_yg;
-    dx[13] = -kappa_zg_u*t_8 - kappa_zg_zg*zg - t_0*xi_zg_u - t_5*xi_zg_zg;
+    const double t_0 = 2*m_du;
+    const double t_1 = 2*m_dxg;
+    const double t_2 = 2*m_dxp;
+    const double t_3 = 2*m_dyg;
+    const double t_4 = 2*m_dyp;
+    const double t_5 = 2*m_dzg;
+    const double t_6 = 2*m_dzp;
+    const double t_7 = ((m_u)*(m_u));
+    const double t_8 = m_u*(m_g1 + t_7*(m_g3 + t_7*(m_g5 + m_g7*t_7)))*(C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1);
+    dx[0] = m_du;
+    dx[1] = m_dxp;
+    dx[2] = m_dyp;
+    dx[3] = m_dzp;
+    dx[4] = m_dxg;
+    dx[5] = m_dyg;
+    dx[6] = m_dzg;
+    dx[7] = -m_E_u_1*((m_omega)*(m_omega))*(C0_1*q[0] - S0_1*q[1]) + m_f_u - m_kappa_u_u*t_8 - m_kappa_u_xg*m_xg - m_kappa_u_xp*m_xp - m_kappa_u_yg*m_yg - m_kappa_u_yp*m_yp - m_kappa_u_zg*m_zg - m_kappa_u_zp*m_zp - t_0*m_xi_u_u - t_1*m_xi_u_xg - t_2*m_xi_u_xp - t_3*m_xi_u_yg - t_4*m_xi_u_yp - t_5*m_xi_u_zg - t_6*m_xi_u_zp;
+    dx[8] = -m_kappa_xp_u*t_8 - m_kappa_xp_xp*m_xp - t_0*m_xi_xp_u - t_2*m_xi_xp_xp;
+    dx[9] = -m_kappa_yp_u*t_8 - m_kappa_yp_yp*m_yp - t_0*m_xi_yp_u - t_4*m_xi_yp_yp;
+    dx[10] = -m_kappa_zp_u*t_8 - m_kappa_zp_zp*m_zp - t_0*m_xi_zp_u - t_6*m_xi_zp_zp;
+    dx[11] = -m_kappa_xg_u*t_8 - m_kappa_xg_xg*m_xg - t_0*m_xi_xg_u - t_1*m_xi_xg_xg;
+    dx[12] = -m_kappa_yg_u*t_8 - m_kappa_yg_yg*m_yg - t_0*m_xi_yg_u - t_3*m_xi_yg_yg;
+    dx[13] = -m_kappa_zg_u*t_8 - m_kappa_zg_zg*m_zg - t_0*m_xi_zg_u - t_5*m_xi_zg_zg;
     (void)tau; (void)p; (void)q;
 }
 
@@ -316,94 +318,94 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
         for (int k = 0; k < GS_NQ; ++k) q[k] = Q[k*n + j];
-        const double u = X[0*n + j];
-        const double xp = X[1*n + j];
-        const double yp = X[2*n + j];
-        const double zp = X[3*n + j];
-        const double xg = X[4*n + j];
-        const double yg = X[5*n + j];
-        const double zg = X[6*n + j];
-        const double du = X[7*n + j];
-        const double dxp = X[8*n + j];
-        const double dyp = X[9*n + j];
-        const double dzp = X[10*n + j];
-        const double dxg = X[11*n + j];
-        const double dyg = X[12*n + j];
-        const double dzg = X[13*n + j];
-        const double omega = P[0*n + j];
-        const double f_u = P[1*n + j];
-        const double xi_u_u = P[2*n + j];
-        const double xi_u_xp = P[3*n + j];
-        const double xi_u_yp = P[4*n + j];
-        const double xi_u_zp = P[5*n + j];
-        const double xi_u_xg = P[6*n + j];
-        const double xi_u_yg = P[7*n + j];
-        const double xi_u_zg = P[8*n + j];
-        const double xi_xp_u = P[9*n + j];
-        const double xi_xp_xp = P[10*n + j];
-        const double xi_yp_u = P[11*n + j];
-        const double xi_yp_yp = P[12*n + j];
-        const double xi_zp_u = P[13*n + j];
-        const double xi_zp_zp = P[14*n + j];
-        const double xi_xg_u = P[15*n + j];
-        const double xi_xg_xg = P[16*n + j];
-        const double xi_yg_u = P[17*n + j];
-        const double xi_yg_yg = P[18*n + j];
-        const double xi_zg_u = P[19*n + j];
-        const double xi_zg_zg = P[20*n + j];
-        const double kappa_u_u = P[21*n + j];
-        const double kappa_u_xp = P[22*n + j];
-        const double kappa_u_yp = P[23*n + j];
-        const double kappa_u_zp = P[24*n + j];
-        const double kappa_u_xg = P[25*n + j];
-        const double kappa_u_yg = P[26*n + j];
-        const double kappa_u_zg = P[27*n + j];
-        const double kappa_xp_u = P[28*n + j];
-        const double kappa_xp_xp = P[29*n + j];
-        const double kappa_yp_u = P[30*n + j];
-        const double kappa_yp_yp = P[31*n + j];
-        const double kappa_zp_u = P[32*n + j];
-        const double kappa_zp_zp = P[33*n + j];
-        const double kappa_xg_u = P[34*n + j];
-        const double kappa_xg_xg = P[35*n + j];
-        const double kappa_yg_u = P[36*n + j];
-        const double kappa_yg_yg = P[37*n + j];
-        const double kappa_zg_u = P[38*n + j];
-        const double kappa_zg_zg = P[39*n + j];
-        const double kc_u_1 = P[40*n + j];
-        const double ks_u_1 = P[41*n + j];
-        const double kc_u_2 = P[42*n + j];
-        const double ks_u_2 = P[43*n + j];
-        const double kc_u_3 = P[44*n + j];
-        const double ks_u_3 = P[45*n + j];
-        const double E_u_1 = P[46*n + j];
-        const double g1 = P[48*n + j];
-        const double g3 = P[49*n + j];
-        const double g5 = P[50*n + j];
-        const double g7 = P[51*n + j];
-        const double t_0 = 2*du;
-        const double t_1 = 2*dxg;
-        const double t_2 = 2*dxp;
-        const double t_3 = 2*dyg;
-        const double t_4 = 2*dyp;
-        const double t_5 = 2*dzg;
-        const double t_6 = 2*dzp;
-        const double t_7 = ((u)*(u));
-        const double t_8 = u*(g1 + t_7*(g3 + t_7*(g5 + g7*t_7)))*(C0_1*kc_u_1 + C0_2*kc_u_2 + C0_3*kc_u_3 + S0_1*ks_u_1 + S0_2*ks_u_2 + S0_3*ks_u_3 + 1);
-        DX[0*n + j] = du;
-        DX[1*n + j] = dxp;
-        DX[2*n + j] = dyp;
-        DX[3*n + j] = dzp;
-        DX[4*n + j] = dxg;
-        DX[5*n + j] = dyg;
-        DX[6*n + j] = dzg;
-        DX[7*n + j] = -E_u_1*((omega)*(omega))*(C0_1*q[0] - S0_1*q[1]) + f_u - kappa_u_u*t_8 - kappa_u_xg*xg - kappa_u_xp*xp - kappa_u_yg*yg - kappa_u_yp*yp - kappa_u_zg*zg - kappa_u_zp*zp - t_0*xi_u_u - t_1*xi_u_xg - t_2*xi_u_xp - t_3*xi_u_yg - t_4*xi_u_yp - t_5*xi_u_zg - t_6*xi_u_zp;
-        DX[8*n + j] = -kappa_xp_u*t_8 - kappa_xp_xp*xp - t_0*xi_xp_u - t_2*xi_xp_xp;
-        DX[9*n + j] = -kappa_yp_u*t_8 - kappa_yp_yp*yp - t_0*xi_yp_u - t_4*xi_yp_yp;
-        DX[10*n + j] = -kappa_zp_u*t_8 - kappa_zp_zp*zp - t_0*xi_zp_u - t_6*xi_zp_zp;
-        DX[11*n + j] = -kappa_xg_u*t_8 - kappa_xg_xg*xg - t_0*xi_xg_u - t_1*xi_xg_xg;
-        DX[12*n + j] = -kappa_yg_u*t_8 - kappa_yg_yg*yg - t_0*xi_yg_u - t_3*xi_yg_yg;
-        DX[13*n + j] = -kappa_zg_u*t_8 - kappa_zg_zg*zg - t_0*xi_zg_u - t_5*xi_zg_zg;
+        const double m_u = X[0*n + j];
+        const double m_xp = X[1*n + j];
+        const double m_yp = X[2*n + j];
+        const double m_zp = X[3*n + j];
+        const double m_xg = X[4*n + j];
+        const double m_yg = X[5*n + j];
+        const double m_zg = X[6*n + j];
+        const double m_du = X[7*n + j];
+        const double m_dxp = X[8*n + j];
+        const double m_dyp = X[9*n + j];
+        const double m_dzp = X[10*n + j];
+        const double m_dxg = X[11*n + j];
+        const double m_dyg = X[12*n + j];
+        const double m_dzg = X[13*n + j];
+        const double m_omega = P[0*n + j];
+        const double m_f_u = P[1*n + j];
+        const double m_xi_u_u = P[2*n + j];
+        const double m_xi_u_xp = P[3*n + j];
+        const double m_xi_u_yp = P[4*n + j];
+        const double m_xi_u_zp = P[5*n + j];
+        const double m_xi_u_xg = P[6*n + j];
+        const double m_xi_u_yg = P[7*n + j];
+        const double m_xi_u_zg = P[8*n + j];
+        const double m_xi_xp_u = P[9*n + j];
+        const double m_xi_xp_xp = P[10*n + j];
+        const double m_xi_yp_u = P[11*n + j];
+        const double m_xi_yp_yp = P[12*n + j];
+        const double m_xi_zp_u = P[13*n + j];
+        const double m_xi_zp_zp = P[14*n + j];
+        const double m_xi_xg_u = P[15*n + j];
+        const double m_xi_xg_xg = P[16*n + j];
+        const double m_xi_yg_u = P[17*n + j];
+        const double m_xi_yg_yg = P[18*n + j];
+        const double m_xi_zg_u = P[19*n + j];
+        const double m_xi_zg_zg = P[20*n + j];
+        const double m_kappa_u_u = P[21*n + j];
+        const double m_kappa_u_xp = P[22*n + j];
+        const double m_kappa_u_yp = P[23*n + j];
+        const double m_kappa_u_zp = P[24*n + j];
+        const double m_kappa_u_xg = P[25*n + j];
+        const double m_kappa_u_yg = P[26*n + j];
+        const double m_kappa_u_zg = P[27*n + j];
+        const double m_kappa_xp_u = P[28*n + j];
+        const double m_kappa_xp_xp = P[29*n + j];
+        const double m_kappa_yp_u = P[30*n + j];
+        const double m_kappa_yp_yp = P[31*n + j];
+        const double m_kappa_zp_u = P[32*n + j];
+        const double m_kappa_zp_zp = P[33*n + j];
+        const double m_kappa_xg_u = P[34*n + j];
+        const double m_kappa_xg_xg = P[35*n + j];
+        const double m_kappa_yg_u = P[36*n + j];
+        const double m_kappa_yg_yg = P[37*n + j];
+        const double m_kappa_zg_u = P[38*n + j];
+        const double m_kappa_zg_zg = P[39*n + j];
+        const double m_kc_u_1 = P[40*n + j];
+        const double m_ks_u_1 = P[41*n + j];
+        const double m_kc_u_2 = P[42*n + j];
+        const double m_ks_u_2 = P[43*n + j];
+        const double m_kc_u_3 = P[44*n + j];
+        const double m_ks_u_3 = P[45*n + j];
+        const double m_E_u_1 = P[46*n + j];
+        const double m_g1 = P[48*n + j];
+        const double m_g3 = P[49*n + j];
+        const double m_g5 = P[50*n + j];
+        const double m_g7 = P[51*n + j];
+        const double t_0 = 2*m_du;
+        const double t_1 = 2*m_dxg;
+        const double t_2 = 2*m_dxp;
+        const double t_3 = 2*m_dyg;
+        const double t_4 = 2*m_dyp;
+        const double t_5 = 2*m_dzg;
+        const double t_6 = 2*m_dzp;
+        const double t_7 = ((m_u)*(m_u));
+        const double t_8 = m_u*(m_g1 + t_7*(m_g3 + t_7*(m_g5 + m_g7*t_7)))*(C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1);
+        DX[0*n + j] = m_du;
+        DX[1*n + j] = m_dxp;
+        DX[2*n + j] = m_dyp;
+        DX[3*n + j] = m_dzp;
+        DX[4*n + j] = m_dxg;
+        DX[5*n + j] = m_dyg;
+        DX[6*n + j] = m_dzg;
+        DX[7*n + j] = -m_E_u_1*((m_omega)*(m_omega))*(C0_1*q[0] - S0_1*q[1]) + m_f_u - m_kappa_u_u*t_8 - m_kappa_u_xg*m_xg - m_kappa_u_xp*m_xp - m_kappa_u_yg*m_yg - m_kappa_u_yp*m_yp - m_kappa_u_zg*m_zg - m_kappa_u_zp*m_zp - t_0*m_xi_u_u - t_1*m_xi_u_xg - t_2*m_xi_u_xp - t_3*m_xi_u_yg - t_4*m_xi_u_yp - t_5*m_xi_u_zg - t_6*m_xi_u_zp;
+        DX[8*n + j] = -m_kappa_xp_u*t_8 - m_kappa_xp_xp*m_xp - t_0*m_xi_xp_u - t_2*m_xi_xp_xp;
+        DX[9*n + j] = -m_kappa_yp_u*t_8 - m_kappa_yp_yp*m_yp - t_0*m_xi_yp_u - t_4*m_xi_yp_yp;
+        DX[10*n + j] = -m_kappa_zp_u*t_8 - m_kappa_zp_zp*m_zp - t_0*m_xi_zp_u - t_6*m_xi_zp_zp;
+        DX[11*n + j] = -m_kappa_xg_u*t_8 - m_kappa_xg_xg*m_xg - t_0*m_xi_xg_u - t_1*m_xi_xg_xg;
+        DX[12*n + j] = -m_kappa_yg_u*t_8 - m_kappa_yg_yg*m_yg - t_0*m_xi_yg_u - t_3*m_xi_yg_yg;
+        DX[13*n + j] = -m_kappa_zg_u*t_8 - m_kappa_zg_zg*m_zg - t_0*m_xi_zg_u - t_5*m_xi_zg_zg;
     }
     (void)tau; (void)P; (void)Q;
 }
@@ -418,28 +420,28 @@ C_SOURCE_VARIATIONAL = r"""
 
 static void gs_prep(const double *p, double *q)
 {
-    const double psi_u_1 = p[47];
-    q[0] = cos(psi_u_1);
-    q[1] = sin(psi_u_1);
+    const double m_psi_u_1 = p[47];
+    q[0] = cos(m_psi_u_1);
+    q[1] = sin(m_psi_u_1);
     (void)p; (void)q;
 }
 
 static inline void gs_rhs(double tau, const double *x, const double *p, const double *q, double *dx)
 {
-    const double u = x[0];
-    const double xp = x[1];
-    const double yp = x[2];
-    const double zp = x[3];
-    const double xg = x[4];
-    const double yg = x[5];
-    const double zg = x[6];
-    const double du = x[7];
-    const double dxp = x[8];
-    const double dyp = x[9];
-    const double dzp = x[10];
-    const double dxg = x[11];
-    const double dyg = x[12];
-    const double dzg = x[13];
+    const double m_u = x[0];
+    const double m_xp = x[1];
+    const double m_yp = x[2];
+    const double m_zp = x[3];
+    const double m_xg = x[4];
+    const double m_yg = x[5];
+    const double m_zg = x[6];
+    const double m_du = x[7];
+    const double m_dxp = x[8];
+    const double m_dyp = x[9];
+    const double m_dzp = x[10];
+    const double m_dxg = x[11];
+    const double m_dyg = x[12];
+    const double m_dzg = x[13];
     const double w0 = x[14];
     const double w1 = x[15];
     const double w2 = x[16];
@@ -454,82 +456,82 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     const double w11 = x[25];
     const double w12 = x[26];
     const double w13 = x[27];
-    const double omega = p[0];
-    const double f_u = p[1];
-    const double xi_u_u = p[2];
-    const double xi_u_xp = p[3];
-    const double xi_u_yp = p[4];
-    const double xi_u_zp = p[5];
-    const double xi_u_xg = p[6];
-    const double xi_u_yg = p[7];
-    const double xi_u_zg = p[8];
-    const double xi_xp_u = p[9];
-    const double xi_xp_xp = p[10];
-    const double xi_yp_u = p[11];
-    const double xi_yp_yp = p[12];
-    const double xi_zp_u = p[13];
-    const double xi_zp_zp = p[14];
-    const double xi_xg_u = p[15];
-    const double xi_xg_xg = p[16];
-    const double xi_yg_u = p[17];
-    const double xi_yg_yg = p[18];
-    const double xi_zg_u = p[19];
-    const double xi_zg_zg = p[20];
-    const double kappa_u_u = p[21];
-    const double kappa_u_xp = p[22];
-    const double kappa_u_yp = p[23];
-    const double kappa_u_zp = p[24];
-    const double kappa_u_xg = p[25];
-    const double kappa_u_yg = p[26];
-    const double kappa_u_zg = p[27];
-    const double kappa_xp_u = p[28];
-    const double kappa_xp_xp = p[29];
-    const double kappa_yp_u = p[30];
-    const double kappa_yp_yp = p[31];
-    const double kappa_zp_u = p[32];
-    const double kappa_zp_zp = p[33];
-    const double kappa_xg_u = p[34];
-    const double kappa_xg_xg = p[35];
-    const double kappa_yg_u = p[36];
-    const double kappa_yg_yg = p[37];
-    const double kappa_zg_u = p[38];
-    const double kappa_zg_zg = p[39];
-    const double kc_u_1 = p[40];
-    const double ks_u_1 = p[41];
-    const double kc_u_2 = p[42];
-    const double ks_u_2 = p[43];
-    const double kc_u_3 = p[44];
-    const double ks_u_3 = p[45];
-    const double E_u_1 = p[46];
-    const double g1 = p[48];
-    const double g3 = p[49];
-    const double g5 = p[50];
-    const double g7 = p[51];
-    const double th0 = (omega)*tau;
+    const double m_omega = p[0];
+    const double m_f_u = p[1];
+    const double m_xi_u_u = p[2];
+    const double m_xi_u_xp = p[3];
+    const double m_xi_u_yp = p[4];
+    const double m_xi_u_zp = p[5];
+    const double m_xi_u_xg = p[6];
+    const double m_xi_u_yg = p[7];
+    const double m_xi_u_zg = p[8];
+    const double m_xi_xp_u = p[9];
+    const double m_xi_xp_xp = p[10];
+    const double m_xi_yp_u = p[11];
+    const double m_xi_yp_yp = p[12];
+    const double m_xi_zp_u = p[13];
+    const double m_xi_zp_zp = p[14];
+    const double m_xi_xg_u = p[15];
+    const double m_xi_xg_xg = p[16];
+    const double m_xi_yg_u = p[17];
+    const double m_xi_yg_yg = p[18];
+    const double m_xi_zg_u = p[19];
+    const double m_xi_zg_zg = p[20];
+    const double m_kappa_u_u = p[21];
+    const double m_kappa_u_xp = p[22];
+    const double m_kappa_u_yp = p[23];
+    const double m_kappa_u_zp = p[24];
+    const double m_kappa_u_xg = p[25];
+    const double m_kappa_u_yg = p[26];
+    const double m_kappa_u_zg = p[27];
+    const double m_kappa_xp_u = p[28];
+    const double m_kappa_xp_xp = p[29];
+    const double m_kappa_yp_u = p[30];
+    const double m_kappa_yp_yp = p[31];
+    const double m_kappa_zp_u = p[32];
+    const double m_kappa_zp_zp = p[33];
+    const double m_kappa_xg_u = p[34];
+    const double m_kappa_xg_xg = p[35];
+    const double m_kappa_yg_u = p[36];
+    const double m_kappa_yg_yg = p[37];
+    const double m_kappa_zg_u = p[38];
+    const double m_kappa_zg_zg = p[39];
+    const double m_kc_u_1 = p[40];
+    const double m_ks_u_1 = p[41];
+    const double m_kc_u_2 = p[42];
+    const double m_ks_u_2 = p[43];
+    const double m_kc_u_3 = p[44];
+    const double m_ks_u_3 = p[45];
+    const double m_E_u_1 = p[46];
+    const double m_g1 = p[48];
+    const double m_g3 = p[49];
+    const double m_g5 = p[50];
+    const double m_g7 = p[51];
+    const double th0 = (m_omega)*tau;
     const double C0_1 = cos(th0), S0_1 = sin(th0);
     const double C0_2 = C0_1*C0_1 - S0_1*S0_1;
     const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
     const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
     const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
-    const double t_0 = 2*du;
-    const double t_1 = 2*dxg;
-    const double t_2 = 2*dxp;
-    const double t_3 = 2*dyg;
-    const double t_4 = 2*dyp;
-    const double t_5 = 2*dzg;
-    const double t_6 = 2*dzp;
-    const double t_7 = ((u)*(u));
-    const double t_8 = g5 + g7*t_7;
-    const double t_9 = g3 + t_7*t_8;
-    const double t_10 = C0_1*kc_u_1 + C0_2*kc_u_2 + C0_3*kc_u_3 + S0_1*ks_u_1 + S0_2*ks_u_2 + S0_3*ks_u_3 + 1;
-    const double t_11 = t_10*(g1 + t_7*t_9);
-    const double t_12 = kappa_u_u*t_11;
-    const double t_13 = kappa_xp_u*t_11;
-    const double t_14 = kappa_yp_u*t_11;
-    const double t_15 = kappa_zp_u*t_11;
-    const double t_16 = kappa_xg_u*t_11;
-    const double t_17 = kappa_yg_u*t_11;
-    const double t_18 = kappa_zg_u*t_11;
+    const double t_0 = 2*m_du;
+    const double t_1 = 2*m_dxg;
+    const double t_2 = 2*m_dxp;
+    const double t_3 = 2*m_dyg;
+    const double t_4 = 2*m_dyp;
+    const double t_5 = 2*m_dzg;
+    const double t_6 = 2*m_dzp;
+    const double t_7 = ((m_u)*(m_u));
+    const double t_8 = m_g5 + m_g7*t_7;
+    const double t_9 = m_g3 + t_7*t_8;
+    const double t_10 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
+    const double t_11 = t_10*(m_g1 + t_7*t_9);
+    const double t_12 = m_kappa_u_u*t_11;
+    const double t_13 = m_kappa_xp_u*t_11;
+    const double t_14 = m_kappa_yp_u*t_11;
+    const double t_15 = m_kappa_zp_u*t_11;
+    const double t_16 = m_kappa_xg_u*t_11;
+    const double t_17 = m_kappa_yg_u*t_11;
+    const double t_18 = m_kappa_zg_u*t_11;
     const double t_19 = 2*w10;
     const double t_20 = 2*w11;
     const double t_21 = 2*w12;
@@ -537,22 +539,22 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     const double t_23 = 2*w7;
     const double t_24 = 2*w8;
     const double t_25 = 2*w9;
-    const double t_26 = 2*u;
-    const double t_27 = t_10*u*(t_26*t_9 + t_7*(2*g7*((u)*(u)*(u)) + t_26*t_8));
-    dx[0] = du;
-    dx[1] = dxp;
-    dx[2] = dyp;
-    dx[3] = dzp;
-    dx[4] = dxg;
-    dx[5] = dyg;
-    dx[6] = dzg;
-    dx[7] = -E_u_1*((omega)*(omega))*(C0_1*q[0] - S0_1*q[1]) + f_u - kappa_u_xg*xg - kappa_u_xp*xp - kappa_u_yg*yg - kappa_u_yp*yp - kappa_u_zg*zg - kappa_u_zp*zp - t_0*xi_u_u - t_1*xi_u_xg - t_12*u - t_2*xi_u_xp - t_3*xi_u_yg - t_4*xi_u_yp - t_5*xi_u_zg - t_6*xi_u_zp;
-    dx[8] = -kappa_xp_xp*xp - t_0*xi_xp_u - t_13*u - t_2*xi_xp_xp;
-    dx[9] = -kappa_yp_yp*yp - t_0*xi_yp_u - t_14*u - t_4*xi_yp_yp;
-    dx[10] = -kappa_zp_zp*zp - t_0*xi_zp_u - t_15*u - t_6*xi_zp_zp;
-    dx[11] = -kappa_xg_xg*xg - t_0*xi_xg_u - t_1*xi_xg_xg - t_16*u;
-    dx[12] = -kappa_yg_yg*yg - t_0*xi_yg_u - t_17*u - t_3*xi_yg_yg;
-    dx[13] = -kappa_zg_zg*zg - t_0*xi_zg_u - t_18*u - t_5*xi_zg_zg;
+    const double t_26 = 2*m_u;
+    const double t_27 = t_10*m_u*(t_26*t_9 + t_7*(2*m_g7*((m_u)*(m_u)*(m_u)) + t_26*t_8));
+    dx[0] = m_du;
+    dx[1] = m_dxp;
+    dx[2] = m_dyp;
+    dx[3] = m_dzp;
+    dx[4] = m_dxg;
+    dx[5] = m_dyg;
+    dx[6] = m_dzg;
+    dx[7] = -m_E_u_1*((m_omega)*(m_omega))*(C0_1*q[0] - S0_1*q[1]) + m_f_u - m_kappa_u_xg*m_xg - m_kappa_u_xp*m_xp - m_kappa_u_yg*m_yg - m_kappa_u_yp*m_yp - m_kappa_u_zg*m_zg - m_kappa_u_zp*m_zp - t_0*m_xi_u_u - t_1*m_xi_u_xg - t_12*m_u - t_2*m_xi_u_xp - t_3*m_xi_u_yg - t_4*m_xi_u_yp - t_5*m_xi_u_zg - t_6*m_xi_u_zp;
+    dx[8] = -m_kappa_xp_xp*m_xp - t_0*m_xi_xp_u - t_13*m_u - t_2*m_xi_xp_xp;
+    dx[9] = -m_kappa_yp_yp*m_yp - t_0*m_xi_yp_u - t_14*m_u - t_4*m_xi_yp_yp;
+    dx[10] = -m_kappa_zp_zp*m_zp - t_0*m_xi_zp_u - t_15*m_u - t_6*m_xi_zp_zp;
+    dx[11] = -m_kappa_xg_xg*m_xg - t_0*m_xi_xg_u - t_1*m_xi_xg_xg - t_16*m_u;
+    dx[12] = -m_kappa_yg_yg*m_yg - t_0*m_xi_yg_u - t_17*m_u - t_3*m_xi_yg_yg;
+    dx[13] = -m_kappa_zg_zg*m_zg - t_0*m_xi_zg_u - t_18*m_u - t_5*m_xi_zg_zg;
     dx[14] = w7;
     dx[15] = w8;
     dx[16] = w9;
@@ -560,13 +562,13 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     dx[18] = w11;
     dx[19] = w12;
     dx[20] = w13;
-    dx[21] = -kappa_u_xg*w4 - kappa_u_xp*w1 - kappa_u_yg*w5 - kappa_u_yp*w2 - kappa_u_zg*w6 - kappa_u_zp*w3 - t_19*xi_u_zp - t_20*xi_u_xg - t_21*xi_u_yg - t_22*xi_u_zg - t_23*xi_u_u - t_24*xi_u_xp - t_25*xi_u_yp + w0*(-kappa_u_u*t_27 - t_12);
-    dx[22] = -kappa_xp_xp*w1 - t_23*xi_xp_u - t_24*xi_xp_xp + w0*(-kappa_xp_u*t_27 - t_13);
-    dx[23] = -kappa_yp_yp*w2 - t_23*xi_yp_u - t_25*xi_yp_yp + w0*(-kappa_yp_u*t_27 - t_14);
-    dx[24] = -kappa_zp_zp*w3 - t_19*xi_zp_zp - t_23*xi_zp_u + w0*(-kappa_zp_u*t_27 - t_15);
-    dx[25] = -kappa_xg_xg*w4 - t_20*xi_xg_xg - t_23*xi_xg_u + w0*(-kappa_xg_u*t_27 - t_16);
-    dx[26] = -kappa_yg_yg*w5 - t_21*xi_yg_yg - t_23*xi_yg_u + w0*(-kappa_yg_u*t_27 - t_17);
-    dx[27] = -kappa_zg_zg*w6 - t_22*xi_zg_zg - t_23*xi_zg_u + w0*(-kappa_zg_u*t_27 - t_18);
+    dx[21] = -m_kappa_u_xg*w4 - m_kappa_u_xp*w1 - m_kappa_u_yg*w5 - m_kappa_u_yp*w2 - m_kappa_u_zg*w6 - m_kappa_u_zp*w3 - t_19*m_xi_u_zp - t_20*m_xi_u_xg - t_21*m_xi_u_yg - t_22*m_xi_u_zg - t_23*m_xi_u_u - t_24*m_xi_u_xp - t_25*m_xi_u_yp + w0*(-m_kappa_u_u*t_27 - t_12);
+    dx[22] = -m_kappa_xp_xp*w1 - t_23*m_xi_xp_u - t_24*m_xi_xp_xp + w0*(-m_kappa_xp_u*t_27 - t_13);
+    dx[23] = -m_kappa_yp_yp*w2 - t_23*m_xi_yp_u - t_25*m_xi_yp_yp + w0*(-m_kappa_yp_u*t_27 - t_14);
+    dx[24] = -m_kappa_zp_zp*w3 - t_19*m_xi_zp_zp - t_23*m_xi_zp_u + w0*(-m_kappa_zp_u*t_27 - t_15);
+    dx[25] = -m_kappa_xg_xg*w4 - t_20*m_xi_xg_xg - t_23*m_xi_xg_u + w0*(-m_kappa_xg_u*t_27 - t_16);
+    dx[26] = -m_kappa_yg_yg*w5 - t_21*m_xi_yg_yg - t_23*m_xi_yg_u + w0*(-m_kappa_yg_u*t_27 - t_17);
+    dx[27] = -m_kappa_zg_zg*w6 - t_22*m_xi_zg_zg - t_23*m_xi_zg_u + w0*(-m_kappa_zg_u*t_27 - t_18);
     (void)tau; (void)p; (void)q;
 }
 
@@ -582,20 +584,20 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
         for (int k = 0; k < GS_NQ; ++k) q[k] = Q[k*n + j];
-        const double u = X[0*n + j];
-        const double xp = X[1*n + j];
-        const double yp = X[2*n + j];
-        const double zp = X[3*n + j];
-        const double xg = X[4*n + j];
-        const double yg = X[5*n + j];
-        const double zg = X[6*n + j];
-        const double du = X[7*n + j];
-        const double dxp = X[8*n + j];
-        const double dyp = X[9*n + j];
-        const double dzp = X[10*n + j];
-        const double dxg = X[11*n + j];
-        const double dyg = X[12*n + j];
-        const double dzg = X[13*n + j];
+        const double m_u = X[0*n + j];
+        const double m_xp = X[1*n + j];
+        const double m_yp = X[2*n + j];
+        const double m_zp = X[3*n + j];
+        const double m_xg = X[4*n + j];
+        const double m_yg = X[5*n + j];
+        const double m_zg = X[6*n + j];
+        const double m_du = X[7*n + j];
+        const double m_dxp = X[8*n + j];
+        const double m_dyp = X[9*n + j];
+        const double m_dzp = X[10*n + j];
+        const double m_dxg = X[11*n + j];
+        const double m_dyg = X[12*n + j];
+        const double m_dzg = X[13*n + j];
         const double w0 = X[14*n + j];
         const double w1 = X[15*n + j];
         const double w2 = X[16*n + j];
@@ -610,76 +612,76 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double w11 = X[25*n + j];
         const double w12 = X[26*n + j];
         const double w13 = X[27*n + j];
-        const double omega = P[0*n + j];
-        const double f_u = P[1*n + j];
-        const double xi_u_u = P[2*n + j];
-        const double xi_u_xp = P[3*n + j];
-        const double xi_u_yp = P[4*n + j];
-        const double xi_u_zp = P[5*n + j];
-        const double xi_u_xg = P[6*n + j];
-        const double xi_u_yg = P[7*n + j];
-        const double xi_u_zg = P[8*n + j];
-        const double xi_xp_u = P[9*n + j];
-        const double xi_xp_xp = P[10*n + j];
-        const double xi_yp_u = P[11*n + j];
-        const double xi_yp_yp = P[12*n + j];
-        const double xi_zp_u = P[13*n + j];
-        const double xi_zp_zp = P[14*n + j];
-        const double xi_xg_u = P[15*n + j];
-        const double xi_xg_xg = P[16*n + j];
-        const double xi_yg_u = P[17*n + j];
-        const double xi_yg_yg = P[18*n + j];
-        const double xi_zg_u = P[19*n + j];
-        const double xi_zg_zg = P[20*n + j];
-        const double kappa_u_u = P[21*n + j];
-        const double kappa_u_xp = P[22*n + j];
-        const double kappa_u_yp = P[23*n + j];
-        const double kappa_u_zp = P[24*n + j];
-        const double kappa_u_xg = P[25*n + j];
-        const double kappa_u_yg = P[26*n + j];
-        const double kappa_u_zg = P[27*n + j];
-        const double kappa_xp_u = P[28*n + j];
-        const double kappa_xp_xp = P[29*n + j];
-        const double kappa_yp_u = P[30*n + j];
-        const double kappa_yp_yp = P[31*n + j];
-        const double kappa_zp_u = P[32*n + j];
-        const double kappa_zp_zp = P[33*n + j];
-        const double kappa_xg_u = P[34*n + j];
-        const double kappa_xg_xg = P[35*n + j];
-        const double kappa_yg_u = P[36*n + j];
-        const double kappa_yg_yg = P[37*n + j];
-        const double kappa_zg_u = P[38*n + j];
-        const double kappa_zg_zg = P[39*n + j];
-        const double kc_u_1 = P[40*n + j];
-        const double ks_u_1 = P[41*n + j];
-        const double kc_u_2 = P[42*n + j];
-        const double ks_u_2 = P[43*n + j];
-        const double kc_u_3 = P[44*n + j];
-        const double ks_u_3 = P[45*n + j];
-        const double E_u_1 = P[46*n + j];
-        const double g1 = P[48*n + j];
-        const double g3 = P[49*n + j];
-        const double g5 = P[50*n + j];
-        const double g7 = P[51*n + j];
-        const double t_0 = 2*du;
-        const double t_1 = 2*dxg;
-        const double t_2 = 2*dxp;
-        const double t_3 = 2*dyg;
-        const double t_4 = 2*dyp;
-        const double t_5 = 2*dzg;
-        const double t_6 = 2*dzp;
-        const double t_7 = ((u)*(u));
-        const double t_8 = g5 + g7*t_7;
-        const double t_9 = g3 + t_7*t_8;
-        const double t_10 = C0_1*kc_u_1 + C0_2*kc_u_2 + C0_3*kc_u_3 + S0_1*ks_u_1 + S0_2*ks_u_2 + S0_3*ks_u_3 + 1;
-        const double t_11 = t_10*(g1 + t_7*t_9);
-        const double t_12 = kappa_u_u*t_11;
-        const double t_13 = kappa_xp_u*t_11;
-        const double t_14 = kappa_yp_u*t_11;
-        const double t_15 = kappa_zp_u*t_11;
-        const double t_16 = kappa_xg_u*t_11;
-        const double t_17 = kappa_yg_u*t_11;
-        const double t_18 = kappa_zg_u*t_11;
+        const double m_omega = P[0*n + j];
+        const double m_f_u = P[1*n + j];
+        const double m_xi_u_u = P[2*n + j];
+        const double m_xi_u_xp = P[3*n + j];
+        const double m_xi_u_yp = P[4*n + j];
+        const double m_xi_u_zp = P[5*n + j];
+        const double m_xi_u_xg = P[6*n + j];
+        const double m_xi_u_yg = P[7*n + j];
+        const double m_xi_u_zg = P[8*n + j];
+        const double m_xi_xp_u = P[9*n + j];
+        const double m_xi_xp_xp = P[10*n + j];
+        const double m_xi_yp_u = P[11*n + j];
+        const double m_xi_yp_yp = P[12*n + j];
+        const double m_xi_zp_u = P[13*n + j];
+        const double m_xi_zp_zp = P[14*n + j];
+        const double m_xi_xg_u = P[15*n + j];
+        const double m_xi_xg_xg = P[16*n + j];
+        const double m_xi_yg_u = P[17*n + j];
+        const double m_xi_yg_yg = P[18*n + j];
+        const double m_xi_zg_u = P[19*n + j];
+        const double m_xi_zg_zg = P[20*n + j];
+        const double m_kappa_u_u = P[21*n + j];
+        const double m_kappa_u_xp = P[22*n + j];
+        const double m_kappa_u_yp = P[23*n + j];
+        const double m_kappa_u_zp = P[24*n + j];
+        const double m_kappa_u_xg = P[25*n + j];
+        const double m_kappa_u_yg = P[26*n + j];
+        const double m_kappa_u_zg = P[27*n + j];
+        const double m_kappa_xp_u = P[28*n + j];
+        const double m_kappa_xp_xp = P[29*n + j];
+        const double m_kappa_yp_u = P[30*n + j];
+        const double m_kappa_yp_yp = P[31*n + j];
+        const double m_kappa_zp_u = P[32*n + j];
+        const double m_kappa_zp_zp = P[33*n + j];
+        const double m_kappa_xg_u = P[34*n + j];
+        const double m_kappa_xg_xg = P[35*n + j];
+        const double m_kappa_yg_u = P[36*n + j];
+        const double m_kappa_yg_yg = P[37*n + j];
+        const double m_kappa_zg_u = P[38*n + j];
+        const double m_kappa_zg_zg = P[39*n + j];
+        const double m_kc_u_1 = P[40*n + j];
+        const double m_ks_u_1 = P[41*n + j];
+        const double m_kc_u_2 = P[42*n + j];
+        const double m_ks_u_2 = P[43*n + j];
+        const double m_kc_u_3 = P[44*n + j];
+        const double m_ks_u_3 = P[45*n + j];
+        const double m_E_u_1 = P[46*n + j];
+        const double m_g1 = P[48*n + j];
+        const double m_g3 = P[49*n + j];
+        const double m_g5 = P[50*n + j];
+        const double m_g7 = P[51*n + j];
+        const double t_0 = 2*m_du;
+        const double t_1 = 2*m_dxg;
+        const double t_2 = 2*m_dxp;
+        const double t_3 = 2*m_dyg;
+        const double t_4 = 2*m_dyp;
+        const double t_5 = 2*m_dzg;
+        const double t_6 = 2*m_dzp;
+        const double t_7 = ((m_u)*(m_u));
+        const double t_8 = m_g5 + m_g7*t_7;
+        const double t_9 = m_g3 + t_7*t_8;
+        const double t_10 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
+        const double t_11 = t_10*(m_g1 + t_7*t_9);
+        const double t_12 = m_kappa_u_u*t_11;
+        const double t_13 = m_kappa_xp_u*t_11;
+        const double t_14 = m_kappa_yp_u*t_11;
+        const double t_15 = m_kappa_zp_u*t_11;
+        const double t_16 = m_kappa_xg_u*t_11;
+        const double t_17 = m_kappa_yg_u*t_11;
+        const double t_18 = m_kappa_zg_u*t_11;
         const double t_19 = 2*w10;
         const double t_20 = 2*w11;
         const double t_21 = 2*w12;
@@ -687,22 +689,22 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double t_23 = 2*w7;
         const double t_24 = 2*w8;
         const double t_25 = 2*w9;
-        const double t_26 = 2*u;
-        const double t_27 = t_10*u*(t_26*t_9 + t_7*(2*g7*((u)*(u)*(u)) + t_26*t_8));
-        DX[0*n + j] = du;
-        DX[1*n + j] = dxp;
-        DX[2*n + j] = dyp;
-        DX[3*n + j] = dzp;
-        DX[4*n + j] = dxg;
-        DX[5*n + j] = dyg;
-        DX[6*n + j] = dzg;
-        DX[7*n + j] = -E_u_1*((omega)*(omega))*(C0_1*q[0] - S0_1*q[1]) + f_u - kappa_u_xg*xg - kappa_u_xp*xp - kappa_u_yg*yg - kappa_u_yp*yp - kappa_u_zg*zg - kappa_u_zp*zp - t_0*xi_u_u - t_1*xi_u_xg - t_12*u - t_2*xi_u_xp - t_3*xi_u_yg - t_4*xi_u_yp - t_5*xi_u_zg - t_6*xi_u_zp;
-        DX[8*n + j] = -kappa_xp_xp*xp - t_0*xi_xp_u - t_13*u - t_2*xi_xp_xp;
-        DX[9*n + j] = -kappa_yp_yp*yp - t_0*xi_yp_u - t_14*u - t_4*xi_yp_yp;
-        DX[10*n + j] = -kappa_zp_zp*zp - t_0*xi_zp_u - t_15*u - t_6*xi_zp_zp;
-        DX[11*n + j] = -kappa_xg_xg*xg - t_0*xi_xg_u - t_1*xi_xg_xg - t_16*u;
-        DX[12*n + j] = -kappa_yg_yg*yg - t_0*xi_yg_u - t_17*u - t_3*xi_yg_yg;
-        DX[13*n + j] = -kappa_zg_zg*zg - t_0*xi_zg_u - t_18*u - t_5*xi_zg_zg;
+        const double t_26 = 2*m_u;
+        const double t_27 = t_10*m_u*(t_26*t_9 + t_7*(2*m_g7*((m_u)*(m_u)*(m_u)) + t_26*t_8));
+        DX[0*n + j] = m_du;
+        DX[1*n + j] = m_dxp;
+        DX[2*n + j] = m_dyp;
+        DX[3*n + j] = m_dzp;
+        DX[4*n + j] = m_dxg;
+        DX[5*n + j] = m_dyg;
+        DX[6*n + j] = m_dzg;
+        DX[7*n + j] = -m_E_u_1*((m_omega)*(m_omega))*(C0_1*q[0] - S0_1*q[1]) + m_f_u - m_kappa_u_xg*m_xg - m_kappa_u_xp*m_xp - m_kappa_u_yg*m_yg - m_kappa_u_yp*m_yp - m_kappa_u_zg*m_zg - m_kappa_u_zp*m_zp - t_0*m_xi_u_u - t_1*m_xi_u_xg - t_12*m_u - t_2*m_xi_u_xp - t_3*m_xi_u_yg - t_4*m_xi_u_yp - t_5*m_xi_u_zg - t_6*m_xi_u_zp;
+        DX[8*n + j] = -m_kappa_xp_xp*m_xp - t_0*m_xi_xp_u - t_13*m_u - t_2*m_xi_xp_xp;
+        DX[9*n + j] = -m_kappa_yp_yp*m_yp - t_0*m_xi_yp_u - t_14*m_u - t_4*m_xi_yp_yp;
+        DX[10*n + j] = -m_kappa_zp_zp*m_zp - t_0*m_xi_zp_u - t_15*m_u - t_6*m_xi_zp_zp;
+        DX[11*n + j] = -m_kappa_xg_xg*m_xg - t_0*m_xi_xg_u - t_1*m_xi_xg_xg - t_16*m_u;
+        DX[12*n + j] = -m_kappa_yg_yg*m_yg - t_0*m_xi_yg_u - t_17*m_u - t_3*m_xi_yg_yg;
+        DX[13*n + j] = -m_kappa_zg_zg*m_zg - t_0*m_xi_zg_u - t_18*m_u - t_5*m_xi_zg_zg;
         DX[14*n + j] = w7;
         DX[15*n + j] = w8;
         DX[16*n + j] = w9;
@@ -710,13 +712,13 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         DX[18*n + j] = w11;
         DX[19*n + j] = w12;
         DX[20*n + j] = w13;
-        DX[21*n + j] = -kappa_u_xg*w4 - kappa_u_xp*w1 - kappa_u_yg*w5 - kappa_u_yp*w2 - kappa_u_zg*w6 - kappa_u_zp*w3 - t_19*xi_u_zp - t_20*xi_u_xg - t_21*xi_u_yg - t_22*xi_u_zg - t_23*xi_u_u - t_24*xi_u_xp - t_25*xi_u_yp + w0*(-kappa_u_u*t_27 - t_12);
-        DX[22*n + j] = -kappa_xp_xp*w1 - t_23*xi_xp_u - t_24*xi_xp_xp + w0*(-kappa_xp_u*t_27 - t_13);
-        DX[23*n + j] = -kappa_yp_yp*w2 - t_23*xi_yp_u - t_25*xi_yp_yp + w0*(-kappa_yp_u*t_27 - t_14);
-        DX[24*n + j] = -kappa_zp_zp*w3 - t_19*xi_zp_zp - t_23*xi_zp_u + w0*(-kappa_zp_u*t_27 - t_15);
-        DX[25*n + j] = -kappa_xg_xg*w4 - t_20*xi_xg_xg - t_23*xi_xg_u + w0*(-kappa_xg_u*t_27 - t_16);
-        DX[26*n + j] = -kappa_yg_yg*w5 - t_21*xi_yg_yg - t_23*xi_yg_u + w0*(-kappa_yg_u*t_27 - t_17);
-        DX[27*n + j] = -kappa_zg_zg*w6 - t_22*xi_zg_zg - t_23*xi_zg_u + w0*(-kappa_zg_u*t_27 - t_18);
+        DX[21*n + j] = -m_kappa_u_xg*w4 - m_kappa_u_xp*w1 - m_kappa_u_yg*w5 - m_kappa_u_yp*w2 - m_kappa_u_zg*w6 - m_kappa_u_zp*w3 - t_19*m_xi_u_zp - t_20*m_xi_u_xg - t_21*m_xi_u_yg - t_22*m_xi_u_zg - t_23*m_xi_u_u - t_24*m_xi_u_xp - t_25*m_xi_u_yp + w0*(-m_kappa_u_u*t_27 - t_12);
+        DX[22*n + j] = -m_kappa_xp_xp*w1 - t_23*m_xi_xp_u - t_24*m_xi_xp_xp + w0*(-m_kappa_xp_u*t_27 - t_13);
+        DX[23*n + j] = -m_kappa_yp_yp*w2 - t_23*m_xi_yp_u - t_25*m_xi_yp_yp + w0*(-m_kappa_yp_u*t_27 - t_14);
+        DX[24*n + j] = -m_kappa_zp_zp*w3 - t_19*m_xi_zp_zp - t_23*m_xi_zp_u + w0*(-m_kappa_zp_u*t_27 - t_15);
+        DX[25*n + j] = -m_kappa_xg_xg*w4 - t_20*m_xi_xg_xg - t_23*m_xi_xg_u + w0*(-m_kappa_xg_u*t_27 - t_16);
+        DX[26*n + j] = -m_kappa_yg_yg*w5 - t_21*m_xi_yg_yg - t_23*m_xi_yg_u + w0*(-m_kappa_yg_u*t_27 - t_17);
+        DX[27*n + j] = -m_kappa_zg_zg*w6 - t_22*m_xi_zg_zg - t_23*m_xi_zg_u + w0*(-m_kappa_zg_u*t_27 - t_18);
     }
     (void)tau; (void)P; (void)Q;
 }
@@ -725,99 +727,99 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
 
 def rhs(tau, x, p):
     """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); result (n,) or (n, N)."""
-    u = x[0]
-    xp = x[1]
-    yp = x[2]
-    zp = x[3]
-    xg = x[4]
-    yg = x[5]
-    zg = x[6]
-    du = x[7]
-    dxp = x[8]
-    dyp = x[9]
-    dzp = x[10]
-    dxg = x[11]
-    dyg = x[12]
-    dzg = x[13]
-    omega = p[0]
-    f_u = p[1]
-    xi_u_u = p[2]
-    xi_u_xp = p[3]
-    xi_u_yp = p[4]
-    xi_u_zp = p[5]
-    xi_u_xg = p[6]
-    xi_u_yg = p[7]
-    xi_u_zg = p[8]
-    xi_xp_u = p[9]
-    xi_xp_xp = p[10]
-    xi_yp_u = p[11]
-    xi_yp_yp = p[12]
-    xi_zp_u = p[13]
-    xi_zp_zp = p[14]
-    xi_xg_u = p[15]
-    xi_xg_xg = p[16]
-    xi_yg_u = p[17]
-    xi_yg_yg = p[18]
-    xi_zg_u = p[19]
-    xi_zg_zg = p[20]
-    kappa_u_u = p[21]
-    kappa_u_xp = p[22]
-    kappa_u_yp = p[23]
-    kappa_u_zp = p[24]
-    kappa_u_xg = p[25]
-    kappa_u_yg = p[26]
-    kappa_u_zg = p[27]
-    kappa_xp_u = p[28]
-    kappa_xp_xp = p[29]
-    kappa_yp_u = p[30]
-    kappa_yp_yp = p[31]
-    kappa_zp_u = p[32]
-    kappa_zp_zp = p[33]
-    kappa_xg_u = p[34]
-    kappa_xg_xg = p[35]
-    kappa_yg_u = p[36]
-    kappa_yg_yg = p[37]
-    kappa_zg_u = p[38]
-    kappa_zg_zg = p[39]
-    kc_u_1 = p[40]
-    ks_u_1 = p[41]
-    kc_u_2 = p[42]
-    ks_u_2 = p[43]
-    kc_u_3 = p[44]
-    ks_u_3 = p[45]
-    E_u_1 = p[46]
-    psi_u_1 = p[47]
-    g1 = p[48]
-    g3 = p[49]
-    g5 = p[50]
-    g7 = p[51]
-    _t0 = 2*du
-    _t1 = 2*dxg
-    _t2 = 2*dxp
-    _t3 = 2*dyg
-    _t4 = 2*dyp
-    _t5 = 2*dzg
-    _t6 = 2*dzp
-    _t7 = omega*tau
-    _t8 = u**2
+    m_u = x[0]
+    m_xp = x[1]
+    m_yp = x[2]
+    m_zp = x[3]
+    m_xg = x[4]
+    m_yg = x[5]
+    m_zg = x[6]
+    m_du = x[7]
+    m_dxp = x[8]
+    m_dyp = x[9]
+    m_dzp = x[10]
+    m_dxg = x[11]
+    m_dyg = x[12]
+    m_dzg = x[13]
+    m_omega = p[0]
+    m_f_u = p[1]
+    m_xi_u_u = p[2]
+    m_xi_u_xp = p[3]
+    m_xi_u_yp = p[4]
+    m_xi_u_zp = p[5]
+    m_xi_u_xg = p[6]
+    m_xi_u_yg = p[7]
+    m_xi_u_zg = p[8]
+    m_xi_xp_u = p[9]
+    m_xi_xp_xp = p[10]
+    m_xi_yp_u = p[11]
+    m_xi_yp_yp = p[12]
+    m_xi_zp_u = p[13]
+    m_xi_zp_zp = p[14]
+    m_xi_xg_u = p[15]
+    m_xi_xg_xg = p[16]
+    m_xi_yg_u = p[17]
+    m_xi_yg_yg = p[18]
+    m_xi_zg_u = p[19]
+    m_xi_zg_zg = p[20]
+    m_kappa_u_u = p[21]
+    m_kappa_u_xp = p[22]
+    m_kappa_u_yp = p[23]
+    m_kappa_u_zp = p[24]
+    m_kappa_u_xg = p[25]
+    m_kappa_u_yg = p[26]
+    m_kappa_u_zg = p[27]
+    m_kappa_xp_u = p[28]
+    m_kappa_xp_xp = p[29]
+    m_kappa_yp_u = p[30]
+    m_kappa_yp_yp = p[31]
+    m_kappa_zp_u = p[32]
+    m_kappa_zp_zp = p[33]
+    m_kappa_xg_u = p[34]
+    m_kappa_xg_xg = p[35]
+    m_kappa_yg_u = p[36]
+    m_kappa_yg_yg = p[37]
+    m_kappa_zg_u = p[38]
+    m_kappa_zg_zg = p[39]
+    m_kc_u_1 = p[40]
+    m_ks_u_1 = p[41]
+    m_kc_u_2 = p[42]
+    m_ks_u_2 = p[43]
+    m_kc_u_3 = p[44]
+    m_ks_u_3 = p[45]
+    m_E_u_1 = p[46]
+    m_psi_u_1 = p[47]
+    m_g1 = p[48]
+    m_g3 = p[49]
+    m_g5 = p[50]
+    m_g7 = p[51]
+    _t0 = 2*m_du
+    _t1 = 2*m_dxg
+    _t2 = 2*m_dxp
+    _t3 = 2*m_dyg
+    _t4 = 2*m_dyp
+    _t5 = 2*m_dzg
+    _t6 = 2*m_dzp
+    _t7 = m_omega*tau
+    _t8 = m_u**2
     _t9 = 2*_t7
     _t10 = 3*_t7
-    _t11 = u*(_t8*(_t8*(_t8*g7 + g5) + g3) + g1)*(kc_u_1*np.cos(_t7) + kc_u_2*np.cos(_t9) + kc_u_3*np.cos(_t10) + ks_u_1*np.sin(_t7) + ks_u_2*np.sin(_t9) + ks_u_3*np.sin(_t10) + 1)
+    _t11 = m_u*(_t8*(_t8*(_t8*m_g7 + m_g5) + m_g3) + m_g1)*(m_kc_u_1*np.cos(_t7) + m_kc_u_2*np.cos(_t9) + m_kc_u_3*np.cos(_t10) + m_ks_u_1*np.sin(_t7) + m_ks_u_2*np.sin(_t9) + m_ks_u_3*np.sin(_t10) + 1)
     return np.array(np.broadcast_arrays(
-        du,
-        dxp,
-        dyp,
-        dzp,
-        dxg,
-        dyg,
-        dzg,
-        -E_u_1*omega**2*np.cos(_t7 + psi_u_1) - _t0*xi_u_u - _t1*xi_u_xg - _t11*kappa_u_u - _t2*xi_u_xp - _t3*xi_u_yg - _t4*xi_u_yp - _t5*xi_u_zg - _t6*xi_u_zp + f_u - kappa_u_xg*xg - kappa_u_xp*xp - kappa_u_yg*yg - kappa_u_yp*yp - kappa_u_zg*zg - kappa_u_zp*zp,
-        -_t0*xi_xp_u - _t11*kappa_xp_u - _t2*xi_xp_xp - kappa_xp_xp*xp,
-        -_t0*xi_yp_u - _t11*kappa_yp_u - _t4*xi_yp_yp - kappa_yp_yp*yp,
-        -_t0*xi_zp_u - _t11*kappa_zp_u - _t6*xi_zp_zp - kappa_zp_zp*zp,
-        -_t0*xi_xg_u - _t1*xi_xg_xg - _t11*kappa_xg_u - kappa_xg_xg*xg,
-        -_t0*xi_yg_u - _t11*kappa_yg_u - _t3*xi_yg_yg - kappa_yg_yg*yg,
-        -_t0*xi_zg_u - _t11*kappa_zg_u - _t5*xi_zg_zg - kappa_zg_zg*zg,
+        m_du,
+        m_dxp,
+        m_dyp,
+        m_dzp,
+        m_dxg,
+        m_dyg,
+        m_dzg,
+        -m_E_u_1*m_omega**2*np.cos(_t7 + m_psi_u_1) - _t0*m_xi_u_u - _t1*m_xi_u_xg - _t11*m_kappa_u_u - _t2*m_xi_u_xp - _t3*m_xi_u_yg - _t4*m_xi_u_yp - _t5*m_xi_u_zg - _t6*m_xi_u_zp + m_f_u - m_kappa_u_xg*m_xg - m_kappa_u_xp*m_xp - m_kappa_u_yg*m_yg - m_kappa_u_yp*m_yp - m_kappa_u_zg*m_zg - m_kappa_u_zp*m_zp,
+        -_t0*m_xi_xp_u - _t11*m_kappa_xp_u - _t2*m_xi_xp_xp - m_kappa_xp_xp*m_xp,
+        -_t0*m_xi_yp_u - _t11*m_kappa_yp_u - _t4*m_xi_yp_yp - m_kappa_yp_yp*m_yp,
+        -_t0*m_xi_zp_u - _t11*m_kappa_zp_u - _t6*m_xi_zp_zp - m_kappa_zp_zp*m_zp,
+        -_t0*m_xi_xg_u - _t1*m_xi_xg_xg - _t11*m_kappa_xg_u - m_kappa_xg_xg*m_xg,
+        -_t0*m_xi_yg_u - _t11*m_kappa_yg_u - _t3*m_xi_yg_yg - m_kappa_yg_yg*m_yg,
+        -_t0*m_xi_zg_u - _t11*m_kappa_zg_u - _t5*m_xi_zg_zg - m_kappa_zg_zg*m_zg,
     ))
 
 
@@ -885,66 +887,66 @@ def _check_stiffness(p):
 
 def jacobian(tau, x, p):
     """d rhs / d X, shape (n, n) or (n, n, N)."""
-    u = x[0]
-    omega = p[0]
-    xi_u_u = p[2]
-    xi_u_xp = p[3]
-    xi_u_yp = p[4]
-    xi_u_zp = p[5]
-    xi_u_xg = p[6]
-    xi_u_yg = p[7]
-    xi_u_zg = p[8]
-    xi_xp_u = p[9]
-    xi_xp_xp = p[10]
-    xi_yp_u = p[11]
-    xi_yp_yp = p[12]
-    xi_zp_u = p[13]
-    xi_zp_zp = p[14]
-    xi_xg_u = p[15]
-    xi_xg_xg = p[16]
-    xi_yg_u = p[17]
-    xi_yg_yg = p[18]
-    xi_zg_u = p[19]
-    xi_zg_zg = p[20]
-    kappa_u_u = p[21]
-    kappa_u_xp = p[22]
-    kappa_u_yp = p[23]
-    kappa_u_zp = p[24]
-    kappa_u_xg = p[25]
-    kappa_u_yg = p[26]
-    kappa_u_zg = p[27]
-    kappa_xp_u = p[28]
-    kappa_xp_xp = p[29]
-    kappa_yp_u = p[30]
-    kappa_yp_yp = p[31]
-    kappa_zp_u = p[32]
-    kappa_zp_zp = p[33]
-    kappa_xg_u = p[34]
-    kappa_xg_xg = p[35]
-    kappa_yg_u = p[36]
-    kappa_yg_yg = p[37]
-    kappa_zg_u = p[38]
-    kappa_zg_zg = p[39]
-    kc_u_1 = p[40]
-    ks_u_1 = p[41]
-    kc_u_2 = p[42]
-    ks_u_2 = p[43]
-    kc_u_3 = p[44]
-    ks_u_3 = p[45]
-    g1 = p[48]
-    g3 = p[49]
-    g5 = p[50]
-    g7 = p[51]
-    _t0 = u**2
-    _t1 = _t0*g7 + g5
-    _t2 = _t0*_t1 + g3
-    _t3 = omega*tau
+    m_u = x[0]
+    m_omega = p[0]
+    m_xi_u_u = p[2]
+    m_xi_u_xp = p[3]
+    m_xi_u_yp = p[4]
+    m_xi_u_zp = p[5]
+    m_xi_u_xg = p[6]
+    m_xi_u_yg = p[7]
+    m_xi_u_zg = p[8]
+    m_xi_xp_u = p[9]
+    m_xi_xp_xp = p[10]
+    m_xi_yp_u = p[11]
+    m_xi_yp_yp = p[12]
+    m_xi_zp_u = p[13]
+    m_xi_zp_zp = p[14]
+    m_xi_xg_u = p[15]
+    m_xi_xg_xg = p[16]
+    m_xi_yg_u = p[17]
+    m_xi_yg_yg = p[18]
+    m_xi_zg_u = p[19]
+    m_xi_zg_zg = p[20]
+    m_kappa_u_u = p[21]
+    m_kappa_u_xp = p[22]
+    m_kappa_u_yp = p[23]
+    m_kappa_u_zp = p[24]
+    m_kappa_u_xg = p[25]
+    m_kappa_u_yg = p[26]
+    m_kappa_u_zg = p[27]
+    m_kappa_xp_u = p[28]
+    m_kappa_xp_xp = p[29]
+    m_kappa_yp_u = p[30]
+    m_kappa_yp_yp = p[31]
+    m_kappa_zp_u = p[32]
+    m_kappa_zp_zp = p[33]
+    m_kappa_xg_u = p[34]
+    m_kappa_xg_xg = p[35]
+    m_kappa_yg_u = p[36]
+    m_kappa_yg_yg = p[37]
+    m_kappa_zg_u = p[38]
+    m_kappa_zg_zg = p[39]
+    m_kc_u_1 = p[40]
+    m_ks_u_1 = p[41]
+    m_kc_u_2 = p[42]
+    m_ks_u_2 = p[43]
+    m_kc_u_3 = p[44]
+    m_ks_u_3 = p[45]
+    m_g1 = p[48]
+    m_g3 = p[49]
+    m_g5 = p[50]
+    m_g7 = p[51]
+    _t0 = m_u**2
+    _t1 = _t0*m_g7 + m_g5
+    _t2 = _t0*_t1 + m_g3
+    _t3 = m_omega*tau
     _t4 = 2*_t3
     _t5 = 3*_t3
-    _t6 = kc_u_1*np.cos(_t3) + kc_u_2*np.cos(_t4) + kc_u_3*np.cos(_t5) + ks_u_1*np.sin(_t3) + ks_u_2*np.sin(_t4) + ks_u_3*np.sin(_t5) + 1
-    _t7 = _t6*(_t0*_t2 + g1)
-    _t8 = 2*u
-    _t9 = _t6*u*(_t0*(_t1*_t8 + 2*g7*u**3) + _t2*_t8)
+    _t6 = m_kc_u_1*np.cos(_t3) + m_kc_u_2*np.cos(_t4) + m_kc_u_3*np.cos(_t5) + m_ks_u_1*np.sin(_t3) + m_ks_u_2*np.sin(_t4) + m_ks_u_3*np.sin(_t5) + 1
+    _t7 = _t6*(_t0*_t2 + m_g1)
+    _t8 = 2*m_u
+    _t9 = _t6*m_u*(_t0*(_t1*_t8 + 2*m_g7*m_u**3) + _t2*_t8)
     return np.array(_broadcast(
         (0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0,),
         (0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0,),
@@ -953,66 +955,66 @@ def jacobian(tau, x, p):
         (0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0,),
         (0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0,),
         (0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1,),
-        (-_t7*kappa_u_u - _t9*kappa_u_u, -kappa_u_xp, -kappa_u_yp, -kappa_u_zp, -kappa_u_xg, -kappa_u_yg, -kappa_u_zg, -2*xi_u_u, -2*xi_u_xp, -2*xi_u_yp, -2*xi_u_zp, -2*xi_u_xg, -2*xi_u_yg, -2*xi_u_zg,),
-        (-_t7*kappa_xp_u - _t9*kappa_xp_u, -kappa_xp_xp, 0, 0, 0, 0, 0, -2*xi_xp_u, -2*xi_xp_xp, 0, 0, 0, 0, 0,),
-        (-_t7*kappa_yp_u - _t9*kappa_yp_u, 0, -kappa_yp_yp, 0, 0, 0, 0, -2*xi_yp_u, 0, -2*xi_yp_yp, 0, 0, 0, 0,),
-        (-_t7*kappa_zp_u - _t9*kappa_zp_u, 0, 0, -kappa_zp_zp, 0, 0, 0, -2*xi_zp_u, 0, 0, -2*xi_zp_zp, 0, 0, 0,),
-        (-_t7*kappa_xg_u - _t9*kappa_xg_u, 0, 0, 0, -kappa_xg_xg, 0, 0, -2*xi_xg_u, 0, 0, 0, -2*xi_xg_xg, 0, 0,),
-        (-_t7*kappa_yg_u - _t9*kappa_yg_u, 0, 0, 0, 0, -kappa_yg_yg, 0, -2*xi_yg_u, 0, 0, 0, 0, -2*xi_yg_yg, 0,),
-        (-_t7*kappa_zg_u - _t9*kappa_zg_u, 0, 0, 0, 0, 0, -kappa_zg_zg, -2*xi_zg_u, 0, 0, 0, 0, 0, -2*xi_zg_zg,),
+        (-_t7*m_kappa_u_u - _t9*m_kappa_u_u, -m_kappa_u_xp, -m_kappa_u_yp, -m_kappa_u_zp, -m_kappa_u_xg, -m_kappa_u_yg, -m_kappa_u_zg, -2*m_xi_u_u, -2*m_xi_u_xp, -2*m_xi_u_yp, -2*m_xi_u_zp, -2*m_xi_u_xg, -2*m_xi_u_yg, -2*m_xi_u_zg,),
+        (-_t7*m_kappa_xp_u - _t9*m_kappa_xp_u, -m_kappa_xp_xp, 0, 0, 0, 0, 0, -2*m_xi_xp_u, -2*m_xi_xp_xp, 0, 0, 0, 0, 0,),
+        (-_t7*m_kappa_yp_u - _t9*m_kappa_yp_u, 0, -m_kappa_yp_yp, 0, 0, 0, 0, -2*m_xi_yp_u, 0, -2*m_xi_yp_yp, 0, 0, 0, 0,),
+        (-_t7*m_kappa_zp_u - _t9*m_kappa_zp_u, 0, 0, -m_kappa_zp_zp, 0, 0, 0, -2*m_xi_zp_u, 0, 0, -2*m_xi_zp_zp, 0, 0, 0,),
+        (-_t7*m_kappa_xg_u - _t9*m_kappa_xg_u, 0, 0, 0, -m_kappa_xg_xg, 0, 0, -2*m_xi_xg_u, 0, 0, 0, -2*m_xi_xg_xg, 0, 0,),
+        (-_t7*m_kappa_yg_u - _t9*m_kappa_yg_u, 0, 0, 0, 0, -m_kappa_yg_yg, 0, -2*m_xi_yg_u, 0, 0, 0, 0, -2*m_xi_yg_yg, 0,),
+        (-_t7*m_kappa_zg_u - _t9*m_kappa_zg_u, 0, 0, 0, 0, 0, -m_kappa_zg_zg, -2*m_xi_zg_u, 0, 0, 0, 0, 0, -2*m_xi_zg_zg,),
     ))
 
 
 def mesh_force(tau, x, p):
     """Dynamic force of each mesh over its k_m b: elastic k_hat(tau) g(u) plus viscous c u' (one damper per mesh); (m,) or (m, N)."""
-    u = x[0]
-    du = x[7]
-    omega = p[0]
-    xi_u_u = p[2]
-    kappa_u_u = p[21]
-    kc_u_1 = p[40]
-    ks_u_1 = p[41]
-    kc_u_2 = p[42]
-    ks_u_2 = p[43]
-    kc_u_3 = p[44]
-    ks_u_3 = p[45]
-    g1 = p[48]
-    g3 = p[49]
-    g5 = p[50]
-    g7 = p[51]
-    _t0 = u**2
-    _t1 = omega*tau
+    m_u = x[0]
+    m_du = x[7]
+    m_omega = p[0]
+    m_xi_u_u = p[2]
+    m_kappa_u_u = p[21]
+    m_kc_u_1 = p[40]
+    m_ks_u_1 = p[41]
+    m_kc_u_2 = p[42]
+    m_ks_u_2 = p[43]
+    m_kc_u_3 = p[44]
+    m_ks_u_3 = p[45]
+    m_g1 = p[48]
+    m_g3 = p[49]
+    m_g5 = p[50]
+    m_g7 = p[51]
+    _t0 = m_u**2
+    _t1 = m_omega*tau
     _t2 = 2*_t1
     _t3 = 3*_t1
     return np.array(np.broadcast_arrays(
-        2*du*xi_u_u/kappa_u_u + u*(_t0*(_t0*(_t0*g7 + g5) + g3) + g1)*(kc_u_1*np.cos(_t1) + kc_u_2*np.cos(_t2) + kc_u_3*np.cos(_t3) + ks_u_1*np.sin(_t1) + ks_u_2*np.sin(_t2) + ks_u_3*np.sin(_t3) + 1),
+        2*m_du*m_xi_u_u/m_kappa_u_u + m_u*(_t0*(_t0*(_t0*m_g7 + m_g5) + m_g3) + m_g1)*(m_kc_u_1*np.cos(_t1) + m_kc_u_2*np.cos(_t2) + m_kc_u_3*np.cos(_t3) + m_ks_u_1*np.sin(_t1) + m_ks_u_2*np.sin(_t2) + m_ks_u_3*np.sin(_t3) + 1),
     ), dtype=float)
 
 
 def static_mesh_force(p):
     """Static force of each mesh over its k_m b: kappa F = f at the mean stiffness."""
-    f_u = p[1]
-    kappa_u_u = p[21]
-    kappa_u_xp = p[22]
-    kappa_u_yp = p[23]
-    kappa_u_zp = p[24]
-    kappa_u_xg = p[25]
-    kappa_u_yg = p[26]
-    kappa_u_zg = p[27]
-    kappa_xp_u = p[28]
-    kappa_xp_xp = p[29]
-    kappa_yp_u = p[30]
-    kappa_yp_yp = p[31]
-    kappa_zp_u = p[32]
-    kappa_zp_zp = p[33]
-    kappa_xg_u = p[34]
-    kappa_xg_xg = p[35]
-    kappa_yg_u = p[36]
-    kappa_yg_yg = p[37]
-    kappa_zg_u = p[38]
-    kappa_zg_zg = p[39]
-    K = np.array([[kappa_u_u, kappa_u_xp, kappa_u_yp, kappa_u_zp, kappa_u_xg, kappa_u_yg, kappa_u_zg], [kappa_xp_u, kappa_xp_xp, 0, 0, 0, 0, 0], [kappa_yp_u, 0, kappa_yp_yp, 0, 0, 0, 0], [kappa_zp_u, 0, 0, kappa_zp_zp, 0, 0, 0], [kappa_xg_u, 0, 0, 0, kappa_xg_xg, 0, 0], [kappa_yg_u, 0, 0, 0, 0, kappa_yg_yg, 0], [kappa_zg_u, 0, 0, 0, 0, 0, kappa_zg_zg]], dtype=float)
-    f = np.array([f_u, 0, 0, 0, 0, 0, 0], dtype=float)
+    m_f_u = p[1]
+    m_kappa_u_u = p[21]
+    m_kappa_u_xp = p[22]
+    m_kappa_u_yp = p[23]
+    m_kappa_u_zp = p[24]
+    m_kappa_u_xg = p[25]
+    m_kappa_u_yg = p[26]
+    m_kappa_u_zg = p[27]
+    m_kappa_xp_u = p[28]
+    m_kappa_xp_xp = p[29]
+    m_kappa_yp_u = p[30]
+    m_kappa_yp_yp = p[31]
+    m_kappa_zp_u = p[32]
+    m_kappa_zp_zp = p[33]
+    m_kappa_xg_u = p[34]
+    m_kappa_xg_xg = p[35]
+    m_kappa_yg_u = p[36]
+    m_kappa_yg_yg = p[37]
+    m_kappa_zg_u = p[38]
+    m_kappa_zg_zg = p[39]
+    K = np.array([[m_kappa_u_u, m_kappa_u_xp, m_kappa_u_yp, m_kappa_u_zp, m_kappa_u_xg, m_kappa_u_yg, m_kappa_u_zg], [m_kappa_xp_u, m_kappa_xp_xp, 0, 0, 0, 0, 0], [m_kappa_yp_u, 0, m_kappa_yp_yp, 0, 0, 0, 0], [m_kappa_zp_u, 0, 0, m_kappa_zp_zp, 0, 0, 0], [m_kappa_xg_u, 0, 0, 0, m_kappa_xg_xg, 0, 0], [m_kappa_yg_u, 0, 0, 0, 0, m_kappa_yg_yg, 0], [m_kappa_zg_u, 0, 0, 0, 0, 0, m_kappa_zg_zg]], dtype=float)
+    f = np.array([m_f_u, 0, 0, 0, 0, 0, 0], dtype=float)
     return np.linalg.solve(K, f)[:1]
 
 
@@ -1029,99 +1031,99 @@ def casadi_functions():
     tau = ca.SX.sym('tau')
     x = ca.SX.sym('x', 14)
     p = ca.SX.sym('p', 52)
-    u = x[0]
-    xp = x[1]
-    yp = x[2]
-    zp = x[3]
-    xg = x[4]
-    yg = x[5]
-    zg = x[6]
-    du = x[7]
-    dxp = x[8]
-    dyp = x[9]
-    dzp = x[10]
-    dxg = x[11]
-    dyg = x[12]
-    dzg = x[13]
-    omega = p[0]
-    f_u = p[1]
-    xi_u_u = p[2]
-    xi_u_xp = p[3]
-    xi_u_yp = p[4]
-    xi_u_zp = p[5]
-    xi_u_xg = p[6]
-    xi_u_yg = p[7]
-    xi_u_zg = p[8]
-    xi_xp_u = p[9]
-    xi_xp_xp = p[10]
-    xi_yp_u = p[11]
-    xi_yp_yp = p[12]
-    xi_zp_u = p[13]
-    xi_zp_zp = p[14]
-    xi_xg_u = p[15]
-    xi_xg_xg = p[16]
-    xi_yg_u = p[17]
-    xi_yg_yg = p[18]
-    xi_zg_u = p[19]
-    xi_zg_zg = p[20]
-    kappa_u_u = p[21]
-    kappa_u_xp = p[22]
-    kappa_u_yp = p[23]
-    kappa_u_zp = p[24]
-    kappa_u_xg = p[25]
-    kappa_u_yg = p[26]
-    kappa_u_zg = p[27]
-    kappa_xp_u = p[28]
-    kappa_xp_xp = p[29]
-    kappa_yp_u = p[30]
-    kappa_yp_yp = p[31]
-    kappa_zp_u = p[32]
-    kappa_zp_zp = p[33]
-    kappa_xg_u = p[34]
-    kappa_xg_xg = p[35]
-    kappa_yg_u = p[36]
-    kappa_yg_yg = p[37]
-    kappa_zg_u = p[38]
-    kappa_zg_zg = p[39]
-    kc_u_1 = p[40]
-    ks_u_1 = p[41]
-    kc_u_2 = p[42]
-    ks_u_2 = p[43]
-    kc_u_3 = p[44]
-    ks_u_3 = p[45]
-    E_u_1 = p[46]
-    psi_u_1 = p[47]
-    g1 = p[48]
-    g3 = p[49]
-    g5 = p[50]
-    g7 = p[51]
-    _t0 = 2*du
-    _t1 = 2*dxg
-    _t2 = 2*dxp
-    _t3 = 2*dyg
-    _t4 = 2*dyp
-    _t5 = 2*dzg
-    _t6 = 2*dzp
-    _t7 = omega*tau
-    _t8 = u**2
+    m_u = x[0]
+    m_xp = x[1]
+    m_yp = x[2]
+    m_zp = x[3]
+    m_xg = x[4]
+    m_yg = x[5]
+    m_zg = x[6]
+    m_du = x[7]
+    m_dxp = x[8]
+    m_dyp = x[9]
+    m_dzp = x[10]
+    m_dxg = x[11]
+    m_dyg = x[12]
+    m_dzg = x[13]
+    m_omega = p[0]
+    m_f_u = p[1]
+    m_xi_u_u = p[2]
+    m_xi_u_xp = p[3]
+    m_xi_u_yp = p[4]
+    m_xi_u_zp = p[5]
+    m_xi_u_xg = p[6]
+    m_xi_u_yg = p[7]
+    m_xi_u_zg = p[8]
+    m_xi_xp_u = p[9]
+    m_xi_xp_xp = p[10]
+    m_xi_yp_u = p[11]
+    m_xi_yp_yp = p[12]
+    m_xi_zp_u = p[13]
+    m_xi_zp_zp = p[14]
+    m_xi_xg_u = p[15]
+    m_xi_xg_xg = p[16]
+    m_xi_yg_u = p[17]
+    m_xi_yg_yg = p[18]
+    m_xi_zg_u = p[19]
+    m_xi_zg_zg = p[20]
+    m_kappa_u_u = p[21]
+    m_kappa_u_xp = p[22]
+    m_kappa_u_yp = p[23]
+    m_kappa_u_zp = p[24]
+    m_kappa_u_xg = p[25]
+    m_kappa_u_yg = p[26]
+    m_kappa_u_zg = p[27]
+    m_kappa_xp_u = p[28]
+    m_kappa_xp_xp = p[29]
+    m_kappa_yp_u = p[30]
+    m_kappa_yp_yp = p[31]
+    m_kappa_zp_u = p[32]
+    m_kappa_zp_zp = p[33]
+    m_kappa_xg_u = p[34]
+    m_kappa_xg_xg = p[35]
+    m_kappa_yg_u = p[36]
+    m_kappa_yg_yg = p[37]
+    m_kappa_zg_u = p[38]
+    m_kappa_zg_zg = p[39]
+    m_kc_u_1 = p[40]
+    m_ks_u_1 = p[41]
+    m_kc_u_2 = p[42]
+    m_ks_u_2 = p[43]
+    m_kc_u_3 = p[44]
+    m_ks_u_3 = p[45]
+    m_E_u_1 = p[46]
+    m_psi_u_1 = p[47]
+    m_g1 = p[48]
+    m_g3 = p[49]
+    m_g5 = p[50]
+    m_g7 = p[51]
+    _t0 = 2*m_du
+    _t1 = 2*m_dxg
+    _t2 = 2*m_dxp
+    _t3 = 2*m_dyg
+    _t4 = 2*m_dyp
+    _t5 = 2*m_dzg
+    _t6 = 2*m_dzp
+    _t7 = m_omega*tau
+    _t8 = m_u**2
     _t9 = 2*_t7
     _t10 = 3*_t7
-    _t11 = u*(_t8*(_t8*(_t8*g7 + g5) + g3) + g1)*(kc_u_1*ca.cos(_t7) + kc_u_2*ca.cos(_t9) + kc_u_3*ca.cos(_t10) + ks_u_1*ca.sin(_t7) + ks_u_2*ca.sin(_t9) + ks_u_3*ca.sin(_t10) + 1)
+    _t11 = m_u*(_t8*(_t8*(_t8*m_g7 + m_g5) + m_g3) + m_g1)*(m_kc_u_1*ca.cos(_t7) + m_kc_u_2*ca.cos(_t9) + m_kc_u_3*ca.cos(_t10) + m_ks_u_1*ca.sin(_t7) + m_ks_u_2*ca.sin(_t9) + m_ks_u_3*ca.sin(_t10) + 1)
     xdot = ca.vertcat(
-        du,
-        dxp,
-        dyp,
-        dzp,
-        dxg,
-        dyg,
-        dzg,
-        -E_u_1*omega**2*ca.cos(_t7 + psi_u_1) - _t0*xi_u_u - _t1*xi_u_xg - _t11*kappa_u_u - _t2*xi_u_xp - _t3*xi_u_yg - _t4*xi_u_yp - _t5*xi_u_zg - _t6*xi_u_zp + f_u - kappa_u_xg*xg - kappa_u_xp*xp - kappa_u_yg*yg - kappa_u_yp*yp - kappa_u_zg*zg - kappa_u_zp*zp,
-        -_t0*xi_xp_u - _t11*kappa_xp_u - _t2*xi_xp_xp - kappa_xp_xp*xp,
-        -_t0*xi_yp_u - _t11*kappa_yp_u - _t4*xi_yp_yp - kappa_yp_yp*yp,
-        -_t0*xi_zp_u - _t11*kappa_zp_u - _t6*xi_zp_zp - kappa_zp_zp*zp,
-        -_t0*xi_xg_u - _t1*xi_xg_xg - _t11*kappa_xg_u - kappa_xg_xg*xg,
-        -_t0*xi_yg_u - _t11*kappa_yg_u - _t3*xi_yg_yg - kappa_yg_yg*yg,
-        -_t0*xi_zg_u - _t11*kappa_zg_u - _t5*xi_zg_zg - kappa_zg_zg*zg,
+        m_du,
+        m_dxp,
+        m_dyp,
+        m_dzp,
+        m_dxg,
+        m_dyg,
+        m_dzg,
+        -m_E_u_1*m_omega**2*ca.cos(_t7 + m_psi_u_1) - _t0*m_xi_u_u - _t1*m_xi_u_xg - _t11*m_kappa_u_u - _t2*m_xi_u_xp - _t3*m_xi_u_yg - _t4*m_xi_u_yp - _t5*m_xi_u_zg - _t6*m_xi_u_zp + m_f_u - m_kappa_u_xg*m_xg - m_kappa_u_xp*m_xp - m_kappa_u_yg*m_yg - m_kappa_u_yp*m_yp - m_kappa_u_zg*m_zg - m_kappa_u_zp*m_zp,
+        -_t0*m_xi_xp_u - _t11*m_kappa_xp_u - _t2*m_xi_xp_xp - m_kappa_xp_xp*m_xp,
+        -_t0*m_xi_yp_u - _t11*m_kappa_yp_u - _t4*m_xi_yp_yp - m_kappa_yp_yp*m_yp,
+        -_t0*m_xi_zp_u - _t11*m_kappa_zp_u - _t6*m_xi_zp_zp - m_kappa_zp_zp*m_zp,
+        -_t0*m_xi_xg_u - _t1*m_xi_xg_xg - _t11*m_kappa_xg_u - m_kappa_xg_xg*m_xg,
+        -_t0*m_xi_yg_u - _t11*m_kappa_yg_u - _t3*m_xi_yg_yg - m_kappa_yg_yg*m_yg,
+        -_t0*m_xi_zg_u - _t11*m_kappa_zg_u - _t5*m_xi_zg_zg - m_kappa_zg_zg*m_zg,
     )
     f = ca.Function('rhs', [tau, x, p], [xdot], ['tau', 'x', 'p'], ['xdot'])
     j = ca.Function('jacobian', [tau, x, p], [ca.jacobian(xdot, x)],

@@ -53,6 +53,8 @@ Time: tau = omega_n t, omega_n = 11068.62872 rad/s.
 
 CONTRACT states as data what a solver needs: velocity indices, forcing frequency,
 loads, contact edges, piecewise or smooth, switching surfaces, valid range.
+
+Model symbols are namespaced in the code: state or parameter NAME is m_NAME.
 """
 
 import numpy as np
@@ -149,74 +151,74 @@ C_SOURCE = r"""
 
 static void gs_prep(const double *p, double *q)
 {
-    const double phi_v = p[23];
-    const double psi_u_1 = p[25];
-    const double psi_v_1 = p[27];
-    q[0] = cos(phi_v);
-    q[1] = -sin(phi_v);
-    q[2] = cos(2*phi_v);
-    q[3] = -sin(2*phi_v);
-    q[4] = cos(3*phi_v);
-    q[5] = -sin(3*phi_v);
-    q[6] = cos(psi_u_1);
-    q[7] = sin(psi_u_1);
-    q[8] = cos(phi_v - psi_v_1);
-    q[9] = -sin(phi_v - psi_v_1);
+    const double m_phi_v = p[23];
+    const double m_psi_u_1 = p[25];
+    const double m_psi_v_1 = p[27];
+    q[0] = cos(m_phi_v);
+    q[1] = -sin(m_phi_v);
+    q[2] = cos(2*m_phi_v);
+    q[3] = -sin(2*m_phi_v);
+    q[4] = cos(3*m_phi_v);
+    q[5] = -sin(3*m_phi_v);
+    q[6] = cos(m_psi_u_1);
+    q[7] = sin(m_psi_u_1);
+    q[8] = cos(m_phi_v - m_psi_v_1);
+    q[9] = -sin(m_phi_v - m_psi_v_1);
     (void)p; (void)q;
 }
 
 static inline void gs_rhs(double tau, const double *x, const double *p, const double *q, double *dx)
 {
-    const double u = x[0];
-    const double v = x[1];
-    const double du = x[2];
-    const double dv = x[3];
-    const double omega = p[0];
-    const double f_u = p[1];
-    const double f_v = p[2];
-    const double xi_u_u = p[3];
-    const double xi_u_v = p[4];
-    const double xi_v_u = p[5];
-    const double xi_v_v = p[6];
-    const double kappa_u_u = p[7];
-    const double kappa_u_v = p[8];
-    const double kappa_v_u = p[9];
-    const double kappa_v_v = p[10];
-    const double kc_u_1 = p[11];
-    const double ks_u_1 = p[12];
-    const double kc_u_2 = p[13];
-    const double ks_u_2 = p[14];
-    const double kc_u_3 = p[15];
-    const double ks_u_3 = p[16];
-    const double kc_v_1 = p[17];
-    const double ks_v_1 = p[18];
-    const double kc_v_2 = p[19];
-    const double ks_v_2 = p[20];
-    const double kc_v_3 = p[21];
-    const double ks_v_3 = p[22];
-    const double E_u_1 = p[24];
-    const double E_v_1 = p[26];
-    const double g1 = p[28];
-    const double g3 = p[29];
-    const double g5 = p[30];
-    const double g7 = p[31];
-    const double th0 = (omega)*tau;
+    const double m_u = x[0];
+    const double m_v = x[1];
+    const double m_du = x[2];
+    const double m_dv = x[3];
+    const double m_omega = p[0];
+    const double m_f_u = p[1];
+    const double m_f_v = p[2];
+    const double m_xi_u_u = p[3];
+    const double m_xi_u_v = p[4];
+    const double m_xi_v_u = p[5];
+    const double m_xi_v_v = p[6];
+    const double m_kappa_u_u = p[7];
+    const double m_kappa_u_v = p[8];
+    const double m_kappa_v_u = p[9];
+    const double m_kappa_v_v = p[10];
+    const double m_kc_u_1 = p[11];
+    const double m_ks_u_1 = p[12];
+    const double m_kc_u_2 = p[13];
+    const double m_ks_u_2 = p[14];
+    const double m_kc_u_3 = p[15];
+    const double m_ks_u_3 = p[16];
+    const double m_kc_v_1 = p[17];
+    const double m_ks_v_1 = p[18];
+    const double m_kc_v_2 = p[19];
+    const double m_ks_v_2 = p[20];
+    const double m_kc_v_3 = p[21];
+    const double m_ks_v_3 = p[22];
+    const double m_E_u_1 = p[24];
+    const double m_E_v_1 = p[26];
+    const double m_g1 = p[28];
+    const double m_g3 = p[29];
+    const double m_g5 = p[30];
+    const double m_g7 = p[31];
+    const double th0 = (m_omega)*tau;
     const double C0_1 = cos(th0), S0_1 = sin(th0);
     const double C0_2 = C0_1*C0_1 - S0_1*S0_1;
     const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
     const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
     const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
-    const double t_0 = 2*du;
-    const double t_1 = 2*dv;
-    const double t_2 = ((omega)*(omega));
-    const double t_3 = ((u)*(u));
-    const double t_4 = u*(g1 + t_3*(g3 + t_3*(g5 + g7*t_3)))*(C0_1*kc_u_1 + C0_2*kc_u_2 + C0_3*kc_u_3 + S0_1*ks_u_1 + S0_2*ks_u_2 + S0_3*ks_u_3 + 1);
-    const double t_5 = ((v)*(v));
-    const double t_6 = v*(g1 + t_5*(g3 + t_5*(g5 + g7*t_5)))*(kc_v_1*(C0_1*q[0] - S0_1*q[1]) + kc_v_2*(C0_2*q[2] - S0_2*q[3]) + kc_v_3*(C0_3*q[4] - S0_3*q[5]) + ks_v_1*(C0_1*q[1] + S0_1*q[0]) + ks_v_2*(C0_2*q[3] + S0_2*q[2]) + ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1);
-    dx[0] = du;
-    dx[1] = dv;
-    dx[2] = -E_u_1*t_2*(C0_1*q[6] - S0_1*q[7]) + f_u - kappa_u_u*t_4 - kappa_u_v*t_6 - t_0*xi_u_u - t_1*xi_u_v;
-    dx[3] = -E_v_1*t_2*(C0_1*q[8] - S0_1*q[9]) + f_v - kappa_v_u*t_4 - kappa_v_v*t_6 - t_0*xi_v_u - t_1*xi_v_v;
+    const double t_0 = 2*m_du;
+    const double t_1 = 2*m_dv;
+    const double t_2 = ((m_omega)*(m_omega));
+    const double t_3 = ((m_u)*(m_u));
+    const double t_4 = m_u*(m_g1 + t_3*(m_g3 + t_3*(m_g5 + m_g7*t_3)))*(C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1);
+    const double t_5 = ((m_v)*(m_v));
+    const double t_6 = m_v*(m_g1 + t_5*(m_g3 + t_5*(m_g5 + m_g7*t_5)))*(m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[2] - S0_2*q[3]) + m_kc_v_3*(C0_3*q[4] - S0_3*q[5]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[3] + S0_2*q[2]) + m_ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1);
+    dx[0] = m_du;
+    dx[1] = m_dv;
+    dx[2] = -m_E_u_1*t_2*(C0_1*q[6] - S0_1*q[7]) + m_f_u - m_kappa_u_u*t_4 - m_kappa_u_v*t_6 - t_0*m_xi_u_u - t_1*m_xi_u_v;
+    dx[3] = -m_E_v_1*t_2*(C0_1*q[8] - S0_1*q[9]) + m_f_v - m_kappa_v_u*t_4 - m_kappa_v_v*t_6 - t_0*m_xi_v_u - t_1*m_xi_v_v;
     (void)tau; (void)p; (void)q;
 }
 
@@ -232,50 +234,50 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
         for (int k = 0; k < GS_NQ; ++k) q[k] = Q[k*n + j];
-        const double u = X[0*n + j];
-        const double v = X[1*n + j];
-        const double du = X[2*n + j];
-        const double dv = X[3*n + j];
-        const double omega = P[0*n + j];
-        const double f_u = P[1*n + j];
-        const double f_v = P[2*n + j];
-        const double xi_u_u = P[3*n + j];
-        const double xi_u_v = P[4*n + j];
-        const double xi_v_u = P[5*n + j];
-        const double xi_v_v = P[6*n + j];
-        const double kappa_u_u = P[7*n + j];
-        const double kappa_u_v = P[8*n + j];
-        const double kappa_v_u = P[9*n + j];
-        const double kappa_v_v = P[10*n + j];
-        const double kc_u_1 = P[11*n + j];
-        const double ks_u_1 = P[12*n + j];
-        const double kc_u_2 = P[13*n + j];
-        const double ks_u_2 = P[14*n + j];
-        const double kc_u_3 = P[15*n + j];
-        const double ks_u_3 = P[16*n + j];
-        const double kc_v_1 = P[17*n + j];
-        const double ks_v_1 = P[18*n + j];
-        const double kc_v_2 = P[19*n + j];
-        const double ks_v_2 = P[20*n + j];
-        const double kc_v_3 = P[21*n + j];
-        const double ks_v_3 = P[22*n + j];
-        const double E_u_1 = P[24*n + j];
-        const double E_v_1 = P[26*n + j];
-        const double g1 = P[28*n + j];
-        const double g3 = P[29*n + j];
-        const double g5 = P[30*n + j];
-        const double g7 = P[31*n + j];
-        const double t_0 = 2*du;
-        const double t_1 = 2*dv;
-        const double t_2 = ((omega)*(omega));
-        const double t_3 = ((u)*(u));
-        const double t_4 = u*(g1 + t_3*(g3 + t_3*(g5 + g7*t_3)))*(C0_1*kc_u_1 + C0_2*kc_u_2 + C0_3*kc_u_3 + S0_1*ks_u_1 + S0_2*ks_u_2 + S0_3*ks_u_3 + 1);
-        const double t_5 = ((v)*(v));
-        const double t_6 = v*(g1 + t_5*(g3 + t_5*(g5 + g7*t_5)))*(kc_v_1*(C0_1*q[0] - S0_1*q[1]) + kc_v_2*(C0_2*q[2] - S0_2*q[3]) + kc_v_3*(C0_3*q[4] - S0_3*q[5]) + ks_v_1*(C0_1*q[1] + S0_1*q[0]) + ks_v_2*(C0_2*q[3] + S0_2*q[2]) + ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1);
-        DX[0*n + j] = du;
-        DX[1*n + j] = dv;
-        DX[2*n + j] = -E_u_1*t_2*(C0_1*q[6] - S0_1*q[7]) + f_u - kappa_u_u*t_4 - kappa_u_v*t_6 - t_0*xi_u_u - t_1*xi_u_v;
-        DX[3*n + j] = -E_v_1*t_2*(C0_1*q[8] - S0_1*q[9]) + f_v - kappa_v_u*t_4 - kappa_v_v*t_6 - t_0*xi_v_u - t_1*xi_v_v;
+        const double m_u = X[0*n + j];
+        const double m_v = X[1*n + j];
+        const double m_du = X[2*n + j];
+        const double m_dv = X[3*n + j];
+        const double m_omega = P[0*n + j];
+        const double m_f_u = P[1*n + j];
+        const double m_f_v = P[2*n + j];
+        const double m_xi_u_u = P[3*n + j];
+        const double m_xi_u_v = P[4*n + j];
+        const double m_xi_v_u = P[5*n + j];
+        const double m_xi_v_v = P[6*n + j];
+        const double m_kappa_u_u = P[7*n + j];
+        const double m_kappa_u_v = P[8*n + j];
+        const double m_kappa_v_u = P[9*n + j];
+        const double m_kappa_v_v = P[10*n + j];
+        const double m_kc_u_1 = P[11*n + j];
+        const double m_ks_u_1 = P[12*n + j];
+        const double m_kc_u_2 = P[13*n + j];
+        const double m_ks_u_2 = P[14*n + j];
+        const double m_kc_u_3 = P[15*n + j];
+        const double m_ks_u_3 = P[16*n + j];
+        const double m_kc_v_1 = P[17*n + j];
+        const double m_ks_v_1 = P[18*n + j];
+        const double m_kc_v_2 = P[19*n + j];
+        const double m_ks_v_2 = P[20*n + j];
+        const double m_kc_v_3 = P[21*n + j];
+        const double m_ks_v_3 = P[22*n + j];
+        const double m_E_u_1 = P[24*n + j];
+        const double m_E_v_1 = P[26*n + j];
+        const double m_g1 = P[28*n + j];
+        const double m_g3 = P[29*n + j];
+        const double m_g5 = P[30*n + j];
+        const double m_g7 = P[31*n + j];
+        const double t_0 = 2*m_du;
+        const double t_1 = 2*m_dv;
+        const double t_2 = ((m_omega)*(m_omega));
+        const double t_3 = ((m_u)*(m_u));
+        const double t_4 = m_u*(m_g1 + t_3*(m_g3 + t_3*(m_g5 + m_g7*t_3)))*(C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1);
+        const double t_5 = ((m_v)*(m_v));
+        const double t_6 = m_v*(m_g1 + t_5*(m_g3 + t_5*(m_g5 + m_g7*t_5)))*(m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[2] - S0_2*q[3]) + m_kc_v_3*(C0_3*q[4] - S0_3*q[5]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[3] + S0_2*q[2]) + m_ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1);
+        DX[0*n + j] = m_du;
+        DX[1*n + j] = m_dv;
+        DX[2*n + j] = -m_E_u_1*t_2*(C0_1*q[6] - S0_1*q[7]) + m_f_u - m_kappa_u_u*t_4 - m_kappa_u_v*t_6 - t_0*m_xi_u_u - t_1*m_xi_u_v;
+        DX[3*n + j] = -m_E_v_1*t_2*(C0_1*q[8] - S0_1*q[9]) + m_f_v - m_kappa_v_u*t_4 - m_kappa_v_v*t_6 - t_0*m_xi_v_u - t_1*m_xi_v_v;
     }
     (void)tau; (void)P; (void)Q;
 }
@@ -290,99 +292,99 @@ C_SOURCE_VARIATIONAL = r"""
 
 static void gs_prep(const double *p, double *q)
 {
-    const double phi_v = p[23];
-    const double psi_u_1 = p[25];
-    const double psi_v_1 = p[27];
-    q[0] = cos(phi_v);
-    q[1] = -sin(phi_v);
-    q[2] = cos(2*phi_v);
-    q[3] = -sin(2*phi_v);
-    q[4] = cos(3*phi_v);
-    q[5] = -sin(3*phi_v);
-    q[6] = cos(psi_u_1);
-    q[7] = sin(psi_u_1);
-    q[8] = cos(phi_v - psi_v_1);
-    q[9] = -sin(phi_v - psi_v_1);
+    const double m_phi_v = p[23];
+    const double m_psi_u_1 = p[25];
+    const double m_psi_v_1 = p[27];
+    q[0] = cos(m_phi_v);
+    q[1] = -sin(m_phi_v);
+    q[2] = cos(2*m_phi_v);
+    q[3] = -sin(2*m_phi_v);
+    q[4] = cos(3*m_phi_v);
+    q[5] = -sin(3*m_phi_v);
+    q[6] = cos(m_psi_u_1);
+    q[7] = sin(m_psi_u_1);
+    q[8] = cos(m_phi_v - m_psi_v_1);
+    q[9] = -sin(m_phi_v - m_psi_v_1);
     (void)p; (void)q;
 }
 
 static inline void gs_rhs(double tau, const double *x, const double *p, const double *q, double *dx)
 {
-    const double u = x[0];
-    const double v = x[1];
-    const double du = x[2];
-    const double dv = x[3];
+    const double m_u = x[0];
+    const double m_v = x[1];
+    const double m_du = x[2];
+    const double m_dv = x[3];
     const double w0 = x[4];
     const double w1 = x[5];
     const double w2 = x[6];
     const double w3 = x[7];
-    const double omega = p[0];
-    const double f_u = p[1];
-    const double f_v = p[2];
-    const double xi_u_u = p[3];
-    const double xi_u_v = p[4];
-    const double xi_v_u = p[5];
-    const double xi_v_v = p[6];
-    const double kappa_u_u = p[7];
-    const double kappa_u_v = p[8];
-    const double kappa_v_u = p[9];
-    const double kappa_v_v = p[10];
-    const double kc_u_1 = p[11];
-    const double ks_u_1 = p[12];
-    const double kc_u_2 = p[13];
-    const double ks_u_2 = p[14];
-    const double kc_u_3 = p[15];
-    const double ks_u_3 = p[16];
-    const double kc_v_1 = p[17];
-    const double ks_v_1 = p[18];
-    const double kc_v_2 = p[19];
-    const double ks_v_2 = p[20];
-    const double kc_v_3 = p[21];
-    const double ks_v_3 = p[22];
-    const double E_u_1 = p[24];
-    const double E_v_1 = p[26];
-    const double g1 = p[28];
-    const double g3 = p[29];
-    const double g5 = p[30];
-    const double g7 = p[31];
-    const double th0 = (omega)*tau;
+    const double m_omega = p[0];
+    const double m_f_u = p[1];
+    const double m_f_v = p[2];
+    const double m_xi_u_u = p[3];
+    const double m_xi_u_v = p[4];
+    const double m_xi_v_u = p[5];
+    const double m_xi_v_v = p[6];
+    const double m_kappa_u_u = p[7];
+    const double m_kappa_u_v = p[8];
+    const double m_kappa_v_u = p[9];
+    const double m_kappa_v_v = p[10];
+    const double m_kc_u_1 = p[11];
+    const double m_ks_u_1 = p[12];
+    const double m_kc_u_2 = p[13];
+    const double m_ks_u_2 = p[14];
+    const double m_kc_u_3 = p[15];
+    const double m_ks_u_3 = p[16];
+    const double m_kc_v_1 = p[17];
+    const double m_ks_v_1 = p[18];
+    const double m_kc_v_2 = p[19];
+    const double m_ks_v_2 = p[20];
+    const double m_kc_v_3 = p[21];
+    const double m_ks_v_3 = p[22];
+    const double m_E_u_1 = p[24];
+    const double m_E_v_1 = p[26];
+    const double m_g1 = p[28];
+    const double m_g3 = p[29];
+    const double m_g5 = p[30];
+    const double m_g7 = p[31];
+    const double th0 = (m_omega)*tau;
     const double C0_1 = cos(th0), S0_1 = sin(th0);
     const double C0_2 = C0_1*C0_1 - S0_1*S0_1;
     const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
     const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
     const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
-    const double t_0 = 2*du;
-    const double t_1 = 2*dv;
-    const double t_2 = ((omega)*(omega));
-    const double t_3 = ((u)*(u));
-    const double t_4 = g5 + g7*t_3;
-    const double t_5 = g3 + t_3*t_4;
-    const double t_6 = C0_1*kc_u_1 + C0_2*kc_u_2 + C0_3*kc_u_3 + S0_1*ks_u_1 + S0_2*ks_u_2 + S0_3*ks_u_3 + 1;
-    const double t_7 = t_6*(g1 + t_3*t_5);
-    const double t_8 = kappa_u_u*t_7;
-    const double t_9 = ((v)*(v));
-    const double t_10 = g5 + g7*t_9;
-    const double t_11 = g3 + t_10*t_9;
-    const double t_12 = kc_v_1*(C0_1*q[0] - S0_1*q[1]) + kc_v_2*(C0_2*q[2] - S0_2*q[3]) + kc_v_3*(C0_3*q[4] - S0_3*q[5]) + ks_v_1*(C0_1*q[1] + S0_1*q[0]) + ks_v_2*(C0_2*q[3] + S0_2*q[2]) + ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1;
-    const double t_13 = t_12*(g1 + t_11*t_9);
-    const double t_14 = kappa_u_v*t_13;
-    const double t_15 = kappa_v_u*t_7;
-    const double t_16 = kappa_v_v*t_13;
+    const double t_0 = 2*m_du;
+    const double t_1 = 2*m_dv;
+    const double t_2 = ((m_omega)*(m_omega));
+    const double t_3 = ((m_u)*(m_u));
+    const double t_4 = m_g5 + m_g7*t_3;
+    const double t_5 = m_g3 + t_3*t_4;
+    const double t_6 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
+    const double t_7 = t_6*(m_g1 + t_3*t_5);
+    const double t_8 = m_kappa_u_u*t_7;
+    const double t_9 = ((m_v)*(m_v));
+    const double t_10 = m_g5 + m_g7*t_9;
+    const double t_11 = m_g3 + t_10*t_9;
+    const double t_12 = m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[2] - S0_2*q[3]) + m_kc_v_3*(C0_3*q[4] - S0_3*q[5]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[3] + S0_2*q[2]) + m_ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1;
+    const double t_13 = t_12*(m_g1 + t_11*t_9);
+    const double t_14 = m_kappa_u_v*t_13;
+    const double t_15 = m_kappa_v_u*t_7;
+    const double t_16 = m_kappa_v_v*t_13;
     const double t_17 = 2*w2;
     const double t_18 = 2*w3;
-    const double t_19 = 2*u;
-    const double t_20 = 2*g7;
-    const double t_21 = t_6*u*(t_19*t_5 + t_3*(t_19*t_4 + t_20*((u)*(u)*(u))));
-    const double t_22 = 2*v;
-    const double t_23 = t_12*v*(t_11*t_22 + t_9*(t_10*t_22 + t_20*((v)*(v)*(v))));
-    dx[0] = du;
-    dx[1] = dv;
-    dx[2] = -E_u_1*t_2*(C0_1*q[6] - S0_1*q[7]) + f_u - t_0*xi_u_u - t_1*xi_u_v - t_14*v - t_8*u;
-    dx[3] = -E_v_1*t_2*(C0_1*q[8] - S0_1*q[9]) + f_v - t_0*xi_v_u - t_1*xi_v_v - t_15*u - t_16*v;
+    const double t_19 = 2*m_u;
+    const double t_20 = 2*m_g7;
+    const double t_21 = t_6*m_u*(t_19*t_5 + t_3*(t_19*t_4 + t_20*((m_u)*(m_u)*(m_u))));
+    const double t_22 = 2*m_v;
+    const double t_23 = t_12*m_v*(t_11*t_22 + t_9*(t_10*t_22 + t_20*((m_v)*(m_v)*(m_v))));
+    dx[0] = m_du;
+    dx[1] = m_dv;
+    dx[2] = -m_E_u_1*t_2*(C0_1*q[6] - S0_1*q[7]) + m_f_u - t_0*m_xi_u_u - t_1*m_xi_u_v - t_14*m_v - t_8*m_u;
+    dx[3] = -m_E_v_1*t_2*(C0_1*q[8] - S0_1*q[9]) + m_f_v - t_0*m_xi_v_u - t_1*m_xi_v_v - t_15*m_u - t_16*m_v;
     dx[4] = w2;
     dx[5] = w3;
-    dx[6] = -t_17*xi_u_u - t_18*xi_u_v + w0*(-kappa_u_u*t_21 - t_8) + w1*(-kappa_u_v*t_23 - t_14);
-    dx[7] = -t_17*xi_v_u - t_18*xi_v_v + w0*(-kappa_v_u*t_21 - t_15) + w1*(-kappa_v_v*t_23 - t_16);
+    dx[6] = -t_17*m_xi_u_u - t_18*m_xi_u_v + w0*(-m_kappa_u_u*t_21 - t_8) + w1*(-m_kappa_u_v*t_23 - t_14);
+    dx[7] = -t_17*m_xi_v_u - t_18*m_xi_v_v + w0*(-m_kappa_v_u*t_21 - t_15) + w1*(-m_kappa_v_v*t_23 - t_16);
     (void)tau; (void)p; (void)q;
 }
 
@@ -398,75 +400,75 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
         for (int k = 0; k < GS_NQ; ++k) q[k] = Q[k*n + j];
-        const double u = X[0*n + j];
-        const double v = X[1*n + j];
-        const double du = X[2*n + j];
-        const double dv = X[3*n + j];
+        const double m_u = X[0*n + j];
+        const double m_v = X[1*n + j];
+        const double m_du = X[2*n + j];
+        const double m_dv = X[3*n + j];
         const double w0 = X[4*n + j];
         const double w1 = X[5*n + j];
         const double w2 = X[6*n + j];
         const double w3 = X[7*n + j];
-        const double omega = P[0*n + j];
-        const double f_u = P[1*n + j];
-        const double f_v = P[2*n + j];
-        const double xi_u_u = P[3*n + j];
-        const double xi_u_v = P[4*n + j];
-        const double xi_v_u = P[5*n + j];
-        const double xi_v_v = P[6*n + j];
-        const double kappa_u_u = P[7*n + j];
-        const double kappa_u_v = P[8*n + j];
-        const double kappa_v_u = P[9*n + j];
-        const double kappa_v_v = P[10*n + j];
-        const double kc_u_1 = P[11*n + j];
-        const double ks_u_1 = P[12*n + j];
-        const double kc_u_2 = P[13*n + j];
-        const double ks_u_2 = P[14*n + j];
-        const double kc_u_3 = P[15*n + j];
-        const double ks_u_3 = P[16*n + j];
-        const double kc_v_1 = P[17*n + j];
-        const double ks_v_1 = P[18*n + j];
-        const double kc_v_2 = P[19*n + j];
-        const double ks_v_2 = P[20*n + j];
-        const double kc_v_3 = P[21*n + j];
-        const double ks_v_3 = P[22*n + j];
-        const double E_u_1 = P[24*n + j];
-        const double E_v_1 = P[26*n + j];
-        const double g1 = P[28*n + j];
-        const double g3 = P[29*n + j];
-        const double g5 = P[30*n + j];
-        const double g7 = P[31*n + j];
-        const double t_0 = 2*du;
-        const double t_1 = 2*dv;
-        const double t_2 = ((omega)*(omega));
-        const double t_3 = ((u)*(u));
-        const double t_4 = g5 + g7*t_3;
-        const double t_5 = g3 + t_3*t_4;
-        const double t_6 = C0_1*kc_u_1 + C0_2*kc_u_2 + C0_3*kc_u_3 + S0_1*ks_u_1 + S0_2*ks_u_2 + S0_3*ks_u_3 + 1;
-        const double t_7 = t_6*(g1 + t_3*t_5);
-        const double t_8 = kappa_u_u*t_7;
-        const double t_9 = ((v)*(v));
-        const double t_10 = g5 + g7*t_9;
-        const double t_11 = g3 + t_10*t_9;
-        const double t_12 = kc_v_1*(C0_1*q[0] - S0_1*q[1]) + kc_v_2*(C0_2*q[2] - S0_2*q[3]) + kc_v_3*(C0_3*q[4] - S0_3*q[5]) + ks_v_1*(C0_1*q[1] + S0_1*q[0]) + ks_v_2*(C0_2*q[3] + S0_2*q[2]) + ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1;
-        const double t_13 = t_12*(g1 + t_11*t_9);
-        const double t_14 = kappa_u_v*t_13;
-        const double t_15 = kappa_v_u*t_7;
-        const double t_16 = kappa_v_v*t_13;
+        const double m_omega = P[0*n + j];
+        const double m_f_u = P[1*n + j];
+        const double m_f_v = P[2*n + j];
+        const double m_xi_u_u = P[3*n + j];
+        const double m_xi_u_v = P[4*n + j];
+        const double m_xi_v_u = P[5*n + j];
+        const double m_xi_v_v = P[6*n + j];
+        const double m_kappa_u_u = P[7*n + j];
+        const double m_kappa_u_v = P[8*n + j];
+        const double m_kappa_v_u = P[9*n + j];
+        const double m_kappa_v_v = P[10*n + j];
+        const double m_kc_u_1 = P[11*n + j];
+        const double m_ks_u_1 = P[12*n + j];
+        const double m_kc_u_2 = P[13*n + j];
+        const double m_ks_u_2 = P[14*n + j];
+        const double m_kc_u_3 = P[15*n + j];
+        const double m_ks_u_3 = P[16*n + j];
+        const double m_kc_v_1 = P[17*n + j];
+        const double m_ks_v_1 = P[18*n + j];
+        const double m_kc_v_2 = P[19*n + j];
+        const double m_ks_v_2 = P[20*n + j];
+        const double m_kc_v_3 = P[21*n + j];
+        const double m_ks_v_3 = P[22*n + j];
+        const double m_E_u_1 = P[24*n + j];
+        const double m_E_v_1 = P[26*n + j];
+        const double m_g1 = P[28*n + j];
+        const double m_g3 = P[29*n + j];
+        const double m_g5 = P[30*n + j];
+        const double m_g7 = P[31*n + j];
+        const double t_0 = 2*m_du;
+        const double t_1 = 2*m_dv;
+        const double t_2 = ((m_omega)*(m_omega));
+        const double t_3 = ((m_u)*(m_u));
+        const double t_4 = m_g5 + m_g7*t_3;
+        const double t_5 = m_g3 + t_3*t_4;
+        const double t_6 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
+        const double t_7 = t_6*(m_g1 + t_3*t_5);
+        const double t_8 = m_kappa_u_u*t_7;
+        const double t_9 = ((m_v)*(m_v));
+        const double t_10 = m_g5 + m_g7*t_9;
+        const double t_11 = m_g3 + t_10*t_9;
+        const double t_12 = m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[2] - S0_2*q[3]) + m_kc_v_3*(C0_3*q[4] - S0_3*q[5]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[3] + S0_2*q[2]) + m_ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1;
+        const double t_13 = t_12*(m_g1 + t_11*t_9);
+        const double t_14 = m_kappa_u_v*t_13;
+        const double t_15 = m_kappa_v_u*t_7;
+        const double t_16 = m_kappa_v_v*t_13;
         const double t_17 = 2*w2;
         const double t_18 = 2*w3;
-        const double t_19 = 2*u;
-        const double t_20 = 2*g7;
-        const double t_21 = t_6*u*(t_19*t_5 + t_3*(t_19*t_4 + t_20*((u)*(u)*(u))));
-        const double t_22 = 2*v;
-        const double t_23 = t_12*v*(t_11*t_22 + t_9*(t_10*t_22 + t_20*((v)*(v)*(v))));
-        DX[0*n + j] = du;
-        DX[1*n + j] = dv;
-        DX[2*n + j] = -E_u_1*t_2*(C0_1*q[6] - S0_1*q[7]) + f_u - t_0*xi_u_u - t_1*xi_u_v - t_14*v - t_8*u;
-        DX[3*n + j] = -E_v_1*t_2*(C0_1*q[8] - S0_1*q[9]) + f_v - t_0*xi_v_u - t_1*xi_v_v - t_15*u - t_16*v;
+        const double t_19 = 2*m_u;
+        const double t_20 = 2*m_g7;
+        const double t_21 = t_6*m_u*(t_19*t_5 + t_3*(t_19*t_4 + t_20*((m_u)*(m_u)*(m_u))));
+        const double t_22 = 2*m_v;
+        const double t_23 = t_12*m_v*(t_11*t_22 + t_9*(t_10*t_22 + t_20*((m_v)*(m_v)*(m_v))));
+        DX[0*n + j] = m_du;
+        DX[1*n + j] = m_dv;
+        DX[2*n + j] = -m_E_u_1*t_2*(C0_1*q[6] - S0_1*q[7]) + m_f_u - t_0*m_xi_u_u - t_1*m_xi_u_v - t_14*m_v - t_8*m_u;
+        DX[3*n + j] = -m_E_v_1*t_2*(C0_1*q[8] - S0_1*q[9]) + m_f_v - t_0*m_xi_v_u - t_1*m_xi_v_v - t_15*m_u - t_16*m_v;
         DX[4*n + j] = w2;
         DX[5*n + j] = w3;
-        DX[6*n + j] = -t_17*xi_u_u - t_18*xi_u_v + w0*(-kappa_u_u*t_21 - t_8) + w1*(-kappa_u_v*t_23 - t_14);
-        DX[7*n + j] = -t_17*xi_v_u - t_18*xi_v_v + w0*(-kappa_v_u*t_21 - t_15) + w1*(-kappa_v_v*t_23 - t_16);
+        DX[6*n + j] = -t_17*m_xi_u_u - t_18*m_xi_u_v + w0*(-m_kappa_u_u*t_21 - t_8) + w1*(-m_kappa_u_v*t_23 - t_14);
+        DX[7*n + j] = -t_17*m_xi_v_u - t_18*m_xi_v_v + w0*(-m_kappa_v_u*t_21 - t_15) + w1*(-m_kappa_v_v*t_23 - t_16);
     }
     (void)tau; (void)P; (void)Q;
 }
@@ -475,60 +477,60 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
 
 def rhs(tau, x, p):
     """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); result (n,) or (n, N)."""
-    u = x[0]
-    v = x[1]
-    du = x[2]
-    dv = x[3]
-    omega = p[0]
-    f_u = p[1]
-    f_v = p[2]
-    xi_u_u = p[3]
-    xi_u_v = p[4]
-    xi_v_u = p[5]
-    xi_v_v = p[6]
-    kappa_u_u = p[7]
-    kappa_u_v = p[8]
-    kappa_v_u = p[9]
-    kappa_v_v = p[10]
-    kc_u_1 = p[11]
-    ks_u_1 = p[12]
-    kc_u_2 = p[13]
-    ks_u_2 = p[14]
-    kc_u_3 = p[15]
-    ks_u_3 = p[16]
-    kc_v_1 = p[17]
-    ks_v_1 = p[18]
-    kc_v_2 = p[19]
-    ks_v_2 = p[20]
-    kc_v_3 = p[21]
-    ks_v_3 = p[22]
-    phi_v = p[23]
-    E_u_1 = p[24]
-    psi_u_1 = p[25]
-    E_v_1 = p[26]
-    psi_v_1 = p[27]
-    g1 = p[28]
-    g3 = p[29]
-    g5 = p[30]
-    g7 = p[31]
-    _t0 = 2*du
-    _t1 = 2*dv
-    _t2 = omega**2
-    _t3 = omega*tau
-    _t4 = u**2
+    m_u = x[0]
+    m_v = x[1]
+    m_du = x[2]
+    m_dv = x[3]
+    m_omega = p[0]
+    m_f_u = p[1]
+    m_f_v = p[2]
+    m_xi_u_u = p[3]
+    m_xi_u_v = p[4]
+    m_xi_v_u = p[5]
+    m_xi_v_v = p[6]
+    m_kappa_u_u = p[7]
+    m_kappa_u_v = p[8]
+    m_kappa_v_u = p[9]
+    m_kappa_v_v = p[10]
+    m_kc_u_1 = p[11]
+    m_ks_u_1 = p[12]
+    m_kc_u_2 = p[13]
+    m_ks_u_2 = p[14]
+    m_kc_u_3 = p[15]
+    m_ks_u_3 = p[16]
+    m_kc_v_1 = p[17]
+    m_ks_v_1 = p[18]
+    m_kc_v_2 = p[19]
+    m_ks_v_2 = p[20]
+    m_kc_v_3 = p[21]
+    m_ks_v_3 = p[22]
+    m_phi_v = p[23]
+    m_E_u_1 = p[24]
+    m_psi_u_1 = p[25]
+    m_E_v_1 = p[26]
+    m_psi_v_1 = p[27]
+    m_g1 = p[28]
+    m_g3 = p[29]
+    m_g5 = p[30]
+    m_g7 = p[31]
+    _t0 = 2*m_du
+    _t1 = 2*m_dv
+    _t2 = m_omega**2
+    _t3 = m_omega*tau
+    _t4 = m_u**2
     _t5 = 2*_t3
     _t6 = 3*_t3
-    _t7 = u*(_t4*(_t4*(_t4*g7 + g5) + g3) + g1)*(kc_u_1*np.cos(_t3) + kc_u_2*np.cos(_t5) + kc_u_3*np.cos(_t6) + ks_u_1*np.sin(_t3) + ks_u_2*np.sin(_t5) + ks_u_3*np.sin(_t6) + 1)
-    _t8 = v**2
-    _t9 = _t3 - phi_v
-    _t10 = _t5 - 2*phi_v
-    _t11 = _t6 - 3*phi_v
-    _t12 = v*(_t8*(_t8*(_t8*g7 + g5) + g3) + g1)*(kc_v_1*np.cos(_t9) + kc_v_2*np.cos(_t10) + kc_v_3*np.cos(_t11) + ks_v_1*np.sin(_t9) + ks_v_2*np.sin(_t10) + ks_v_3*np.sin(_t11) + 1)
+    _t7 = m_u*(_t4*(_t4*(_t4*m_g7 + m_g5) + m_g3) + m_g1)*(m_kc_u_1*np.cos(_t3) + m_kc_u_2*np.cos(_t5) + m_kc_u_3*np.cos(_t6) + m_ks_u_1*np.sin(_t3) + m_ks_u_2*np.sin(_t5) + m_ks_u_3*np.sin(_t6) + 1)
+    _t8 = m_v**2
+    _t9 = _t3 - m_phi_v
+    _t10 = _t5 - 2*m_phi_v
+    _t11 = _t6 - 3*m_phi_v
+    _t12 = m_v*(_t8*(_t8*(_t8*m_g7 + m_g5) + m_g3) + m_g1)*(m_kc_v_1*np.cos(_t9) + m_kc_v_2*np.cos(_t10) + m_kc_v_3*np.cos(_t11) + m_ks_v_1*np.sin(_t9) + m_ks_v_2*np.sin(_t10) + m_ks_v_3*np.sin(_t11) + 1)
     return np.array(np.broadcast_arrays(
-        du,
-        dv,
-        -E_u_1*_t2*np.cos(_t3 + psi_u_1) - _t0*xi_u_u - _t1*xi_u_v - _t12*kappa_u_v - _t7*kappa_u_u + f_u,
-        -E_v_1*_t2*np.cos(_t9 + psi_v_1) - _t0*xi_v_u - _t1*xi_v_v - _t12*kappa_v_v - _t7*kappa_v_u + f_v,
+        m_du,
+        m_dv,
+        -m_E_u_1*_t2*np.cos(_t3 + m_psi_u_1) - _t0*m_xi_u_u - _t1*m_xi_u_v - _t12*m_kappa_u_v - _t7*m_kappa_u_u + m_f_u,
+        -m_E_v_1*_t2*np.cos(_t9 + m_psi_v_1) - _t0*m_xi_v_u - _t1*m_xi_v_v - _t12*m_kappa_v_v - _t7*m_kappa_v_u + m_f_v,
     ))
 
 
@@ -595,115 +597,115 @@ def _check_stiffness(p):
 
 def jacobian(tau, x, p):
     """d rhs / d X, shape (n, n) or (n, n, N)."""
-    u = x[0]
-    v = x[1]
-    omega = p[0]
-    xi_u_u = p[3]
-    xi_u_v = p[4]
-    xi_v_u = p[5]
-    xi_v_v = p[6]
-    kappa_u_u = p[7]
-    kappa_u_v = p[8]
-    kappa_v_u = p[9]
-    kappa_v_v = p[10]
-    kc_u_1 = p[11]
-    ks_u_1 = p[12]
-    kc_u_2 = p[13]
-    ks_u_2 = p[14]
-    kc_u_3 = p[15]
-    ks_u_3 = p[16]
-    kc_v_1 = p[17]
-    ks_v_1 = p[18]
-    kc_v_2 = p[19]
-    ks_v_2 = p[20]
-    kc_v_3 = p[21]
-    ks_v_3 = p[22]
-    phi_v = p[23]
-    g1 = p[28]
-    g3 = p[29]
-    g5 = p[30]
-    g7 = p[31]
-    _t0 = u**2
-    _t1 = _t0*g7 + g5
-    _t2 = _t0*_t1 + g3
-    _t3 = omega*tau
+    m_u = x[0]
+    m_v = x[1]
+    m_omega = p[0]
+    m_xi_u_u = p[3]
+    m_xi_u_v = p[4]
+    m_xi_v_u = p[5]
+    m_xi_v_v = p[6]
+    m_kappa_u_u = p[7]
+    m_kappa_u_v = p[8]
+    m_kappa_v_u = p[9]
+    m_kappa_v_v = p[10]
+    m_kc_u_1 = p[11]
+    m_ks_u_1 = p[12]
+    m_kc_u_2 = p[13]
+    m_ks_u_2 = p[14]
+    m_kc_u_3 = p[15]
+    m_ks_u_3 = p[16]
+    m_kc_v_1 = p[17]
+    m_ks_v_1 = p[18]
+    m_kc_v_2 = p[19]
+    m_ks_v_2 = p[20]
+    m_kc_v_3 = p[21]
+    m_ks_v_3 = p[22]
+    m_phi_v = p[23]
+    m_g1 = p[28]
+    m_g3 = p[29]
+    m_g5 = p[30]
+    m_g7 = p[31]
+    _t0 = m_u**2
+    _t1 = _t0*m_g7 + m_g5
+    _t2 = _t0*_t1 + m_g3
+    _t3 = m_omega*tau
     _t4 = 2*_t3
     _t5 = 3*_t3
-    _t6 = kc_u_1*np.cos(_t3) + kc_u_2*np.cos(_t4) + kc_u_3*np.cos(_t5) + ks_u_1*np.sin(_t3) + ks_u_2*np.sin(_t4) + ks_u_3*np.sin(_t5) + 1
-    _t7 = _t6*(_t0*_t2 + g1)
-    _t8 = 2*u
-    _t9 = 2*g7
-    _t10 = _t6*u*(_t0*(_t1*_t8 + _t9*u**3) + _t2*_t8)
-    _t11 = v**2
-    _t12 = _t11*g7 + g5
-    _t13 = _t11*_t12 + g3
-    _t14 = _t3 - phi_v
-    _t15 = _t4 - 2*phi_v
-    _t16 = _t5 - 3*phi_v
-    _t17 = kc_v_1*np.cos(_t14) + kc_v_2*np.cos(_t15) + kc_v_3*np.cos(_t16) + ks_v_1*np.sin(_t14) + ks_v_2*np.sin(_t15) + ks_v_3*np.sin(_t16) + 1
-    _t18 = _t17*(_t11*_t13 + g1)
-    _t19 = 2*v
-    _t20 = _t17*v*(_t11*(_t12*_t19 + _t9*v**3) + _t13*_t19)
+    _t6 = m_kc_u_1*np.cos(_t3) + m_kc_u_2*np.cos(_t4) + m_kc_u_3*np.cos(_t5) + m_ks_u_1*np.sin(_t3) + m_ks_u_2*np.sin(_t4) + m_ks_u_3*np.sin(_t5) + 1
+    _t7 = _t6*(_t0*_t2 + m_g1)
+    _t8 = 2*m_u
+    _t9 = 2*m_g7
+    _t10 = _t6*m_u*(_t0*(_t1*_t8 + _t9*m_u**3) + _t2*_t8)
+    _t11 = m_v**2
+    _t12 = _t11*m_g7 + m_g5
+    _t13 = _t11*_t12 + m_g3
+    _t14 = _t3 - m_phi_v
+    _t15 = _t4 - 2*m_phi_v
+    _t16 = _t5 - 3*m_phi_v
+    _t17 = m_kc_v_1*np.cos(_t14) + m_kc_v_2*np.cos(_t15) + m_kc_v_3*np.cos(_t16) + m_ks_v_1*np.sin(_t14) + m_ks_v_2*np.sin(_t15) + m_ks_v_3*np.sin(_t16) + 1
+    _t18 = _t17*(_t11*_t13 + m_g1)
+    _t19 = 2*m_v
+    _t20 = _t17*m_v*(_t11*(_t12*_t19 + _t9*m_v**3) + _t13*_t19)
     return np.array(_broadcast(
         (0, 0, 1, 0,),
         (0, 0, 0, 1,),
-        (-_t10*kappa_u_u - _t7*kappa_u_u, -_t18*kappa_u_v - _t20*kappa_u_v, -2*xi_u_u, -2*xi_u_v,),
-        (-_t10*kappa_v_u - _t7*kappa_v_u, -_t18*kappa_v_v - _t20*kappa_v_v, -2*xi_v_u, -2*xi_v_v,),
+        (-_t10*m_kappa_u_u - _t7*m_kappa_u_u, -_t18*m_kappa_u_v - _t20*m_kappa_u_v, -2*m_xi_u_u, -2*m_xi_u_v,),
+        (-_t10*m_kappa_v_u - _t7*m_kappa_v_u, -_t18*m_kappa_v_v - _t20*m_kappa_v_v, -2*m_xi_v_u, -2*m_xi_v_v,),
     ))
 
 
 def mesh_force(tau, x, p):
     """Dynamic force of each mesh over its k_m b: elastic k_hat(tau) g(u) plus viscous c u' (one damper per mesh); (m,) or (m, N)."""
-    u = x[0]
-    v = x[1]
-    du = x[2]
-    dv = x[3]
-    omega = p[0]
-    xi_u_u = p[3]
-    xi_v_v = p[6]
-    kappa_u_u = p[7]
-    kappa_v_v = p[10]
-    kc_u_1 = p[11]
-    ks_u_1 = p[12]
-    kc_u_2 = p[13]
-    ks_u_2 = p[14]
-    kc_u_3 = p[15]
-    ks_u_3 = p[16]
-    kc_v_1 = p[17]
-    ks_v_1 = p[18]
-    kc_v_2 = p[19]
-    ks_v_2 = p[20]
-    kc_v_3 = p[21]
-    ks_v_3 = p[22]
-    phi_v = p[23]
-    g1 = p[28]
-    g3 = p[29]
-    g5 = p[30]
-    g7 = p[31]
-    _t0 = u**2
-    _t1 = omega*tau
+    m_u = x[0]
+    m_v = x[1]
+    m_du = x[2]
+    m_dv = x[3]
+    m_omega = p[0]
+    m_xi_u_u = p[3]
+    m_xi_v_v = p[6]
+    m_kappa_u_u = p[7]
+    m_kappa_v_v = p[10]
+    m_kc_u_1 = p[11]
+    m_ks_u_1 = p[12]
+    m_kc_u_2 = p[13]
+    m_ks_u_2 = p[14]
+    m_kc_u_3 = p[15]
+    m_ks_u_3 = p[16]
+    m_kc_v_1 = p[17]
+    m_ks_v_1 = p[18]
+    m_kc_v_2 = p[19]
+    m_ks_v_2 = p[20]
+    m_kc_v_3 = p[21]
+    m_ks_v_3 = p[22]
+    m_phi_v = p[23]
+    m_g1 = p[28]
+    m_g3 = p[29]
+    m_g5 = p[30]
+    m_g7 = p[31]
+    _t0 = m_u**2
+    _t1 = m_omega*tau
     _t2 = 2*_t1
     _t3 = 3*_t1
-    _t4 = v**2
-    _t5 = _t1 - phi_v
-    _t6 = _t2 - 2*phi_v
-    _t7 = _t3 - 3*phi_v
+    _t4 = m_v**2
+    _t5 = _t1 - m_phi_v
+    _t6 = _t2 - 2*m_phi_v
+    _t7 = _t3 - 3*m_phi_v
     return np.array(np.broadcast_arrays(
-        2*du*xi_u_u/kappa_u_u + u*(_t0*(_t0*(_t0*g7 + g5) + g3) + g1)*(kc_u_1*np.cos(_t1) + kc_u_2*np.cos(_t2) + kc_u_3*np.cos(_t3) + ks_u_1*np.sin(_t1) + ks_u_2*np.sin(_t2) + ks_u_3*np.sin(_t3) + 1),
-        2*dv*xi_v_v/kappa_v_v + v*(_t4*(_t4*(_t4*g7 + g5) + g3) + g1)*(kc_v_1*np.cos(_t5) + kc_v_2*np.cos(_t6) + kc_v_3*np.cos(_t7) + ks_v_1*np.sin(_t5) + ks_v_2*np.sin(_t6) + ks_v_3*np.sin(_t7) + 1),
+        2*m_du*m_xi_u_u/m_kappa_u_u + m_u*(_t0*(_t0*(_t0*m_g7 + m_g5) + m_g3) + m_g1)*(m_kc_u_1*np.cos(_t1) + m_kc_u_2*np.cos(_t2) + m_kc_u_3*np.cos(_t3) + m_ks_u_1*np.sin(_t1) + m_ks_u_2*np.sin(_t2) + m_ks_u_3*np.sin(_t3) + 1),
+        2*m_dv*m_xi_v_v/m_kappa_v_v + m_v*(_t4*(_t4*(_t4*m_g7 + m_g5) + m_g3) + m_g1)*(m_kc_v_1*np.cos(_t5) + m_kc_v_2*np.cos(_t6) + m_kc_v_3*np.cos(_t7) + m_ks_v_1*np.sin(_t5) + m_ks_v_2*np.sin(_t6) + m_ks_v_3*np.sin(_t7) + 1),
     ), dtype=float)
 
 
 def static_mesh_force(p):
     """Static force of each mesh over its k_m b: kappa F = f at the mean stiffness."""
-    f_u = p[1]
-    f_v = p[2]
-    kappa_u_u = p[7]
-    kappa_u_v = p[8]
-    kappa_v_u = p[9]
-    kappa_v_v = p[10]
-    K = np.array([[kappa_u_u, kappa_u_v], [kappa_v_u, kappa_v_v]], dtype=float)
-    f = np.array([f_u, f_v], dtype=float)
+    m_f_u = p[1]
+    m_f_v = p[2]
+    m_kappa_u_u = p[7]
+    m_kappa_u_v = p[8]
+    m_kappa_v_u = p[9]
+    m_kappa_v_v = p[10]
+    K = np.array([[m_kappa_u_u, m_kappa_u_v], [m_kappa_v_u, m_kappa_v_v]], dtype=float)
+    f = np.array([m_f_u, m_f_v], dtype=float)
     return np.linalg.solve(K, f)
 
 
@@ -720,60 +722,60 @@ def casadi_functions():
     tau = ca.SX.sym('tau')
     x = ca.SX.sym('x', 4)
     p = ca.SX.sym('p', 32)
-    u = x[0]
-    v = x[1]
-    du = x[2]
-    dv = x[3]
-    omega = p[0]
-    f_u = p[1]
-    f_v = p[2]
-    xi_u_u = p[3]
-    xi_u_v = p[4]
-    xi_v_u = p[5]
-    xi_v_v = p[6]
-    kappa_u_u = p[7]
-    kappa_u_v = p[8]
-    kappa_v_u = p[9]
-    kappa_v_v = p[10]
-    kc_u_1 = p[11]
-    ks_u_1 = p[12]
-    kc_u_2 = p[13]
-    ks_u_2 = p[14]
-    kc_u_3 = p[15]
-    ks_u_3 = p[16]
-    kc_v_1 = p[17]
-    ks_v_1 = p[18]
-    kc_v_2 = p[19]
-    ks_v_2 = p[20]
-    kc_v_3 = p[21]
-    ks_v_3 = p[22]
-    phi_v = p[23]
-    E_u_1 = p[24]
-    psi_u_1 = p[25]
-    E_v_1 = p[26]
-    psi_v_1 = p[27]
-    g1 = p[28]
-    g3 = p[29]
-    g5 = p[30]
-    g7 = p[31]
-    _t0 = 2*du
-    _t1 = 2*dv
-    _t2 = omega**2
-    _t3 = omega*tau
-    _t4 = u**2
+    m_u = x[0]
+    m_v = x[1]
+    m_du = x[2]
+    m_dv = x[3]
+    m_omega = p[0]
+    m_f_u = p[1]
+    m_f_v = p[2]
+    m_xi_u_u = p[3]
+    m_xi_u_v = p[4]
+    m_xi_v_u = p[5]
+    m_xi_v_v = p[6]
+    m_kappa_u_u = p[7]
+    m_kappa_u_v = p[8]
+    m_kappa_v_u = p[9]
+    m_kappa_v_v = p[10]
+    m_kc_u_1 = p[11]
+    m_ks_u_1 = p[12]
+    m_kc_u_2 = p[13]
+    m_ks_u_2 = p[14]
+    m_kc_u_3 = p[15]
+    m_ks_u_3 = p[16]
+    m_kc_v_1 = p[17]
+    m_ks_v_1 = p[18]
+    m_kc_v_2 = p[19]
+    m_ks_v_2 = p[20]
+    m_kc_v_3 = p[21]
+    m_ks_v_3 = p[22]
+    m_phi_v = p[23]
+    m_E_u_1 = p[24]
+    m_psi_u_1 = p[25]
+    m_E_v_1 = p[26]
+    m_psi_v_1 = p[27]
+    m_g1 = p[28]
+    m_g3 = p[29]
+    m_g5 = p[30]
+    m_g7 = p[31]
+    _t0 = 2*m_du
+    _t1 = 2*m_dv
+    _t2 = m_omega**2
+    _t3 = m_omega*tau
+    _t4 = m_u**2
     _t5 = 2*_t3
     _t6 = 3*_t3
-    _t7 = u*(_t4*(_t4*(_t4*g7 + g5) + g3) + g1)*(kc_u_1*ca.cos(_t3) + kc_u_2*ca.cos(_t5) + kc_u_3*ca.cos(_t6) + ks_u_1*ca.sin(_t3) + ks_u_2*ca.sin(_t5) + ks_u_3*ca.sin(_t6) + 1)
-    _t8 = v**2
-    _t9 = _t3 - phi_v
-    _t10 = _t5 - 2*phi_v
-    _t11 = _t6 - 3*phi_v
-    _t12 = v*(_t8*(_t8*(_t8*g7 + g5) + g3) + g1)*(kc_v_1*ca.cos(_t9) + kc_v_2*ca.cos(_t10) + kc_v_3*ca.cos(_t11) + ks_v_1*ca.sin(_t9) + ks_v_2*ca.sin(_t10) + ks_v_3*ca.sin(_t11) + 1)
+    _t7 = m_u*(_t4*(_t4*(_t4*m_g7 + m_g5) + m_g3) + m_g1)*(m_kc_u_1*ca.cos(_t3) + m_kc_u_2*ca.cos(_t5) + m_kc_u_3*ca.cos(_t6) + m_ks_u_1*ca.sin(_t3) + m_ks_u_2*ca.sin(_t5) + m_ks_u_3*ca.sin(_t6) + 1)
+    _t8 = m_v**2
+    _t9 = _t3 - m_phi_v
+    _t10 = _t5 - 2*m_phi_v
+    _t11 = _t6 - 3*m_phi_v
+    _t12 = m_v*(_t8*(_t8*(_t8*m_g7 + m_g5) + m_g3) + m_g1)*(m_kc_v_1*ca.cos(_t9) + m_kc_v_2*ca.cos(_t10) + m_kc_v_3*ca.cos(_t11) + m_ks_v_1*ca.sin(_t9) + m_ks_v_2*ca.sin(_t10) + m_ks_v_3*ca.sin(_t11) + 1)
     xdot = ca.vertcat(
-        du,
-        dv,
-        -E_u_1*_t2*ca.cos(_t3 + psi_u_1) - _t0*xi_u_u - _t1*xi_u_v - _t12*kappa_u_v - _t7*kappa_u_u + f_u,
-        -E_v_1*_t2*ca.cos(_t9 + psi_v_1) - _t0*xi_v_u - _t1*xi_v_v - _t12*kappa_v_v - _t7*kappa_v_u + f_v,
+        m_du,
+        m_dv,
+        -m_E_u_1*_t2*ca.cos(_t3 + m_psi_u_1) - _t0*m_xi_u_u - _t1*m_xi_u_v - _t12*m_kappa_u_v - _t7*m_kappa_u_u + m_f_u,
+        -m_E_v_1*_t2*ca.cos(_t9 + m_psi_v_1) - _t0*m_xi_v_u - _t1*m_xi_v_v - _t12*m_kappa_v_v - _t7*m_kappa_v_u + m_f_v,
     )
     f = ca.Function('rhs', [tau, x, p], [xdot], ['tau', 'x', 'p'], ['xdot'])
     j = ca.Function('jacobian', [tau, x, p], [ca.jacobian(xdot, x)],

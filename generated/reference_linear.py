@@ -30,6 +30,8 @@ Time: tau = omega_n t, omega_n = 11068.62872 rad/s.
 
 CONTRACT states as data what a solver needs: velocity indices, forcing frequency,
 loads, contact edges, piecewise or smooth, switching surfaces, valid range.
+
+Model symbols are namespaced in the code: state or parameter NAME is m_NAME.
 """
 
 import numpy as np
@@ -108,22 +110,22 @@ static void gs_prep(const double *p, double *q)
 
 static inline void gs_rhs(double tau, const double *x, const double *p, const double *q, double *dx)
 {
-    const double u = x[0];
-    const double v = x[1];
-    const double du = x[2];
-    const double dv = x[3];
-    const double f_u = p[1];
-    const double f_v = p[2];
-    const double xi_u_u = p[3];
-    const double xi_v_v = p[4];
-    const double kappa_u_u = p[5];
-    const double kappa_u_v = p[6];
-    const double kappa_v_u = p[7];
-    const double kappa_v_v = p[8];
-    dx[0] = du;
-    dx[1] = dv;
-    dx[2] = -2*du*xi_u_u + f_u - kappa_u_u*u - kappa_u_v*v;
-    dx[3] = -2*dv*xi_v_v + f_v - kappa_v_u*u - kappa_v_v*v;
+    const double m_u = x[0];
+    const double m_v = x[1];
+    const double m_du = x[2];
+    const double m_dv = x[3];
+    const double m_f_u = p[1];
+    const double m_f_v = p[2];
+    const double m_xi_u_u = p[3];
+    const double m_xi_v_v = p[4];
+    const double m_kappa_u_u = p[5];
+    const double m_kappa_u_v = p[6];
+    const double m_kappa_v_u = p[7];
+    const double m_kappa_v_v = p[8];
+    dx[0] = m_du;
+    dx[1] = m_dv;
+    dx[2] = -2*m_du*m_xi_u_u + m_f_u - m_kappa_u_u*m_u - m_kappa_u_v*m_v;
+    dx[3] = -2*m_dv*m_xi_v_v + m_f_v - m_kappa_v_u*m_u - m_kappa_v_v*m_v;
     (void)tau; (void)p; (void)q;
 }
 
@@ -131,22 +133,22 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
 {
 #pragma GCC ivdep
     for (int j = 0; j < n; ++j) {
-        const double u = X[0*n + j];
-        const double v = X[1*n + j];
-        const double du = X[2*n + j];
-        const double dv = X[3*n + j];
-        const double f_u = P[1*n + j];
-        const double f_v = P[2*n + j];
-        const double xi_u_u = P[3*n + j];
-        const double xi_v_v = P[4*n + j];
-        const double kappa_u_u = P[5*n + j];
-        const double kappa_u_v = P[6*n + j];
-        const double kappa_v_u = P[7*n + j];
-        const double kappa_v_v = P[8*n + j];
-        DX[0*n + j] = du;
-        DX[1*n + j] = dv;
-        DX[2*n + j] = -2*du*xi_u_u + f_u - kappa_u_u*u - kappa_u_v*v;
-        DX[3*n + j] = -2*dv*xi_v_v + f_v - kappa_v_u*u - kappa_v_v*v;
+        const double m_u = X[0*n + j];
+        const double m_v = X[1*n + j];
+        const double m_du = X[2*n + j];
+        const double m_dv = X[3*n + j];
+        const double m_f_u = P[1*n + j];
+        const double m_f_v = P[2*n + j];
+        const double m_xi_u_u = P[3*n + j];
+        const double m_xi_v_v = P[4*n + j];
+        const double m_kappa_u_u = P[5*n + j];
+        const double m_kappa_u_v = P[6*n + j];
+        const double m_kappa_v_u = P[7*n + j];
+        const double m_kappa_v_v = P[8*n + j];
+        DX[0*n + j] = m_du;
+        DX[1*n + j] = m_dv;
+        DX[2*n + j] = -2*m_du*m_xi_u_u + m_f_u - m_kappa_u_u*m_u - m_kappa_u_v*m_v;
+        DX[3*n + j] = -2*m_dv*m_xi_v_v + m_f_v - m_kappa_v_u*m_u - m_kappa_v_v*m_v;
     }
     (void)tau; (void)P; (void)Q;
 }
@@ -166,32 +168,32 @@ static void gs_prep(const double *p, double *q)
 
 static inline void gs_rhs(double tau, const double *x, const double *p, const double *q, double *dx)
 {
-    const double u = x[0];
-    const double v = x[1];
-    const double du = x[2];
-    const double dv = x[3];
+    const double m_u = x[0];
+    const double m_v = x[1];
+    const double m_du = x[2];
+    const double m_dv = x[3];
     const double w0 = x[4];
     const double w1 = x[5];
     const double w2 = x[6];
     const double w3 = x[7];
-    const double f_u = p[1];
-    const double f_v = p[2];
-    const double xi_u_u = p[3];
-    const double xi_v_v = p[4];
-    const double kappa_u_u = p[5];
-    const double kappa_u_v = p[6];
-    const double kappa_v_u = p[7];
-    const double kappa_v_v = p[8];
-    const double t_0 = 2*xi_u_u;
-    const double t_1 = 2*xi_v_v;
-    dx[0] = du;
-    dx[1] = dv;
-    dx[2] = -du*t_0 + f_u - kappa_u_u*u - kappa_u_v*v;
-    dx[3] = -dv*t_1 + f_v - kappa_v_u*u - kappa_v_v*v;
+    const double m_f_u = p[1];
+    const double m_f_v = p[2];
+    const double m_xi_u_u = p[3];
+    const double m_xi_v_v = p[4];
+    const double m_kappa_u_u = p[5];
+    const double m_kappa_u_v = p[6];
+    const double m_kappa_v_u = p[7];
+    const double m_kappa_v_v = p[8];
+    const double t_0 = 2*m_xi_u_u;
+    const double t_1 = 2*m_xi_v_v;
+    dx[0] = m_du;
+    dx[1] = m_dv;
+    dx[2] = -m_du*t_0 + m_f_u - m_kappa_u_u*m_u - m_kappa_u_v*m_v;
+    dx[3] = -m_dv*t_1 + m_f_v - m_kappa_v_u*m_u - m_kappa_v_v*m_v;
     dx[4] = w2;
     dx[5] = w3;
-    dx[6] = -kappa_u_u*w0 - kappa_u_v*w1 - t_0*w2;
-    dx[7] = -kappa_v_u*w0 - kappa_v_v*w1 - t_1*w3;
+    dx[6] = -m_kappa_u_u*w0 - m_kappa_u_v*w1 - t_0*w2;
+    dx[7] = -m_kappa_v_u*w0 - m_kappa_v_v*w1 - t_1*w3;
     (void)tau; (void)p; (void)q;
 }
 
@@ -199,32 +201,32 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
 {
 #pragma GCC ivdep
     for (int j = 0; j < n; ++j) {
-        const double u = X[0*n + j];
-        const double v = X[1*n + j];
-        const double du = X[2*n + j];
-        const double dv = X[3*n + j];
+        const double m_u = X[0*n + j];
+        const double m_v = X[1*n + j];
+        const double m_du = X[2*n + j];
+        const double m_dv = X[3*n + j];
         const double w0 = X[4*n + j];
         const double w1 = X[5*n + j];
         const double w2 = X[6*n + j];
         const double w3 = X[7*n + j];
-        const double f_u = P[1*n + j];
-        const double f_v = P[2*n + j];
-        const double xi_u_u = P[3*n + j];
-        const double xi_v_v = P[4*n + j];
-        const double kappa_u_u = P[5*n + j];
-        const double kappa_u_v = P[6*n + j];
-        const double kappa_v_u = P[7*n + j];
-        const double kappa_v_v = P[8*n + j];
-        const double t_0 = 2*xi_u_u;
-        const double t_1 = 2*xi_v_v;
-        DX[0*n + j] = du;
-        DX[1*n + j] = dv;
-        DX[2*n + j] = -du*t_0 + f_u - kappa_u_u*u - kappa_u_v*v;
-        DX[3*n + j] = -dv*t_1 + f_v - kappa_v_u*u - kappa_v_v*v;
+        const double m_f_u = P[1*n + j];
+        const double m_f_v = P[2*n + j];
+        const double m_xi_u_u = P[3*n + j];
+        const double m_xi_v_v = P[4*n + j];
+        const double m_kappa_u_u = P[5*n + j];
+        const double m_kappa_u_v = P[6*n + j];
+        const double m_kappa_v_u = P[7*n + j];
+        const double m_kappa_v_v = P[8*n + j];
+        const double t_0 = 2*m_xi_u_u;
+        const double t_1 = 2*m_xi_v_v;
+        DX[0*n + j] = m_du;
+        DX[1*n + j] = m_dv;
+        DX[2*n + j] = -m_du*t_0 + m_f_u - m_kappa_u_u*m_u - m_kappa_u_v*m_v;
+        DX[3*n + j] = -m_dv*t_1 + m_f_v - m_kappa_v_u*m_u - m_kappa_v_v*m_v;
         DX[4*n + j] = w2;
         DX[5*n + j] = w3;
-        DX[6*n + j] = -kappa_u_u*w0 - kappa_u_v*w1 - t_0*w2;
-        DX[7*n + j] = -kappa_v_u*w0 - kappa_v_v*w1 - t_1*w3;
+        DX[6*n + j] = -m_kappa_u_u*w0 - m_kappa_u_v*w1 - t_0*w2;
+        DX[7*n + j] = -m_kappa_v_u*w0 - m_kappa_v_v*w1 - t_1*w3;
     }
     (void)tau; (void)P; (void)Q;
 }
@@ -233,23 +235,23 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
 
 def rhs(tau, x, p):
     """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); result (n,) or (n, N)."""
-    u = x[0]
-    v = x[1]
-    du = x[2]
-    dv = x[3]
-    f_u = p[1]
-    f_v = p[2]
-    xi_u_u = p[3]
-    xi_v_v = p[4]
-    kappa_u_u = p[5]
-    kappa_u_v = p[6]
-    kappa_v_u = p[7]
-    kappa_v_v = p[8]
+    m_u = x[0]
+    m_v = x[1]
+    m_du = x[2]
+    m_dv = x[3]
+    m_f_u = p[1]
+    m_f_v = p[2]
+    m_xi_u_u = p[3]
+    m_xi_v_v = p[4]
+    m_kappa_u_u = p[5]
+    m_kappa_u_v = p[6]
+    m_kappa_v_u = p[7]
+    m_kappa_v_v = p[8]
     return np.array(np.broadcast_arrays(
-        du,
-        dv,
-        -2*du*xi_u_u + f_u - kappa_u_u*u - kappa_u_v*v,
-        -2*dv*xi_v_v + f_v - kappa_v_u*u - kappa_v_v*v,
+        m_du,
+        m_dv,
+        -2*m_du*m_xi_u_u + m_f_u - m_kappa_u_u*m_u - m_kappa_u_v*m_v,
+        -2*m_dv*m_xi_v_v + m_f_v - m_kappa_v_u*m_u - m_kappa_v_v*m_v,
     ))
 
 
@@ -290,46 +292,46 @@ def parameters(**values):
 
 def jacobian(tau, x, p):
     """d rhs / d X, shape (n, n) or (n, n, N)."""
-    xi_u_u = p[3]
-    xi_v_v = p[4]
-    kappa_u_u = p[5]
-    kappa_u_v = p[6]
-    kappa_v_u = p[7]
-    kappa_v_v = p[8]
+    m_xi_u_u = p[3]
+    m_xi_v_v = p[4]
+    m_kappa_u_u = p[5]
+    m_kappa_u_v = p[6]
+    m_kappa_v_u = p[7]
+    m_kappa_v_v = p[8]
     return np.array(_broadcast(
         (0, 0, 1, 0,),
         (0, 0, 0, 1,),
-        (-kappa_u_u, -kappa_u_v, -2*xi_u_u, 0,),
-        (-kappa_v_u, -kappa_v_v, 0, -2*xi_v_v,),
+        (-m_kappa_u_u, -m_kappa_u_v, -2*m_xi_u_u, 0,),
+        (-m_kappa_v_u, -m_kappa_v_v, 0, -2*m_xi_v_v,),
     ))
 
 
 def mesh_force(tau, x, p):
     """Dynamic force of each mesh over its k_m b: elastic k_hat(tau) g(u) plus viscous c u' (one damper per mesh); (m,) or (m, N)."""
-    u = x[0]
-    v = x[1]
-    du = x[2]
-    dv = x[3]
-    xi_u_u = p[3]
-    xi_v_v = p[4]
-    kappa_u_u = p[5]
-    kappa_v_v = p[8]
+    m_u = x[0]
+    m_v = x[1]
+    m_du = x[2]
+    m_dv = x[3]
+    m_xi_u_u = p[3]
+    m_xi_v_v = p[4]
+    m_kappa_u_u = p[5]
+    m_kappa_v_v = p[8]
     return np.array(np.broadcast_arrays(
-        2*du*xi_u_u/kappa_u_u + u,
-        2*dv*xi_v_v/kappa_v_v + v,
+        2*m_du*m_xi_u_u/m_kappa_u_u + m_u,
+        2*m_dv*m_xi_v_v/m_kappa_v_v + m_v,
     ), dtype=float)
 
 
 def static_mesh_force(p):
     """Static force of each mesh over its k_m b: kappa F = f at the mean stiffness."""
-    f_u = p[1]
-    f_v = p[2]
-    kappa_u_u = p[5]
-    kappa_u_v = p[6]
-    kappa_v_u = p[7]
-    kappa_v_v = p[8]
-    K = np.array([[kappa_u_u, kappa_u_v], [kappa_v_u, kappa_v_v]], dtype=float)
-    f = np.array([f_u, f_v], dtype=float)
+    m_f_u = p[1]
+    m_f_v = p[2]
+    m_kappa_u_u = p[5]
+    m_kappa_u_v = p[6]
+    m_kappa_v_u = p[7]
+    m_kappa_v_v = p[8]
+    K = np.array([[m_kappa_u_u, m_kappa_u_v], [m_kappa_v_u, m_kappa_v_v]], dtype=float)
+    f = np.array([m_f_u, m_f_v], dtype=float)
     return np.linalg.solve(K, f)
 
 
@@ -346,23 +348,23 @@ def casadi_functions():
     tau = ca.SX.sym('tau')
     x = ca.SX.sym('x', 4)
     p = ca.SX.sym('p', 9)
-    u = x[0]
-    v = x[1]
-    du = x[2]
-    dv = x[3]
-    f_u = p[1]
-    f_v = p[2]
-    xi_u_u = p[3]
-    xi_v_v = p[4]
-    kappa_u_u = p[5]
-    kappa_u_v = p[6]
-    kappa_v_u = p[7]
-    kappa_v_v = p[8]
+    m_u = x[0]
+    m_v = x[1]
+    m_du = x[2]
+    m_dv = x[3]
+    m_f_u = p[1]
+    m_f_v = p[2]
+    m_xi_u_u = p[3]
+    m_xi_v_v = p[4]
+    m_kappa_u_u = p[5]
+    m_kappa_u_v = p[6]
+    m_kappa_v_u = p[7]
+    m_kappa_v_v = p[8]
     xdot = ca.vertcat(
-        du,
-        dv,
-        -2*du*xi_u_u + f_u - kappa_u_u*u - kappa_u_v*v,
-        -2*dv*xi_v_v + f_v - kappa_v_u*u - kappa_v_v*v,
+        m_du,
+        m_dv,
+        -2*m_du*m_xi_u_u + m_f_u - m_kappa_u_u*m_u - m_kappa_u_v*m_v,
+        -2*m_dv*m_xi_v_v + m_f_v - m_kappa_v_u*m_u - m_kappa_v_v*m_v,
     )
     f = ca.Function('rhs', [tau, x, p], [xdot], ['tau', 'x', 'p'], ['xdot'])
     j = ca.Function('jacobian', [tau, x, p], [ca.jacobian(xdot, x)],

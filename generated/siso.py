@@ -35,6 +35,8 @@ Time: tau = omega_n t, omega_n = 11068.62872 rad/s.
 
 CONTRACT states as data what a solver needs: velocity indices, forcing frequency,
 loads, contact edges, piecewise or smooth, switching surfaces, valid range.
+
+Model symbols are namespaced in the code: state or parameter NAME is m_NAME.
 """
 
 import numpy as np
@@ -115,40 +117,40 @@ C_SOURCE = r"""
 
 static void gs_prep(const double *p, double *q)
 {
-    const double psi_u_1 = p[11];
-    q[0] = cos(psi_u_1);
-    q[1] = sin(psi_u_1);
+    const double m_psi_u_1 = p[11];
+    q[0] = cos(m_psi_u_1);
+    q[1] = sin(m_psi_u_1);
     (void)p; (void)q;
 }
 
 static inline void gs_rhs(double tau, const double *x, const double *p, const double *q, double *dx)
 {
-    const double u = x[0];
-    const double du = x[1];
-    const double omega = p[0];
-    const double f_u = p[1];
-    const double xi_u_u = p[2];
-    const double kappa_u_u = p[3];
-    const double kc_u_1 = p[4];
-    const double ks_u_1 = p[5];
-    const double kc_u_2 = p[6];
-    const double ks_u_2 = p[7];
-    const double kc_u_3 = p[8];
-    const double ks_u_3 = p[9];
-    const double E_u_1 = p[10];
-    const double g1 = p[12];
-    const double g3 = p[13];
-    const double g5 = p[14];
-    const double g7 = p[15];
-    const double th0 = (omega)*tau;
+    const double m_u = x[0];
+    const double m_du = x[1];
+    const double m_omega = p[0];
+    const double m_f_u = p[1];
+    const double m_xi_u_u = p[2];
+    const double m_kappa_u_u = p[3];
+    const double m_kc_u_1 = p[4];
+    const double m_ks_u_1 = p[5];
+    const double m_kc_u_2 = p[6];
+    const double m_ks_u_2 = p[7];
+    const double m_kc_u_3 = p[8];
+    const double m_ks_u_3 = p[9];
+    const double m_E_u_1 = p[10];
+    const double m_g1 = p[12];
+    const double m_g3 = p[13];
+    const double m_g5 = p[14];
+    const double m_g7 = p[15];
+    const double th0 = (m_omega)*tau;
     const double C0_1 = cos(th0), S0_1 = sin(th0);
     const double C0_2 = C0_1*C0_1 - S0_1*S0_1;
     const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
     const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
     const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
-    const double t_0 = ((u)*(u));
-    dx[0] = du;
-    dx[1] = -E_u_1*((omega)*(omega))*(C0_1*q[0] - S0_1*q[1]) - 2*du*xi_u_u + f_u - kappa_u_u*u*(g1 + t_0*(g3 + t_0*(g5 + g7*t_0)))*(C0_1*kc_u_1 + C0_2*kc_u_2 + C0_3*kc_u_3 + S0_1*ks_u_1 + S0_2*ks_u_2 + S0_3*ks_u_3 + 1);
+    const double t_0 = ((m_u)*(m_u));
+    dx[0] = m_du;
+    dx[1] = -m_E_u_1*((m_omega)*(m_omega))*(C0_1*q[0] - S0_1*q[1]) - 2*m_du*m_xi_u_u + m_f_u - m_kappa_u_u*m_u*(m_g1 + t_0*(m_g3 + t_0*(m_g5 + m_g7*t_0)))*(C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1);
     (void)tau; (void)p; (void)q;
 }
 
@@ -164,26 +166,26 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
         for (int k = 0; k < GS_NQ; ++k) q[k] = Q[k*n + j];
-        const double u = X[0*n + j];
-        const double du = X[1*n + j];
-        const double omega = P[0*n + j];
-        const double f_u = P[1*n + j];
-        const double xi_u_u = P[2*n + j];
-        const double kappa_u_u = P[3*n + j];
-        const double kc_u_1 = P[4*n + j];
-        const double ks_u_1 = P[5*n + j];
-        const double kc_u_2 = P[6*n + j];
-        const double ks_u_2 = P[7*n + j];
-        const double kc_u_3 = P[8*n + j];
-        const double ks_u_3 = P[9*n + j];
-        const double E_u_1 = P[10*n + j];
-        const double g1 = P[12*n + j];
-        const double g3 = P[13*n + j];
-        const double g5 = P[14*n + j];
-        const double g7 = P[15*n + j];
-        const double t_0 = ((u)*(u));
-        DX[0*n + j] = du;
-        DX[1*n + j] = -E_u_1*((omega)*(omega))*(C0_1*q[0] - S0_1*q[1]) - 2*du*xi_u_u + f_u - kappa_u_u*u*(g1 + t_0*(g3 + t_0*(g5 + g7*t_0)))*(C0_1*kc_u_1 + C0_2*kc_u_2 + C0_3*kc_u_3 + S0_1*ks_u_1 + S0_2*ks_u_2 + S0_3*ks_u_3 + 1);
+        const double m_u = X[0*n + j];
+        const double m_du = X[1*n + j];
+        const double m_omega = P[0*n + j];
+        const double m_f_u = P[1*n + j];
+        const double m_xi_u_u = P[2*n + j];
+        const double m_kappa_u_u = P[3*n + j];
+        const double m_kc_u_1 = P[4*n + j];
+        const double m_ks_u_1 = P[5*n + j];
+        const double m_kc_u_2 = P[6*n + j];
+        const double m_ks_u_2 = P[7*n + j];
+        const double m_kc_u_3 = P[8*n + j];
+        const double m_ks_u_3 = P[9*n + j];
+        const double m_E_u_1 = P[10*n + j];
+        const double m_g1 = P[12*n + j];
+        const double m_g3 = P[13*n + j];
+        const double m_g5 = P[14*n + j];
+        const double m_g7 = P[15*n + j];
+        const double t_0 = ((m_u)*(m_u));
+        DX[0*n + j] = m_du;
+        DX[1*n + j] = -m_E_u_1*((m_omega)*(m_omega))*(C0_1*q[0] - S0_1*q[1]) - 2*m_du*m_xi_u_u + m_f_u - m_kappa_u_u*m_u*(m_g1 + t_0*(m_g3 + t_0*(m_g5 + m_g7*t_0)))*(C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1);
     }
     (void)tau; (void)P; (void)Q;
 }
@@ -198,50 +200,50 @@ C_SOURCE_VARIATIONAL = r"""
 
 static void gs_prep(const double *p, double *q)
 {
-    const double psi_u_1 = p[11];
-    q[0] = cos(psi_u_1);
-    q[1] = sin(psi_u_1);
+    const double m_psi_u_1 = p[11];
+    q[0] = cos(m_psi_u_1);
+    q[1] = sin(m_psi_u_1);
     (void)p; (void)q;
 }
 
 static inline void gs_rhs(double tau, const double *x, const double *p, const double *q, double *dx)
 {
-    const double u = x[0];
-    const double du = x[1];
+    const double m_u = x[0];
+    const double m_du = x[1];
     const double w0 = x[2];
     const double w1 = x[3];
-    const double omega = p[0];
-    const double f_u = p[1];
-    const double xi_u_u = p[2];
-    const double kappa_u_u = p[3];
-    const double kc_u_1 = p[4];
-    const double ks_u_1 = p[5];
-    const double kc_u_2 = p[6];
-    const double ks_u_2 = p[7];
-    const double kc_u_3 = p[8];
-    const double ks_u_3 = p[9];
-    const double E_u_1 = p[10];
-    const double g1 = p[12];
-    const double g3 = p[13];
-    const double g5 = p[14];
-    const double g7 = p[15];
-    const double th0 = (omega)*tau;
+    const double m_omega = p[0];
+    const double m_f_u = p[1];
+    const double m_xi_u_u = p[2];
+    const double m_kappa_u_u = p[3];
+    const double m_kc_u_1 = p[4];
+    const double m_ks_u_1 = p[5];
+    const double m_kc_u_2 = p[6];
+    const double m_ks_u_2 = p[7];
+    const double m_kc_u_3 = p[8];
+    const double m_ks_u_3 = p[9];
+    const double m_E_u_1 = p[10];
+    const double m_g1 = p[12];
+    const double m_g3 = p[13];
+    const double m_g5 = p[14];
+    const double m_g7 = p[15];
+    const double th0 = (m_omega)*tau;
     const double C0_1 = cos(th0), S0_1 = sin(th0);
     const double C0_2 = C0_1*C0_1 - S0_1*S0_1;
     const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
     const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
     const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
-    const double t_0 = 2*xi_u_u;
-    const double t_1 = ((u)*(u));
-    const double t_2 = g5 + g7*t_1;
-    const double t_3 = g3 + t_1*t_2;
-    const double t_4 = kappa_u_u*(C0_1*kc_u_1 + C0_2*kc_u_2 + C0_3*kc_u_3 + S0_1*ks_u_1 + S0_2*ks_u_2 + S0_3*ks_u_3 + 1);
-    const double t_5 = t_4*(g1 + t_1*t_3);
-    const double t_6 = 2*u;
-    dx[0] = du;
-    dx[1] = -E_u_1*((omega)*(omega))*(C0_1*q[0] - S0_1*q[1]) - du*t_0 + f_u - t_5*u;
+    const double t_0 = 2*m_xi_u_u;
+    const double t_1 = ((m_u)*(m_u));
+    const double t_2 = m_g5 + m_g7*t_1;
+    const double t_3 = m_g3 + t_1*t_2;
+    const double t_4 = m_kappa_u_u*(C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1);
+    const double t_5 = t_4*(m_g1 + t_1*t_3);
+    const double t_6 = 2*m_u;
+    dx[0] = m_du;
+    dx[1] = -m_E_u_1*((m_omega)*(m_omega))*(C0_1*q[0] - S0_1*q[1]) - m_du*t_0 + m_f_u - t_5*m_u;
     dx[2] = w1;
-    dx[3] = -t_0*w1 + w0*(-t_4*u*(t_1*(2*g7*((u)*(u)*(u)) + t_2*t_6) + t_3*t_6) - t_5);
+    dx[3] = -t_0*w1 + w0*(-t_4*m_u*(t_1*(2*m_g7*((m_u)*(m_u)*(m_u)) + t_2*t_6) + t_3*t_6) - t_5);
     (void)tau; (void)p; (void)q;
 }
 
@@ -257,36 +259,36 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
         for (int k = 0; k < GS_NQ; ++k) q[k] = Q[k*n + j];
-        const double u = X[0*n + j];
-        const double du = X[1*n + j];
+        const double m_u = X[0*n + j];
+        const double m_du = X[1*n + j];
         const double w0 = X[2*n + j];
         const double w1 = X[3*n + j];
-        const double omega = P[0*n + j];
-        const double f_u = P[1*n + j];
-        const double xi_u_u = P[2*n + j];
-        const double kappa_u_u = P[3*n + j];
-        const double kc_u_1 = P[4*n + j];
-        const double ks_u_1 = P[5*n + j];
-        const double kc_u_2 = P[6*n + j];
-        const double ks_u_2 = P[7*n + j];
-        const double kc_u_3 = P[8*n + j];
-        const double ks_u_3 = P[9*n + j];
-        const double E_u_1 = P[10*n + j];
-        const double g1 = P[12*n + j];
-        const double g3 = P[13*n + j];
-        const double g5 = P[14*n + j];
-        const double g7 = P[15*n + j];
-        const double t_0 = 2*xi_u_u;
-        const double t_1 = ((u)*(u));
-        const double t_2 = g5 + g7*t_1;
-        const double t_3 = g3 + t_1*t_2;
-        const double t_4 = kappa_u_u*(C0_1*kc_u_1 + C0_2*kc_u_2 + C0_3*kc_u_3 + S0_1*ks_u_1 + S0_2*ks_u_2 + S0_3*ks_u_3 + 1);
-        const double t_5 = t_4*(g1 + t_1*t_3);
-        const double t_6 = 2*u;
-        DX[0*n + j] = du;
-        DX[1*n + j] = -E_u_1*((omega)*(omega))*(C0_1*q[0] - S0_1*q[1]) - du*t_0 + f_u - t_5*u;
+        const double m_omega = P[0*n + j];
+        const double m_f_u = P[1*n + j];
+        const double m_xi_u_u = P[2*n + j];
+        const double m_kappa_u_u = P[3*n + j];
+        const double m_kc_u_1 = P[4*n + j];
+        const double m_ks_u_1 = P[5*n + j];
+        const double m_kc_u_2 = P[6*n + j];
+        const double m_ks_u_2 = P[7*n + j];
+        const double m_kc_u_3 = P[8*n + j];
+        const double m_ks_u_3 = P[9*n + j];
+        const double m_E_u_1 = P[10*n + j];
+        const double m_g1 = P[12*n + j];
+        const double m_g3 = P[13*n + j];
+        const double m_g5 = P[14*n + j];
+        const double m_g7 = P[15*n + j];
+        const double t_0 = 2*m_xi_u_u;
+        const double t_1 = ((m_u)*(m_u));
+        const double t_2 = m_g5 + m_g7*t_1;
+        const double t_3 = m_g3 + t_1*t_2;
+        const double t_4 = m_kappa_u_u*(C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1);
+        const double t_5 = t_4*(m_g1 + t_1*t_3);
+        const double t_6 = 2*m_u;
+        DX[0*n + j] = m_du;
+        DX[1*n + j] = -m_E_u_1*((m_omega)*(m_omega))*(C0_1*q[0] - S0_1*q[1]) - m_du*t_0 + m_f_u - t_5*m_u;
         DX[2*n + j] = w1;
-        DX[3*n + j] = -t_0*w1 + w0*(-t_4*u*(t_1*(2*g7*((u)*(u)*(u)) + t_2*t_6) + t_3*t_6) - t_5);
+        DX[3*n + j] = -t_0*w1 + w0*(-t_4*m_u*(t_1*(2*m_g7*((m_u)*(m_u)*(m_u)) + t_2*t_6) + t_3*t_6) - t_5);
     }
     (void)tau; (void)P; (void)Q;
 }
@@ -295,31 +297,31 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
 
 def rhs(tau, x, p):
     """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); result (n,) or (n, N)."""
-    u = x[0]
-    du = x[1]
-    omega = p[0]
-    f_u = p[1]
-    xi_u_u = p[2]
-    kappa_u_u = p[3]
-    kc_u_1 = p[4]
-    ks_u_1 = p[5]
-    kc_u_2 = p[6]
-    ks_u_2 = p[7]
-    kc_u_3 = p[8]
-    ks_u_3 = p[9]
-    E_u_1 = p[10]
-    psi_u_1 = p[11]
-    g1 = p[12]
-    g3 = p[13]
-    g5 = p[14]
-    g7 = p[15]
-    _t0 = omega*tau
-    _t1 = u**2
+    m_u = x[0]
+    m_du = x[1]
+    m_omega = p[0]
+    m_f_u = p[1]
+    m_xi_u_u = p[2]
+    m_kappa_u_u = p[3]
+    m_kc_u_1 = p[4]
+    m_ks_u_1 = p[5]
+    m_kc_u_2 = p[6]
+    m_ks_u_2 = p[7]
+    m_kc_u_3 = p[8]
+    m_ks_u_3 = p[9]
+    m_E_u_1 = p[10]
+    m_psi_u_1 = p[11]
+    m_g1 = p[12]
+    m_g3 = p[13]
+    m_g5 = p[14]
+    m_g7 = p[15]
+    _t0 = m_omega*tau
+    _t1 = m_u**2
     _t2 = 2*_t0
     _t3 = 3*_t0
     return np.array(np.broadcast_arrays(
-        du,
-        -E_u_1*omega**2*np.cos(_t0 + psi_u_1) - 2*du*xi_u_u + f_u - kappa_u_u*u*(_t1*(_t1*(_t1*g7 + g5) + g3) + g1)*(kc_u_1*np.cos(_t0) + kc_u_2*np.cos(_t2) + kc_u_3*np.cos(_t3) + ks_u_1*np.sin(_t0) + ks_u_2*np.sin(_t2) + ks_u_3*np.sin(_t3) + 1),
+        m_du,
+        -m_E_u_1*m_omega**2*np.cos(_t0 + m_psi_u_1) - 2*m_du*m_xi_u_u + m_f_u - m_kappa_u_u*m_u*(_t1*(_t1*(_t1*m_g7 + m_g5) + m_g3) + m_g1)*(m_kc_u_1*np.cos(_t0) + m_kc_u_2*np.cos(_t2) + m_kc_u_3*np.cos(_t3) + m_ks_u_1*np.sin(_t0) + m_ks_u_2*np.sin(_t2) + m_ks_u_3*np.sin(_t3) + 1),
     ))
 
 
@@ -381,66 +383,66 @@ def _check_stiffness(p):
 
 def jacobian(tau, x, p):
     """d rhs / d X, shape (n, n) or (n, n, N)."""
-    u = x[0]
-    omega = p[0]
-    xi_u_u = p[2]
-    kappa_u_u = p[3]
-    kc_u_1 = p[4]
-    ks_u_1 = p[5]
-    kc_u_2 = p[6]
-    ks_u_2 = p[7]
-    kc_u_3 = p[8]
-    ks_u_3 = p[9]
-    g1 = p[12]
-    g3 = p[13]
-    g5 = p[14]
-    g7 = p[15]
-    _t0 = u**2
-    _t1 = _t0*g7 + g5
-    _t2 = _t0*_t1 + g3
-    _t3 = omega*tau
+    m_u = x[0]
+    m_omega = p[0]
+    m_xi_u_u = p[2]
+    m_kappa_u_u = p[3]
+    m_kc_u_1 = p[4]
+    m_ks_u_1 = p[5]
+    m_kc_u_2 = p[6]
+    m_ks_u_2 = p[7]
+    m_kc_u_3 = p[8]
+    m_ks_u_3 = p[9]
+    m_g1 = p[12]
+    m_g3 = p[13]
+    m_g5 = p[14]
+    m_g7 = p[15]
+    _t0 = m_u**2
+    _t1 = _t0*m_g7 + m_g5
+    _t2 = _t0*_t1 + m_g3
+    _t3 = m_omega*tau
     _t4 = 2*_t3
     _t5 = 3*_t3
-    _t6 = kappa_u_u*(kc_u_1*np.cos(_t3) + kc_u_2*np.cos(_t4) + kc_u_3*np.cos(_t5) + ks_u_1*np.sin(_t3) + ks_u_2*np.sin(_t4) + ks_u_3*np.sin(_t5) + 1)
-    _t7 = 2*u
+    _t6 = m_kappa_u_u*(m_kc_u_1*np.cos(_t3) + m_kc_u_2*np.cos(_t4) + m_kc_u_3*np.cos(_t5) + m_ks_u_1*np.sin(_t3) + m_ks_u_2*np.sin(_t4) + m_ks_u_3*np.sin(_t5) + 1)
+    _t7 = 2*m_u
     return np.array(_broadcast(
         (0, 1,),
-        (-_t6*u*(_t0*(_t1*_t7 + 2*g7*u**3) + _t2*_t7) - _t6*(_t0*_t2 + g1), -2*xi_u_u,),
+        (-_t6*m_u*(_t0*(_t1*_t7 + 2*m_g7*m_u**3) + _t2*_t7) - _t6*(_t0*_t2 + m_g1), -2*m_xi_u_u,),
     ))
 
 
 def mesh_force(tau, x, p):
     """Dynamic force of each mesh over its k_m b: elastic k_hat(tau) g(u) plus viscous c u' (one damper per mesh); (m,) or (m, N)."""
-    u = x[0]
-    du = x[1]
-    omega = p[0]
-    xi_u_u = p[2]
-    kappa_u_u = p[3]
-    kc_u_1 = p[4]
-    ks_u_1 = p[5]
-    kc_u_2 = p[6]
-    ks_u_2 = p[7]
-    kc_u_3 = p[8]
-    ks_u_3 = p[9]
-    g1 = p[12]
-    g3 = p[13]
-    g5 = p[14]
-    g7 = p[15]
-    _t0 = u**2
-    _t1 = omega*tau
+    m_u = x[0]
+    m_du = x[1]
+    m_omega = p[0]
+    m_xi_u_u = p[2]
+    m_kappa_u_u = p[3]
+    m_kc_u_1 = p[4]
+    m_ks_u_1 = p[5]
+    m_kc_u_2 = p[6]
+    m_ks_u_2 = p[7]
+    m_kc_u_3 = p[8]
+    m_ks_u_3 = p[9]
+    m_g1 = p[12]
+    m_g3 = p[13]
+    m_g5 = p[14]
+    m_g7 = p[15]
+    _t0 = m_u**2
+    _t1 = m_omega*tau
     _t2 = 2*_t1
     _t3 = 3*_t1
     return np.array(np.broadcast_arrays(
-        2*du*xi_u_u/kappa_u_u + u*(_t0*(_t0*(_t0*g7 + g5) + g3) + g1)*(kc_u_1*np.cos(_t1) + kc_u_2*np.cos(_t2) + kc_u_3*np.cos(_t3) + ks_u_1*np.sin(_t1) + ks_u_2*np.sin(_t2) + ks_u_3*np.sin(_t3) + 1),
+        2*m_du*m_xi_u_u/m_kappa_u_u + m_u*(_t0*(_t0*(_t0*m_g7 + m_g5) + m_g3) + m_g1)*(m_kc_u_1*np.cos(_t1) + m_kc_u_2*np.cos(_t2) + m_kc_u_3*np.cos(_t3) + m_ks_u_1*np.sin(_t1) + m_ks_u_2*np.sin(_t2) + m_ks_u_3*np.sin(_t3) + 1),
     ), dtype=float)
 
 
 def static_mesh_force(p):
     """Static force of each mesh over its k_m b: kappa F = f at the mean stiffness."""
-    f_u = p[1]
-    kappa_u_u = p[3]
-    K = np.array([[kappa_u_u]], dtype=float)
-    f = np.array([f_u], dtype=float)
+    m_f_u = p[1]
+    m_kappa_u_u = p[3]
+    K = np.array([[m_kappa_u_u]], dtype=float)
+    f = np.array([m_f_u], dtype=float)
     return np.linalg.solve(K, f)
 
 
@@ -457,31 +459,31 @@ def casadi_functions():
     tau = ca.SX.sym('tau')
     x = ca.SX.sym('x', 2)
     p = ca.SX.sym('p', 16)
-    u = x[0]
-    du = x[1]
-    omega = p[0]
-    f_u = p[1]
-    xi_u_u = p[2]
-    kappa_u_u = p[3]
-    kc_u_1 = p[4]
-    ks_u_1 = p[5]
-    kc_u_2 = p[6]
-    ks_u_2 = p[7]
-    kc_u_3 = p[8]
-    ks_u_3 = p[9]
-    E_u_1 = p[10]
-    psi_u_1 = p[11]
-    g1 = p[12]
-    g3 = p[13]
-    g5 = p[14]
-    g7 = p[15]
-    _t0 = omega*tau
-    _t1 = u**2
+    m_u = x[0]
+    m_du = x[1]
+    m_omega = p[0]
+    m_f_u = p[1]
+    m_xi_u_u = p[2]
+    m_kappa_u_u = p[3]
+    m_kc_u_1 = p[4]
+    m_ks_u_1 = p[5]
+    m_kc_u_2 = p[6]
+    m_ks_u_2 = p[7]
+    m_kc_u_3 = p[8]
+    m_ks_u_3 = p[9]
+    m_E_u_1 = p[10]
+    m_psi_u_1 = p[11]
+    m_g1 = p[12]
+    m_g3 = p[13]
+    m_g5 = p[14]
+    m_g7 = p[15]
+    _t0 = m_omega*tau
+    _t1 = m_u**2
     _t2 = 2*_t0
     _t3 = 3*_t0
     xdot = ca.vertcat(
-        du,
-        -E_u_1*omega**2*ca.cos(_t0 + psi_u_1) - 2*du*xi_u_u + f_u - kappa_u_u*u*(_t1*(_t1*(_t1*g7 + g5) + g3) + g1)*(kc_u_1*ca.cos(_t0) + kc_u_2*ca.cos(_t2) + kc_u_3*ca.cos(_t3) + ks_u_1*ca.sin(_t0) + ks_u_2*ca.sin(_t2) + ks_u_3*ca.sin(_t3) + 1),
+        m_du,
+        -m_E_u_1*m_omega**2*ca.cos(_t0 + m_psi_u_1) - 2*m_du*m_xi_u_u + m_f_u - m_kappa_u_u*m_u*(_t1*(_t1*(_t1*m_g7 + m_g5) + m_g3) + m_g1)*(m_kc_u_1*ca.cos(_t0) + m_kc_u_2*ca.cos(_t2) + m_kc_u_3*ca.cos(_t3) + m_ks_u_1*ca.sin(_t0) + m_ks_u_2*ca.sin(_t2) + m_ks_u_3*ca.sin(_t3) + 1),
     )
     f = ca.Function('rhs', [tau, x, p], [xdot], ['tau', 'x', 'p'], ['xdot'])
     j = ca.Function('jacobian', [tau, x, p], [ca.jacobian(xdot, x)],
