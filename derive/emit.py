@@ -206,7 +206,8 @@ def _docstring(model: Model, command: str) -> str:
         "CONTRACT states as data what a solver needs: velocity indices, forcing frequency,",
         "loads, contact edges, piecewise or smooth, switching surfaces, valid range.",
         "",
-        f"Model symbols are namespaced in the code: state or parameter NAME is {code_name('NAME')}.",
+        "Model symbols are namespaced in the code: state or parameter NAME is "
+        f"{code_name('NAME')}.",
     ]
     # Names, paths and meanings are the user's text: escaped, so that none can end the
     # docstring or a line (derive/escape.py).

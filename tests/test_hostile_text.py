@@ -153,9 +153,7 @@ def _topology_with_coordinates(root, folder, u, v):
 
 
 @pytest.mark.parametrize("u,v", [("int", "q"), ("NAN", "restrict"), ("X", "th0")])
-def test_a_coordinate_named_like_a_c_word_compiles_and_simulates(
-    u, v, root, tmp_path, monkeypatch
-):
+def test_a_coordinate_named_like_a_c_word_compiles_and_simulates(u, v, root, tmp_path, monkeypatch):
     """The compiled right-hand side of a model whose coordinates are C words (``int``,
     ``NAN``, ...) or names of the generated code (``q``, ``X``, ``th0``) builds, and its
     compiled simulation agrees with SciPy's on the same model (rtol 1e-8 runs: 1e-6)."""
