@@ -24,6 +24,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from ._input import InputError, Table, nearest
+from .escape import markdown
 
 __all__ = [
     "ORIENTATIONS",
@@ -128,7 +129,7 @@ def reading_section(model) -> str:
     nd = model.nondim
     lines = [
         f"## Reading of the loads: `{reading.id}`\n",
-        (reading.description + ". " if reading.description else "")
+        (markdown(reading.description) + ". " if reading.description else "")
         + "The reading sets the orientation $s_i$ of each mesh coordinate and the sign "
         "$\\sigma_k$ of each input torque; the scene gives each load as a size, and its sign "
         "is that of $\\partial f_i/\\partial T_k$ (from the load term of section 8) times "
