@@ -11,6 +11,10 @@ every step, the exponent's variational system beside the state):
   default: coordinates from one half backlash beyond the lower contact edge to one beyond
   the upper, velocities in [-1, 1]); each draw depends only on (seed, grid point, k).
 
+Without a working C compiler the runs go through SciPy's integrators instead (the same
+results to the tolerance, much slower: ``integrate/native/fallback.py``), after one warning
+line; which one runs is decided once, here, not in every worker.
+
 Each run is classified and the runs of a grid point grouped into attractors
 (``attractors.py``).  Work goes in tasks -- the forward chain, the backward chain, and one
 task per column of random starts -- run serially, on local processes or with dask
@@ -31,7 +35,7 @@ import numpy as np
 
 from .._json import dumps
 from ..contract import load_generated
-from ..integrate.native.maps import run_map
+from ..integrate.native.maps import map_backend, run_map
 from ..integrate.simulate import default_initial_state
 from ..system import System
 from .attractors import RunOutcome, group_runs, outcome
@@ -88,6 +92,7 @@ def _run_column(col: _Column, X0: np.ndarray, opts: dict) -> list[RunOutcome]:
             X0[idx],
             lyapunov_periods=opts["lyapunov_periods"],
             seed=opts["seed"],
+            backend=opts["backends"][f],
             **run_opts,
         )
         base = System(module, col.P[idx[0]])
@@ -262,14 +267,18 @@ def regime_map(
         files = tuple(g.module.__file__ for g in cells)
         return _Column(ix, kind, files, tuple(g.p for g in cells), None, (kind,) * len(cells))
 
+    # the compiled library of every model, built once here (or the fallback, warned once)
+    tangent = lyapunov_periods > 0
+    models = {g.module.__file__: g.module for col in grid for g in col}
+    run_opts = {**opts, "backends": {f: map_backend(m, tangent) for f, m in models.items()}}
     tasks = []
     chains = {"forward": range(len(xv)), "backward": range(len(xv) - 1, -1, -1)}
     for kind in list(chains)[: min(initial_states, 2)]:
         order = list(chains[kind])
         first = np.array([default_initial_state(g) for g in grid[order[0]]])
-        tasks.append(([column(ix, kind) for ix in order], first, opts, root))
+        tasks.append(([column(ix, kind) for ix in order], first, run_opts, root))
     if n_random:
-        tasks += [([column(ix, "random")], None, opts, root) for ix in range(len(xv))]
+        tasks += [([column(ix, "random")], None, run_opts, root) for ix in range(len(xv))]
     bar = Progress(len(tasks), "map", enabled=progress)
     results = map_tasks(
         _task,

@@ -23,13 +23,22 @@ from ..events import escape_event
 from ..tableau import RK4, rk_step
 from .build import NativeUnavailable, library
 
-__all__ = ["NATIVE_METHODS", "STATUS", "BatchResult", "benettin", "run_batch"]
+__all__ = ["NATIVE_METHODS", "STATUS", "BatchResult", "benettin", "fallback_warning", "run_batch"]
 
 NATIVE_METHODS = ("dopri5", "dop853", "rk4")
 _CODES = {"dopri5": 0, "dop853": 1, "rk4": 2}
 STATUS = {0: "ok", 1: "divergent", 2: "too many steps", 3: "not finite", 4: "step too small",
           5: "left the valid range"}  # fmt: skip
 _warned: set[str] = set()
+
+
+def fallback_warning(err: Exception, instead: str = "integrating with NumPy instead") -> None:
+    """The one warning line of a run that goes without the compiled library: why, and what
+    runs instead; once per reason and session (``native.reset`` forgets)."""
+    text = f"{err}; {instead} (slower)"
+    if text not in _warned:
+        _warned.add(text)
+        warnings.warn(text, stacklevel=3)
 
 
 @dataclass(frozen=True)
@@ -157,9 +166,7 @@ def run_batch(
     except NativeUnavailable as err:
         if not fallback:
             raise
-        if str(err) not in _warned:
-            _warned.add(str(err))
-            warnings.warn(f"{err}; integrating with NumPy instead (slower)", stacklevel=2)
+        fallback_warning(err)
         return _numpy_batch(module, P, X0, t, period, started, opts)
     N = P.shape[0]
     out = np.empty((N, k, n))

@@ -44,7 +44,9 @@ _failed: dict[str, str] = {}  # cache key -> why it could not be built (once per
 
 
 class NativeUnavailable(RuntimeError):
-    """No C compiler, or the compilation failed: the NumPy path is used instead."""
+    """No C compiler, or the compilation failed: the NumPy path is used instead.  A
+    compiler that fails on a model's C text is a bug; its output is saved beside the
+    library it should have built (``<name>-<key>.log`` in :func:`cache_dir`)."""
 
 
 def compiler() -> str | None:
@@ -112,6 +114,32 @@ def _compiler_id(cc: str) -> str:
     return version + "|" + cpu
 
 
+def _bug_report(module, cc: str, path: Path, c_file: Path, done) -> str:
+    """Save the compiler's full output (and the C text it was given) beside the library it
+    should have made, and return the one line that says so: the C code of a model that
+    derives is valid by construction, so a failing compile is a bug to report."""
+    log, kept = path.with_suffix(".log"), path.with_suffix(".c")
+    how = f"exit status {done.returncode}" if done.returncode else "no library written"
+    lines = [
+        f"$ {cc} {' '.join(_FLAGS)} -o lib.so {kept.name} -lm",
+        f"({how})",
+        "--- stdout ---",
+        done.stdout or "",
+        "--- stderr ---",
+        done.stderr or "",
+    ]
+    try:
+        shutil.copyfile(c_file, kept)
+        log.write_text("\n".join(lines), encoding="utf-8")
+        saved = f"the compiler's full output is in {log}"
+    except OSError as err:
+        saved = f"the compiler's output could not be saved: {err.strerror or err}"
+    return (
+        f"compiling the C code of {module.NAME} with {cc} failed ({how}); this is a bug, "
+        f"please report it ({saved})"
+    )
+
+
 def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
     """Compile (or load from the cache) the native library of ``module``.
 
@@ -161,16 +189,22 @@ def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
                     timeout=300,
                 )
             except (OSError, subprocess.SubprocessError) as err:
-                _failed[key] = f"the C compiler {cc} could not be run: {err}"
+                _failed[key] = f"the C compiler {cc} could not be run ({err})"
                 raise NativeUnavailable(_failed[key]) from None
-            if done.returncode != 0:
-                first = (done.stderr or done.stdout).strip().splitlines()[:3]
-                _failed[key] = f"compiling {module.NAME} failed: {' / '.join(first)}"
+            if done.returncode != 0 or not so.exists():
+                _failed[key] = _bug_report(module, cc, path, c_file, done)
                 raise NativeUnavailable(_failed[key])
             os.replace(so, path)  # atomic: parallel workers never see half a library
         facts.update(compiled=True, seconds=time.perf_counter() - started)
     _paths[memo] = path
-    lib = ctypes.CDLL(str(path))
+    try:
+        lib = ctypes.CDLL(str(path))
+    except OSError as err:
+        # a library that does not load (cut short on disk, another CPU's): build it anew
+        # next time, and say why this run goes without it
+        path.unlink(missing_ok=True)
+        _failed[key] = f"the compiled library {path} could not be loaded ({err})"
+        raise NativeUnavailable(_failed[key]) from None
     d, i, ll = ctypes.c_double, ctypes.c_int, ctypes.c_longlong
     ptr = np.ctypeslib.ndpointer
     lib.gs_run.restype = i

@@ -15,8 +15,10 @@ step per point:
   exponents for smooth dynamical systems", Meccanica 15); ``log |w|`` is summed over the
   last ``lyapunov_periods`` periods of the run, so the first periods align the vector.
 
-Raises :class:`~.build.NativeUnavailable` without a compiler (the map layer then takes the
-slower path of ``run_batch`` and ``largest_lyapunov``).
+Without a working compiler (``backend="auto"``) the same runs go through SciPy's
+integrators point by point (``fallback.py``: the same fields with the same meaning,
+some 300 times slower), with one warning line; ``backend="native"`` raises
+:class:`~.build.NativeUnavailable` instead.
 """
 
 from __future__ import annotations
@@ -27,10 +29,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...contract import Contract, load_generated
-from .batch import _CODES, STATUS
-from .build import library
+from .batch import _CODES, STATUS, fallback_warning
+from .build import NativeUnavailable, library
+from .fallback import numpy_map
 
-__all__ = ["MAP_STATUS", "MapRun", "run_map"]
+__all__ = ["MAP_BACKENDS", "MAP_STATUS", "MapRun", "map_backend", "run_map"]
+
+MAP_BACKENDS = ("auto", "native", "numpy")
 
 MAP_STATUS = {**STATUS, 5: "left the valid range"}
 
@@ -39,7 +44,7 @@ MAP_STATUS = {**STATUS, 5: "left the valid range"}
 class MapRun:
     """What a map keeps of N runs: ``poincare`` (N, periods + 1, n), ``xmin``/``xmax``
     (N, n), ``lyapunov`` (N, L) running exponent or None, per-run work and status; the
-    final state of run i is ``poincare[i, -1]``."""
+    final state of run i is ``poincare[i, -1]``; ``backend``: "native" or "numpy"."""
 
     poincare: np.ndarray
     xmin: np.ndarray
@@ -50,11 +55,25 @@ class MapRun:
     status: tuple[str, ...]
     t_fail: np.ndarray
     wall_time: float
+    backend: str = "native"
 
 
 def _tangent(n: int, seed: int) -> np.ndarray:
     v = np.random.default_rng(seed).standard_normal(n)
     return v / np.linalg.norm(v)
+
+
+def map_backend(module, lyapunov: bool) -> str:
+    """The backend of a map run: "native" when the library of ``module`` (with the
+    tangent vector's variational system when ``lyapunov``) compiles or is cached, else
+    "numpy" after the one warning line.  The map layer asks once in the parent process,
+    so workers neither compile nor warn again."""
+    try:
+        library(module, variational=lyapunov)
+    except NativeUnavailable as err:
+        fallback_warning(err)
+        return "numpy"
+    return "native"
 
 
 def run_map(
@@ -73,12 +92,16 @@ def run_map(
     group: int = 64,
     seed: int = 0,
     workers: int = 1,
+    backend: str = "auto",
 ) -> MapRun:
     """Integrate ``P`` (N, P) from ``X0`` (N, n) over ``transient + periods`` forcing
     periods ``T = 2 pi / omega``; see the module text for what is kept.  ``workers`` > 1
-    splits the points over as many processes."""
+    splits the points over as many processes.  ``backend``: "native" (the compiled
+    engine), "numpy" (SciPy, ``fallback.py``) or "auto" (native when it builds)."""
     if method not in ("dopri5", "dop853"):
         raise ValueError(f"maps run with 'dopri5' or 'dop853', got {method!r}")
+    if backend not in MAP_BACKENDS:
+        raise ValueError(f"unknown map backend {backend!r}; backends: {', '.join(MAP_BACKENDS)}")
     P = np.ascontiguousarray(np.atleast_2d(np.asarray(P, dtype=float)))
     X0 = np.ascontiguousarray(np.atleast_2d(np.asarray(X0, dtype=float)))
     contract = Contract.of(module)
@@ -108,7 +131,11 @@ def run_map(
     )
     started = time.perf_counter()
     tangent = lyapunov_periods > 0
-    library(module, variational=tangent)  # compile here once, not in every worker
+    if backend == "auto":  # compile here once, not in every worker
+        backend = map_backend(module, tangent)
+    elif backend == "native":
+        library(module, variational=tangent)
+    opts["backend"] = backend
     N = P.shape[0]
     if workers > 1 and N > 1:
         from ...sweep.executor import map_tasks
@@ -129,6 +156,7 @@ def run_map(
         status=tuple(s for r in parts for s in r.status),
         t_fail=np.concatenate([r.t_fail for r in parts]),
         wall_time=time.perf_counter() - started,
+        backend=backend,
     )
 
 
@@ -138,7 +166,25 @@ def _chunk(task) -> MapRun:
 
 
 def _run(module, P, X0, *, method, rtol, atol, transient, periods, lyapunov_periods, bound,
-         max_steps, group, seed) -> MapRun:  # fmt: skip
+         max_steps, group, seed, backend) -> MapRun:  # fmt: skip
+    if backend == "numpy":
+        n = X0.shape[1]
+        w0 = _tangent(n, seed) if lyapunov_periods > 0 else None
+        fields = numpy_map(
+            module,
+            P,
+            X0,
+            w0,
+            method=method,
+            rtol=rtol,
+            atol=atol,
+            transient=transient,
+            periods=periods,
+            lyapunov_periods=lyapunov_periods,
+            bound=bound,
+            max_steps=max_steps,
+        )
+        return MapRun(**fields, backend="numpy")
     contract = Contract.of(module)
     n = len(contract.states)
     tangent = lyapunov_periods > 0

@@ -12,12 +12,11 @@ a compiler the same runs go through SciPy's DOP853 point by point, with a warnin
 from __future__ import annotations
 
 import time
-import warnings
 
 import numpy as np
 
 from ...contract import Contract
-from .batch import _CODES, STATUS, BatchResult
+from .batch import _CODES, STATUS, BatchResult, fallback_warning
 from .build import NativeUnavailable, library
 
 __all__ = ["run_phase"]
@@ -63,7 +62,7 @@ def run_phase(
     try:
         lib, facts = library(module)
     except NativeUnavailable as err:
-        warnings.warn(f"{err}; running SciPy's DOP853 point by point", stacklevel=2)
+        fallback_warning(err, "integrating with SciPy's DOP853 point by point instead")
         return _scipy(module, P, X0, s, iw, rtol, atol, bound, started)
     out = np.empty((N, k, n))
     nfev = np.zeros(N, dtype=np.int64)

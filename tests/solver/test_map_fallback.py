@@ -1,0 +1,161 @@
+"""Maps without a compiler (issue 23, item 4): the SciPy fallback of the map engine
+(``integrate/native/fallback.py``) against the compiled engine, and a compiler that is
+missing or fails as one warning line on the command line.
+
+Tolerances, from the integration tolerance ``rtol`` (``atol`` = 1e-10 is far below the
+states, of order 1):
+
+* Poincare points: both engines integrate the same equations with the local error held
+  to ``rtol |x|`` per step; on these contracting period-1 orbits (exponent about -0.03
+  per tau, so the multipliers shrink errors by 0.68 per period) local errors do not pile
+  up, each engine's global error stays within a few ``rtol |x|`` and the two differ by
+  at most ``10 rtol max|x|`` (measured: 0.2 rtol max|x| at rtol 1e-8).
+* Exponents: each period adds ``log |w|`` with the relative error of the tangent vector,
+  a few ``rtol``; the mean over the summed periods, per unit tau, then differs by at most
+  ``10 rtol / T`` (measured: 0.35 rtol / T).
+* Extremes are taken at accepted steps, which the engines place differently: a sinusoid
+  of range R sampled at steps up to twice the mean step ``T / m`` (m accepted steps per
+  period) misses its extreme by at most ``R (1 - cos(2 pi / m)) / 2`` (measured: a tenth
+  of that).
+"""
+
+import os
+import subprocess
+import sys
+import warnings
+
+import numpy as np
+import pytest
+from gearsym.solver.integrate import native
+from gearsym.solver.integrate.native.maps import run_map
+from gearsym.solver.sweep.atlas import regime_map
+from gearsym.solver.system import System
+
+RTOL = 1e-8
+GEARSYM = [sys.executable, "-m", "gearsym.cli"]
+SMALL = ["--transient", "10", "--periods", "4", "--lyapunov-periods", "8", "--quiet"]
+
+
+@pytest.fixture
+def no_compiler(monkeypatch):
+    """GEARSYM_CC=none, with this session's loaded libraries, failed builds and warnings
+    forgotten before and after (``native.reset``)."""
+    native.reset()
+    monkeypatch.setenv("GEARSYM_CC", "none")
+    yield
+    native.reset()
+
+
+def _compiled(fn):
+    native.reset()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no fallback on this side
+        return fn()
+
+
+def test_fallback_fills_every_field_as_the_compiled_engine(no_compiler, monkeypatch):
+    s = System.load("reference_light")
+    P = np.array(
+        [s.parameters_with(**{"lambda": a, "f1": b}) for a in (0, 0.5, 1) for b in (0.1, 0.2)]
+    )
+    X0 = np.tile([1.0, 0.0, 0.0, 0.0], (len(P), 1))
+    kw = dict(transient=20, periods=10, lyapunov_periods=20, rtol=RTOL, atol=1e-10)
+    with pytest.warns(UserWarning, match="no C compiler found.*NumPy instead"):
+        got = run_map(s.module, P, X0, **kw)
+    with pytest.raises(native.NativeUnavailable):
+        run_map(s.module, P, X0, backend="native", **kw)
+    monkeypatch.delenv("GEARSYM_CC")
+    ref = _compiled(lambda: run_map(s.module, P, X0, backend="native", **kw))
+    assert (got.backend, ref.backend) == ("numpy", "native")
+    assert got.status == ref.status == ("ok",) * len(P)
+    assert got.poincare.shape == ref.poincare.shape == (len(P), 11, 4)
+    scale = np.max(np.abs(ref.poincare))
+    assert np.max(np.abs(got.poincare - ref.poincare)) <= 10 * RTOL * scale
+    assert got.lyapunov.shape == ref.lyapunov.shape == (len(P), 20)
+    assert np.max(np.abs(got.lyapunov - ref.lyapunov)) <= 10 * RTOL / s.period
+    for r in (got, ref):
+        assert np.all(r.xmin <= r.poincare.min(axis=1)) and np.all(r.xmax >= r.poincare.max(axis=1))
+    m = min(got.nsteps.min(), ref.nsteps.min()) / (kw["transient"] + kw["periods"])
+    miss = (ref.xmax - ref.xmin) * (1 - np.cos(2 * np.pi / m)) / 2
+    assert np.all(np.abs(got.xmax - ref.xmax) <= miss)
+    assert np.all(np.abs(got.xmin - ref.xmin) <= miss)
+    assert np.all(got.nfev > 0) and np.all(got.nsteps > 0) and np.all(np.isnan(got.t_fail))
+
+
+@pytest.mark.parametrize(("bound", "status"), [(1e3, "left the valid range"), (2.0, "divergent")])
+def test_fallback_stops_a_failing_point_as_the_compiled_engine(
+    no_compiler, monkeypatch, bound, status
+):
+    # a negative damping grows: it leaves the valid range |u|, |v| <= 3 first, or passes
+    # the escape bound when that is lower; the same status and time, NaN after, no exponent
+    s = System.load("reference_light")
+    P = np.array(
+        [s.parameters_with(**{"lambda": 0.8}), s.parameters_with(xi_u_u=-0.5, xi_v_v=-0.5)]
+    )
+    X0 = np.tile([1.0, 0.0, 0.0, 0.0], (2, 1))
+    kw = dict(transient=20, periods=5, lyapunov_periods=10, rtol=RTOL, atol=1e-10, bound=bound)
+    got = run_map(s.module, P, X0, backend="numpy", **kw)
+    monkeypatch.delenv("GEARSYM_CC")
+    ref = _compiled(lambda: run_map(s.module, P, X0, backend="native", **kw))
+    assert got.status == ref.status == ("ok", status)
+    assert np.all(np.isnan(got.poincare[1])) and np.all(np.isnan(got.lyapunov[1]))
+    assert np.all(np.isfinite(got.lyapunov[0]))
+    # each stops at the end of the accepted step that crossed: within a step of each other
+    # (both take 15 to 20 steps per period T here, see nsteps)
+    assert abs(got.t_fail[1] - ref.t_fail[1]) < s.period / 10
+
+
+def test_a_map_without_a_compiler_gives_the_compiled_verdicts(no_compiler, monkeypatch):
+    s = System.load("reference_light")
+    kw = dict(initial_states=2, transient=60, periods=20, lyapunov_periods=40)
+    kw.update(rtol=RTOL, executor="serial")
+    axes = (("lambda", np.linspace(0, 1, 3)), ("f1", np.array([0.1, 0.2])))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        got = regime_map(s, *axes, **kw)
+    assert [str(w.message) for w in caught if "NumPy instead" in str(w.message)] == [
+        "no C compiler found (install gcc or clang, or set GEARSYM_CC); integrating with "
+        "NumPy instead (slower)"
+    ]
+    monkeypatch.delenv("GEARSYM_CC")
+    ref = _compiled(lambda: regime_map(s, *axes, **kw))
+    for row_got, row_ref in zip(got.cells, ref.cells, strict=True):
+        for a, b in zip(row_got, row_ref, strict=True):
+            assert len(a.attractors) == len(b.attractors)
+            for ga, gb in zip(a.attractors, b.attractors, strict=True):
+                ra, rb = ga.run, gb.run
+                verdict_a = (ga.starts, ra.status, ra.motion, ra.period, ra.meshing)
+                assert verdict_a == (gb.starts, rb.status, rb.motion, rb.period, rb.meshing)
+                assert np.max(np.abs(ra.tail - rb.tail)) <= 10 * RTOL * np.max(np.abs(rb.tail))
+                assert abs(ra.lyapunov - rb.lyapunov) <= 10 * RTOL / s.period
+
+
+def _cli_map(tmp_path, cc: str):
+    env = os.environ | {"GEARSYM_CC": cc, "GEARSYM_CACHE": str(tmp_path / "cache")}
+    grid = ["--x=lambda=0:1:3", "--y=f1=0.1:0.2:2", "--initial-states=2"]
+    argv = ["map", "reference-light", *grid, *SMALL, f"--out={tmp_path / 'map'}"]
+    done = subprocess.run([*GEARSYM, *argv], capture_output=True, text=True, env=env)
+    return done.returncode, done.stderr.splitlines()
+
+
+def test_map_cli_without_a_compiler_is_one_warning_line(tmp_path):
+    code, lines = _cli_map(tmp_path, "none")
+    assert code == 0, lines
+    assert lines == [
+        "gearsym: warning: no C compiler found (install gcc or clang, or set GEARSYM_CC); "
+        "integrating with NumPy instead (slower)"
+    ]
+    assert (tmp_path / "map" / "map.json").exists()
+
+
+def test_a_compiler_that_fails_is_one_bug_report_line_and_still_a_map(tmp_path):
+    code, lines = _cli_map(tmp_path, "false")
+    assert code == 0, lines
+    assert len(lines) == 1, lines
+    line = lines[0]
+    assert line.startswith("gearsym: warning: compiling the C code of reference_light with ")
+    assert "failed (exit status 1); this is a bug, please report it" in line
+    assert line.endswith("; integrating with NumPy instead (slower)")
+    log = line.split("the compiler's full output is in ")[1].split(")")[0]
+    assert log.startswith(str(tmp_path / "cache")) and os.path.isfile(log)
+    assert (tmp_path / "map" / "map.json").exists()
