@@ -917,7 +917,9 @@ def main(argv: list[str] | None = None) -> int:
     command = "gearsym bench" + " --quick" * args.quick + " --docs" * args.docs
     write_doc(res, report, figure, command)
     if args.json:
-        print(json.dumps(res, indent=2))
+        from gearsym.solver._json import dumps
+
+        print(dumps(res, indent=2))
     else:
         print(f"wrote {report} and {figure}")
     return 0

@@ -16,7 +16,6 @@ Run through ``gearsym bench`` (a section of performance.md) or on its own:
 
 from __future__ import annotations
 
-import json
 import statistics
 import sys
 import time
@@ -147,5 +146,7 @@ def response_section(r: dict) -> list[str]:
 
 if __name__ == "__main__":
     res = response_speed("--quick" in sys.argv)
-    print(json.dumps(res, indent=1))
+    from gearsym.solver._json import dumps
+
+    print(dumps(res, indent=1))
     print("\n".join(response_section(res)))

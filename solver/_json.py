@@ -1,4 +1,10 @@
-"""JSON that other tools can read: non-finite numbers become null, never NaN."""
+"""JSON that other tools can read: non-finite numbers become null, never NaN.
+
+Every JSON the toolkit writes or prints goes through :func:`dumps` (strict JSON,
+``allow_nan=False``: RFC 8259 has no NaN or Infinity).  Where a null is not an ordinary
+"not computed" of the record, :func:`with_status` says which numbers were not finite and
+why, so that a reader can tell a missing value from a broken one.
+"""
 
 from __future__ import annotations
 
@@ -36,3 +42,34 @@ def clean(obj):
 
 def dumps(obj, **kwargs) -> str:
     return json.dumps(clean(obj), allow_nan=False, **kwargs)
+
+
+def non_finite(obj, where: str = "") -> list[str]:
+    """Where ``obj`` holds NaN or an infinity, in order, as ``modes[1].frequency_hz``."""
+    if isinstance(obj, dict):
+        return [
+            p for k, v in obj.items() for p in non_finite(v, f"{where}.{k}" if where else str(k))
+        ]
+    if isinstance(obj, list | tuple):
+        return [p for i, v in enumerate(obj) for p in non_finite(v, f"{where}[{i}]")]
+    if isinstance(obj, np.ndarray):
+        if obj.dtype.kind == "O":
+            return non_finite(obj.tolist(), where)
+        if obj.dtype.kind not in "fc":
+            return []
+        return [where + "".join(f"[{i}]" for i in idx) for idx in np.argwhere(~np.isfinite(obj))]
+    if isinstance(obj, float | np.floating) and not math.isfinite(obj):
+        return [where]
+    return []
+
+
+def with_status(obj: dict, why: str, *, shown: int = 5) -> dict:
+    """``obj``, plus a ``"status"`` when it holds non-finite numbers (written as null by
+    :func:`dumps`): how many, the first ``shown`` of them, and ``why``."""
+    bad = non_finite(obj)
+    if not bad:
+        return obj
+    more = f" and {len(bad) - shown} more" if len(bad) > shown else ""
+    key = "json_status" if "status" in obj else "status"
+    text = f"{len(bad)} non-finite number(s) written as null ({', '.join(bad[:shown])}{more})"
+    return {**obj, key: f"{text}: {why}"}

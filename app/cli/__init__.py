@@ -10,13 +10,16 @@
 * ``_common.py`` -- the one-line failure and the shared options.
 
 User errors (bad files, bad values) print one line and exit 2; ``--debug`` shows the
-traceback instead.
+traceback instead.  Unix manners: when the reader of the output goes away
+(``gearsym ... | head -1``) the command ends quietly, killed by SIGPIPE as ``cat`` is (the
+shell reports 141); Ctrl-C prints one line and exits 130, keeping what was stored.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
 
 # The commands parallelise over processes and their matrices are small: one BLAS thread
@@ -52,6 +55,55 @@ def _one_line_warning(message, category, filename, lineno, line=None) -> str:
     return f"gearsym: warning: {message}\n"
 
 
+def _say(line: str) -> None:
+    """One line on stderr; nothing when stderr itself is a closed pipe."""
+    try:
+        print(line, file=sys.stderr, flush=True)
+    except (OSError, ValueError):
+        pass
+
+
+def _reader_gone() -> bool:
+    """Whether stdout or stderr is a pipe (or socket) whose reader has closed it: poll
+    reports POLLERR on the write end then.  A broken pipe elsewhere (a connection to a
+    dask scheduler, say) is not the user closing the output."""
+    import select
+
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            poll = select.poll()
+            poll.register(stream.fileno(), select.POLLOUT)
+            if any(ev & (select.POLLERR | select.POLLHUP) for _, ev in poll.poll(0)):
+                return True
+        except (AttributeError, OSError, ValueError):  # no descriptor (captured output)
+            continue
+    return False
+
+
+def _closed_pipe(as_program: bool) -> int:
+    """End as ``cat`` does when its reader goes away: killed by SIGPIPE, no message.
+
+    The exception has already unwound the command (its pool is shut down, its stores
+    closed).  Run as the program, the process kills itself with SIGPIPE (exit status
+    141 in the shell, -13 from ``subprocess``) after pointing stdout at /dev/null, so
+    that nothing still buffered is flushed at exit into the closed pipe.  Called from
+    Python (``main([...])``) it returns 128 + SIGPIPE instead of ending the caller.
+    """
+    code = 128 + getattr(signal, "SIGPIPE", 13)
+    if not as_program:
+        return code
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.dup2(devnull, sys.stderr.fileno())
+    except (AttributeError, OSError, ValueError):
+        pass
+    if hasattr(signal, "SIGPIPE"):
+        signal.signal(signal.SIGPIPE, signal.SIG_DFL)
+        os.kill(os.getpid(), signal.SIGPIPE)
+    return code
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
@@ -59,8 +111,20 @@ def main(argv: list[str] | None = None) -> int:
         from gearsym.solver.integrate import fastest_method
 
         args.method = fastest_method(args.rtol)
+    try:
+        return _run(args)
+    except BrokenPipeError:
+        if not _reader_gone():
+            raise
+        return _closed_pipe(as_program=argv is None)
+
+
+def _run(args) -> int:
+    """Run the command; every failure a user can cause becomes one line and a status."""
     if args.debug:
-        return args.func(args)
+        code = args.func(args)
+        sys.stdout.flush()
+        return code
     import warnings
 
     from gearsym.derive import InputError
@@ -69,20 +133,28 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if getattr(args, "out", None) and args.command != "bench":  # bench checks its own
             out_folder(args.out)
-        return args.func(args)
+        code = args.func(args)
+        sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's exit
+        return code
     except (InputError, Fail) as err:
-        print(f"gearsym: error: {err}", file=sys.stderr)
+        _say(f"gearsym: error: {err}")
         return 2
     except RunFailed as err:
-        print(f"gearsym: run failed: {err}", file=sys.stderr)
+        _say(f"gearsym: run failed: {err}")
         return 3
+    except BrokenPipeError as err:
+        if _reader_gone():
+            raise  # main() ends quietly
+        _say(f"gearsym: error: a connection closed while writing ({err.strerror or err})")
+        return 2
     except OSError as err:
         # A file-system failure the checks before computing could not foresee (the disk
         # filling up, say): the file and the reason; what was stored so far stays.
         where = err.filename or "a file"
-        print(f"gearsym: error: cannot write or read {where} ({err.strerror or err}); "
-              "free space or choose another folder, and run again (finished work is kept)",
-              file=sys.stderr)  # fmt: skip
+        _say(
+            f"gearsym: error: cannot write or read {where} ({err.strerror or err}); "
+            "free space or choose another folder, and run again (finished work is kept)"
+        )
         return 2
     except ValueError as err:
         from gearsym.solver.sweep.store import SweepStoreError
@@ -90,14 +162,16 @@ def main(argv: list[str] | None = None) -> int:
         if not isinstance(err, SweepStoreError):
             raise
         # An output folder whose store holds another sweep or map (reproduce's, say).
-        print(f"gearsym: error: {err}", file=sys.stderr)
+        _say(f"gearsym: error: {err}")
         return 2
     except MemoryError:
-        print("gearsym: error: out of memory; ask for fewer periods, points or harmonics",
-              file=sys.stderr)  # fmt: skip
+        _say("gearsym: error: out of memory; ask for fewer periods, points or harmonics")
         return 2
     except KeyboardInterrupt:
-        print("gearsym: interrupted", file=sys.stderr)
+        # Every store (sweep, map) has its finished points already: the same command
+        # resumes from them.  On a terminal the progress line may be half drawn.
+        tty = getattr(sys.stderr, "isatty", lambda: False)()
+        _say(("\n" if tty else "") + "gearsym: interrupted")
         return 130
     finally:
         warnings.formatwarning = shown

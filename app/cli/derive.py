@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
@@ -106,7 +105,7 @@ def _cmd_derive(args) -> int:
     from gearsym.derive.build import (
         build_files,
         check,
-        describe_json,
+        describe,
         project_root,
         shipped_targets,
         write_files,
@@ -158,7 +157,9 @@ def _cmd_derive(args) -> int:
         if shipped:
             written.append(write_stiffness_figure(where))
     if args.json:
-        print(describe_json(built.models))
+        from gearsym.solver._json import dumps
+
+        print(dumps({m.name: describe(m) for m in built.models}, indent=2))
         return 0
     for model in built.models:
         _summary(model)
@@ -224,8 +225,10 @@ def _cmd_backlash(args) -> int:
         raise Fail(f"backlash {option}: {err}") from None
     error = fit.max_error()
     if args.json:
+        from gearsym.solver._json import dumps
+
         print(
-            json.dumps(
+            dumps(
                 {
                     "order": fit.order,
                     "range": fit.fit_range,
@@ -260,7 +263,6 @@ def _cmd_backlash(args) -> int:
 
 
 def _cmd_stiffness(args) -> int:
-    import json
     import warnings
 
     from gearsym.derive._input import load_toml, nearest
@@ -300,7 +302,14 @@ def _cmd_stiffness(args) -> int:
                 plot_mesh(res, plot, f"{topology.name}: mesh {mesh.id}")
                 rep["plot"] = str(plot)
     if args.json:
-        print(json.dumps({"topology": topology.name, "meshes": reports}, indent=2))
+        from gearsym.solver._json import dumps, with_status
+
+        why = (
+            "a stiffness overflowed or is undefined: check the material and gear data "
+            "(a Young's modulus far outside physical ranges?)"
+        )
+        data = {"topology": topology.name, "meshes": reports}
+        print(dumps(with_status(data, why), indent=2))
         return 0
     for rep in reports:
         cr, pem, iso = rep["contact_ratio"], rep["pem"], rep["iso6336"]

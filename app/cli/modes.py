@@ -3,7 +3,6 @@ model, with the resonance (Campbell) diagram against the mesh frequency."""
 
 from __future__ import annotations
 
-import json
 import math
 
 from ._common import Fail, figure_file
@@ -58,7 +57,13 @@ def _cmd_modes(args) -> int:
 
         campbell_figure(result, speeds, args.plot, scene_rpm=scene_rpm)
     if args.json:
-        print(json.dumps(result.to_json(speeds), indent=1))
+        from gearsym.solver._json import dumps, with_status
+
+        why = (
+            "the eigenproblem overflowed: its inertias, masses or stiffnesses span more "
+            "than double precision (one far outside physical ranges?)"
+        )
+        print(dumps(with_status(result.to_json(speeds), why), indent=1))
         return 0
     print(
         f"{result.model}: {len(result.modes)} modes of the linear, time-averaged model; "

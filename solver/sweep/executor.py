@@ -16,6 +16,7 @@ import sys
 import threading
 import time
 from collections.abc import Callable, Sequence
+from contextlib import contextmanager
 
 __all__ = ["EXECUTORS", "map_tasks"]
 
@@ -74,19 +75,40 @@ def _pool(fn, tasks, workers, on_result) -> list:
     )
     results = []
     try:
-        for result in pool.map(fn, tasks):
+        # The workers start here.  Ctrl-C reaches the whole process group, and a worker
+        # struck before its initializer ignores SIGINT would print a KeyboardInterrupt
+        # traceback of its own: SIGINT stays blocked while they start (they inherit the
+        # mask, and unblock it once they ignore it); here a Ctrl-C waits till then.
+        with _sigint_blocked():
+            futures = [pool.submit(fn, task) for task in tasks]
+        for future in futures:
+            result = future.result()
             results.append(result)
             if on_result is not None:
                 on_result(result)
     except BaseException as err:
-        if not isinstance(err, Exception):
-            # Ctrl-C or an exit: stop now, not after the running tasks (a chain of a sweep
-            # can take minutes); what they stored so far stays.
+        if not isinstance(err, Exception) or isinstance(err, BrokenPipeError):
+            # Ctrl-C, an exit or a closed output: stop now, not after the running tasks
+            # (a chain of a sweep can take minutes); what they stored so far stays.
             _kill_workers(pool)
         raise
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
     return results
+
+
+@contextmanager
+def _sigint_blocked():
+    """SIGINT held pending in this thread (where the OS can block it) inside the block."""
+    block = getattr(signal, "pthread_sigmask", None)
+    if block is None or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = block(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        block(signal.SIG_SETMASK, previous)
 
 
 def _kill_workers(pool) -> None:
@@ -115,7 +137,9 @@ def _bind_to_parent(parent: int | None) -> None:
     whole process group; only the parent acts on it (it kills the workers), so that a
     worker does not print a traceback of its own.
     """
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # discards a pending Ctrl-C too
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
     watched = os.getppid() if parent is None else parent
     if not _death_signal(signal.SIGKILL):
         threading.Thread(target=_watch_parent, args=(watched,), daemon=True).start()
