@@ -12,6 +12,8 @@ from pathlib import Path
 import numpy as np
 
 __all__ = [
+    "LIMITS",
+    "MAX_TOTAL_PERIODS",
     "Fail",
     "OneLineParser",
     "RunFailed",
@@ -197,6 +199,15 @@ def refuse_conflicts(args, varied: list[str], option: str) -> None:
                    f"'{args.executor}'); drop --scheduler or add --executor dask")  # fmt: skip
 
 
+# Bounded work: the most periods a run may ask for (stated in each option's help).  The
+# compiled integrator takes 10 us to 1 ms a period depending on the model, the exponent's
+# variational run about 1 ms: a million periods is seconds to a quarter of an hour.
+LIMITS = {"transient": 1_000_000, "periods": 1_000_000, "lyapunov_periods": 100_000}
+# periods integrated in all by a sweep or a map (points x runs x periods): 1e9 is about
+# three hours of one core on the smallest model, minutes on a cluster
+MAX_TOTAL_PERIODS = 1e9
+
+
 def analysis_settings(args) -> dict:
     for name in ("rtol", "atol"):
         value = getattr(args, name)
@@ -216,6 +227,11 @@ def analysis_settings(args) -> dict:
         check_samples(args.periods, spp, 8)
     except ValueError as err:
         raise Fail(f"--periods {args.periods}: {err}") from None
+    for name, most in LIMITS.items():
+        if getattr(args, name) > most:
+            option = "--" + name.replace("_", "-")
+            raise Fail(f"{option} {getattr(args, name)}: at most {most:,} periods (a longer "
+                       "run takes hours)")  # fmt: skip
     if spp < 64 and not getattr(args, "quiet", False):
         print(f"gearsym: note: {args.periods} periods are sampled {spp} times each (not 64) "
               f"to bound memory; spectra reach {spp // 2} times the excitation frequency",
@@ -248,10 +264,20 @@ def analysis_options(sub) -> None:
         help="integrator (default: the fastest that meets --rtol: dop853, or cvodes without a "
         "C compiler; RK45 is the study's)",
     )
-    sub.add_argument("--rtol", type=float, default=1e-8)
-    sub.add_argument("--atol", type=float, default=1e-10)
-    sub.add_argument("--transient", type=int, default=300, help="periods discarded")
-    sub.add_argument("--periods", type=int, default=100, help="periods sampled")
+    sub.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance (<= 0.1)")
+    sub.add_argument("--atol", type=float, default=1e-10, help="absolute tolerance")
+    sub.add_argument(
+        "--transient",
+        type=int,
+        default=300,
+        help=f"periods discarded (300; at most {LIMITS['transient']:,})",
+    )
+    sub.add_argument(
+        "--periods",
+        type=int,
+        default=100,
+        help=f"periods sampled (100; at most {LIMITS['periods']:,}, and what memory holds)",
+    )
     sub.add_argument(
         "--on-invalid",
         choices=("warn", "error"),
@@ -263,7 +289,8 @@ def analysis_options(sub) -> None:
         "--lyapunov-periods",
         type=int,
         default=200,
-        help="periods for the largest Lyapunov exponent (0: skip)",
+        help=f"periods for the largest Lyapunov exponent (200; 0: skip; at most "
+        f"{LIMITS['lyapunov_periods']:,})",
     )
 
 

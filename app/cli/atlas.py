@@ -2,13 +2,25 @@
 
 from __future__ import annotations
 
-import json
 import math
 import sys
 
-from ._common import Fail, out_folder, parse_range, parse_set, refuse_conflicts, require, system_of
+from ._common import (
+    LIMITS,
+    MAX_TOTAL_PERIODS,
+    Fail,
+    out_folder,
+    parse_range,
+    parse_set,
+    refuse_conflicts,
+    require,
+    system_of,
+)
 
 __all__ = ["register"]
+
+MAX_INITIAL_STATES = 64
+MAX_WORKERS = 1024
 
 
 def register(sub) -> None:
@@ -28,14 +40,16 @@ def register(sub) -> None:
             required=True,
             metavar="NAME=START:STOP:NUM",
             help=f"the {axis} axis: a scene or model parameter (or an open value) and NUM "
-            "values from START to STOP",
+            "values from START to STOP (the grid's runs x (--transient + --periods) at most "
+            f"{MAX_TOTAL_PERIODS:.0e} periods)",
         )
     mp.add_argument(
         "--initial-states",
         type=int,
         default=4,
         metavar="K",
-        help="initial states per grid point: forward, backward, then K - 2 random (default 4)",
+        help="initial states per grid point: forward, backward, then K - 2 random (default 4, "
+        f"at most {MAX_INITIAL_STATES})",
     )
     mp.add_argument("--seed", type=int, default=0, help="seed of the random initial states")
     mp.add_argument(
@@ -51,16 +65,32 @@ def register(sub) -> None:
     mp.add_argument("--method", choices=("dop853", "dopri5"), default="dop853")
     mp.add_argument("--rtol", type=float, default=1e-8)
     mp.add_argument("--atol", type=float, default=1e-10)
-    mp.add_argument("--transient", type=int, default=300, help="periods discarded")
-    mp.add_argument("--periods", type=int, default=100, help="periods sampled")
+    mp.add_argument(
+        "--transient",
+        type=int,
+        default=300,
+        help=f"periods discarded (300; at most {LIMITS['transient']:,})",
+    )
+    mp.add_argument(
+        "--periods",
+        type=int,
+        default=100,
+        help=f"periods sampled (100; at most {LIMITS['periods']:,})",
+    )
     mp.add_argument(
         "--lyapunov-periods",
         type=int,
         default=200,
-        help="the exponent is summed over the last N periods of the run (0: none)",
+        help="the exponent is summed over the last N periods of the run (200; 0: none; at "
+        f"most the run's periods and {LIMITS['lyapunov_periods']:,})",
     )
     mp.add_argument("--executor", choices=("serial", "processes", "dask"), default="processes")
-    mp.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
+    mp.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        help=f"processes (default: all cores; at most {MAX_WORKERS})",
+    )
     mp.add_argument("--scheduler", metavar="ADDRESS", help="dask scheduler address")
     mp.add_argument("--out", metavar="DIR", help="output folder (default map_<model>_<x>_<y>)")
     mp.add_argument(
@@ -131,6 +161,21 @@ def _resolver(scene: str, system, sets: dict, names: tuple[str, str]):
     return resolve
 
 
+def _bounded(args, runs: int) -> None:
+    """Refuse a size that would make the map take hours (the limits above)."""
+    sizes = [("--initial-states", args.initial_states, MAX_INITIAL_STATES),
+             ("--workers", args.workers or 1, MAX_WORKERS)]  # fmt: skip
+    sizes += [("--" + k.replace("_", "-"), getattr(args, k), most) for k, most in LIMITS.items()]
+    for option, value, most in sizes:
+        if value > most:
+            raise Fail(f"{option} {value}: at most {most:,}")
+    total = runs * (args.transient + args.periods)
+    if total > MAX_TOTAL_PERIODS:
+        raise Fail(f"{runs:,} runs of {args.transient} + {args.periods} periods is {total:.2g} "
+                   f"periods, more than {MAX_TOTAL_PERIODS:.0e} (hours of work); map fewer "
+                   "points, initial states or periods")  # fmt: skip
+
+
 def _cmd_map(args) -> int:
     from gearsym.solver.plots_maps import map_figures
     from gearsym.solver.sweep.atlas import regime_map
@@ -161,6 +206,7 @@ def _cmd_map(args) -> int:
     require(runs * 8.0 * (4 * (args.periods + 1) + 8 + args.lyapunov_periods) * 2,
             f"{xv.size} x {yv.size} x {args.initial_states} runs of {args.periods} periods",
             "map fewer points, initial states or periods")  # fmt: skip
+    _bounded(args, runs)
     sets = parse_set(args.set)
     box = _box(args.box)
     system = system_of(args.scene, sets)
@@ -206,10 +252,10 @@ def _cmd_map(args) -> int:
     result.save(out / "map.csv")
     figures = map_figures(result, out)
     if args.json:
-        from gearsym.solver._json import clean
+        from gearsym.solver._json import dumps
 
         for record in result.records():
-            sys.stdout.write(json.dumps(clean(record)) + "\n")
+            sys.stdout.write(dumps(record) + "\n")
         return 0
     if stored:
         print(f"resumed: {stored} finished columns came from {out / 'store'}")

@@ -21,6 +21,15 @@ from ._start import resolve_start, start_options
 
 __all__ = ["register"]
 
+# Bounded work (each stated in its option's help).  A period-n orbit costs about n times a
+# period-1 one (0.3 s a period on the reference scenes, minutes for period 64 on the
+# largest model); the guess is settled by CVODES at about a millisecond a period.
+MAX_PERIOD = 64
+MAX_SEGMENTS = 256
+MAX_TRIES = 100
+MAX_SETTLED = 200_000  # periods T settled for the guesses in all: settle x n x (tries + 1)
+MIN_STEP = 1e-5  # continue_orbit's smallest step: a smaller first step ends the branch
+
 
 def register(sub) -> None:
     sh = sub.add_parser(
@@ -36,16 +45,27 @@ def register(sub) -> None:
     )
     sh.add_argument("scene", metavar="SCENE")
     sh.add_argument("--set", action="append", metavar="KEY=VALUE")
-    sh.add_argument("--period", type=int, default=1, help="n: the orbit's period is n T")
+    sh.add_argument(
+        "--period",
+        type=int,
+        default=1,
+        help=f"n: the orbit's period is n T (1 to {MAX_PERIOD})",
+    )
     sh.add_argument(
         "--tries",
         type=int,
         default=6,
-        help="more guesses when the first leads to a lower period (default 6)",
+        help=f"more guesses when the first leads to a lower period (default 6, at most "
+        f"{MAX_TRIES}; each settles max(--settle, 300) n T)",
     )
     sh.add_argument("--seed", type=int, default=0, help="seed of those guesses' random starts")
     start_options(sh)
-    sh.add_argument("--segments", type=int, default=1, help="multiple shooting segments")
+    sh.add_argument(
+        "--segments",
+        type=int,
+        default=1,
+        help=f"multiple shooting segments (1 to {MAX_SEGMENTS})",
+    )
     sh.add_argument(
         "--monodromy",
         choices=("ad", "variational", "fd"),
@@ -62,7 +82,8 @@ def register(sub) -> None:
         type=int,
         default=None,
         help="periods n T simulated for the guess (default 300; 0 with --x0 or "
-        "--from-sweep: their state is the guess as given)",
+        "--from-sweep: their state is the guess as given); the guesses settle at most "
+        f"{MAX_SETTLED:,} periods T in all (N x n x (tries + 1))",
     )
     sh.add_argument("--json", action="store_true")
     sh.add_argument("--out", metavar="DIR", help="also write orbit.json and multipliers.png")
@@ -72,20 +93,41 @@ def register(sub) -> None:
         "continue",
         help="continue a periodic orbit in a parameter",
         description="Pseudo-arclength continuation of the period-n orbit, "
-        "with fold, period-doubling and Neimark-Sacker points located.",
+        "with fold, period-doubling and Neimark-Sacker points located; at most 400 points. "
+        "A branch that reaches the edge of the parameter's valid range stops there and "
+        "says so (the points up to there are kept).",
     )
     co.add_argument("scene", metavar="SCENE")
-    co.add_argument("--param", required=True)
-    co.add_argument("--from", dest="from_", type=float, required=True)
-    co.add_argument("--to", type=float, required=True)
-    co.add_argument("--period", type=int, default=1)
-    co.add_argument("--step", type=float, default=0.02, help="initial arclength step")
+    co.add_argument(
+        "--param",
+        required=True,
+        help="the parameter to continue: a scene or model parameter (not an open value)",
+    )
+    co.add_argument(
+        "--from", dest="from_", type=float, required=True, help="start (inside its valid range)"
+    )
+    co.add_argument("--to", type=float, required=True, help="end (inside its valid range)")
+    co.add_argument(
+        "--period", type=int, default=1, help=f"n: the orbit's period is n T (1 to {MAX_PERIOD})"
+    )
+    co.add_argument(
+        "--step",
+        type=float,
+        default=0.02,
+        help=f"initial arclength step ({MIN_STEP:g} to |TO - FROM|; it then adapts up to "
+        "four times this)",
+    )
     co.add_argument(
         "--switch",
         action="store_true",
         help="switch onto the period-2n branch at each period doubling",
     )
-    co.add_argument("--settle", type=int, default=300)
+    co.add_argument(
+        "--settle",
+        type=int,
+        default=300,
+        help=f"periods n T simulated for the first guess (300; N x n at most {MAX_SETTLED:,})",
+    )
     co.add_argument("--set", action="append", metavar="KEY=VALUE")
     co.add_argument("--out", metavar="DIR")
     co.set_defaults(func=_cmd_continue)
@@ -109,6 +151,22 @@ def _guesses(system, n: int, first, tries: int, seed: int, settle: int):
             yield run.x_final
 
 
+def _bounded_shoot(args) -> None:
+    """Refuse a size that would make ``shoot`` run for hours (the limits above)."""
+    for option, value, most in (("--period", args.period, MAX_PERIOD),
+                                ("--segments", args.segments, MAX_SEGMENTS),
+                                ("--tries", args.tries, MAX_TRIES)):  # fmt: skip
+        if value > most:
+            raise Fail(f"{option} {value}: at most {most}")
+    settle = 300 if args.settle is None else args.settle
+    tries = args.tries if args.period > 1 else 0
+    total = settle * args.period + tries * max(settle, 300) * args.period
+    if total > MAX_SETTLED:
+        raise Fail(f"--settle {settle} with --period {args.period} and --tries {tries} settles "
+                   f"up to {total:,} periods T, more than {MAX_SETTLED:,}; lower --settle or "
+                   "--tries")  # fmt: skip
+
+
 def _cmd_shoot(args) -> int:
     from gearsym.solver._json import dumps
     from gearsym.solver.integrate import SimulationError, simulate
@@ -126,6 +184,7 @@ def _cmd_shoot(args) -> int:
     # Newton's matrix on all segments, dense: (n S)^2 numbers, and its factors
     require(24.0 * (system.n * args.segments) ** 2, f"--segments {args.segments}",
             "use fewer segments (one per period is the default; a few suffice)")  # fmt: skip
+    _bounded_shoot(args)
     if start.x0 is None:
         settle = 300 if args.settle is None else args.settle
         guess = orbit_guess(system, args.period, settle)
@@ -237,6 +296,22 @@ def _cmd_continue(args) -> int:
     if args.from_ == args.to:
         raise Fail(f"--to {args.to:g} equals --from: there is nothing to continue; give "
                    "another end")  # fmt: skip
+    span = abs(args.to - args.from_)
+    if not MIN_STEP <= args.step <= span:
+        raise Fail(f"--step {args.step:g}: give {MIN_STEP:g} to {span:g} (|--to - --from|; "
+                   "a larger first step leaves the range at once)")  # fmt: skip
+    if args.period > MAX_PERIOD:
+        raise Fail(f"--period {args.period}: at most {MAX_PERIOD}")
+    if args.settle * args.period > MAX_SETTLED:
+        raise Fail(f"--settle {args.settle} with --period {args.period} settles "
+                   f"{args.settle * args.period:,} periods T, more than {MAX_SETTLED:,}; "
+                   "lower --settle")  # fmt: skip
+    from gearsym.derive.open_values import is_open_value
+
+    if is_open_value(args.param):
+        raise Fail(f"--param {args.param}: an open value (each value derives its own model), "
+                   "not a parameter to continue; map it with `gearsym map`, or set one value "
+                   "with --set")  # fmt: skip
     refuse_conflicts(args, [args.param], f"--param {args.param}")
     system = system_of(args.scene, parse_set(args.set))
     from gearsym.solver.integrate.simulate import check_start

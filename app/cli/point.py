@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._common import (
+    MAX_TOTAL_PERIODS,
     Fail,
     RunFailed,
     analysis_options,
@@ -20,6 +21,8 @@ from ._common import (
 from ._start import resolve_start, start_options
 
 __all__ = ["register"]
+
+MAX_SWEEP_POINTS = 100_000  # a sweep's values (with the periods' total: _common.py)
 
 
 def register(sub) -> None:
@@ -50,7 +53,9 @@ def register(sub) -> None:
         "--range",
         required=True,
         metavar="START:STOP:NUM",
-        help="NUM values from START to STOP; write --range=-1:1:21 when START is negative",
+        help="NUM values from START to STOP; write --range=-1:1:21 when START is negative; "
+        f"NUM at most {MAX_SWEEP_POINTS:,}, and NUM x (--transient + --periods + "
+        f"--lyapunov-periods) at most {MAX_TOTAL_PERIODS:.0e} periods",
     )
     sw.add_argument("--backward", action="store_true", help="continue from STOP to START")
     sw.add_argument(
@@ -181,6 +186,12 @@ def _cmd_sweep(args) -> int:
     require(len(values) * (8.0 * 4 * args.periods + 4096) * 2,
             f"--range {args.range}: {len(values)} points of {args.periods} periods",
             "sweep fewer points or periods")  # fmt: skip
+    total = len(values) * (args.transient + args.periods + args.lyapunov_periods)
+    if len(values) > MAX_SWEEP_POINTS or total > MAX_TOTAL_PERIODS:
+        raise Fail(f"--range {args.range}: {len(values):,} points of {args.transient} + "
+                   f"{args.periods} + {args.lyapunov_periods} periods; at most "
+                   f"{MAX_SWEEP_POINTS:,} points and {MAX_TOTAL_PERIODS:.0e} periods in all "
+                   "(hours of work); sweep fewer points or periods")  # fmt: skip
     from gearsym.derive.open_values import is_open_value
 
     if is_open_value(args.param):

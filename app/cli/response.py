@@ -3,13 +3,25 @@ parameter) by harmonic-balance and shooting continuation, stable and unstable br
 
 from __future__ import annotations
 
-import json
 import math
 import sys
 
 from ._common import Fail, RunFailed, out_folder, parse_set, refuse_conflicts, require, system_of
 
 __all__ = ["register"]
+
+# Bounded work (every size that sets the cost; each stated in its option's help).  The
+# harmonic-balance continuation stops after 20,000 points (more NUM only shortens its
+# first step); a shooting point costs a Newton solve with the monodromy (0.1 to 1 s), an
+# integration point a settled run: 2,000 of them is some minutes on the smallest model.
+MAX_POINTS = 20_000
+MAX_POINTS_TIMED = 2_000
+MAX_PERIOD = 64  # subharmonics beyond period 64 are not resolved by 15 harmonics anyway
+MAX_SETTLE = 10_000
+MAX_INTEGRATED = 1e7  # periods a sweep of --method integration (up and down run together)
+# solver/sweep/frequency.py's MAX_HARMONICS and MAX_UNKNOWNS (imported only when a command
+# runs: the parser is built without the solver; tests/test_cli_limits.py checks they agree)
+MAX_HARMONICS, MAX_UNKNOWNS = 256, 4096
 
 
 def register(sub) -> None:
@@ -28,23 +40,38 @@ def register(sub) -> None:
         "--param",
         required=True,
         metavar="NAME=START:STOP:NUM",
-        help="the parameter and its range; NUM sets the first continuation step (the range "
-        "over NUM; the step then adapts), for example omega=0.3:1:400",
+        help="the parameter (a scene or model parameter; START and STOP inside its valid "
+        "range) and its range; NUM sets the first continuation step (the range over NUM; "
+        f"the step then adapts), for example omega=0.3:1:400; NUM at most {MAX_POINTS:,} "
+        f"({MAX_POINTS_TIMED:,} with shooting or integration). A branch that reaches the edge "
+        "of the parameter's valid range stops there and says so",
     )
     fr.add_argument(
         "--set", action="append", metavar="KEY=VALUE", help="set a scene or model parameter"
     )
     fr.add_argument(
-        "--harmonics", type=int, default=15, metavar="H", help="harmonics of omega/n (15)"
+        "--harmonics",
+        type=int,
+        default=15,
+        metavar="H",
+        help=f"harmonics of omega/n (15; at most {MAX_HARMONICS}, and at most "
+        f"{MAX_UNKNOWNS} unknowns: states x (2H + 1))",
     )
     fr.add_argument(
         "--tail",
         type=float,
         metavar="SHARE",
-        help="raise H (doubling, from --harmonics) until the top quarter of the harmonics "
-        "carries at most SHARE of the response at the start, for example 1e-6",
+        help="raise H (doubling, from --harmonics, up to the --harmonics limit) until the "
+        "top quarter of the harmonics carries at most SHARE of the response at the start, "
+        "for example 1e-6",
     )
-    fr.add_argument("--period", type=int, default=1, metavar="N", help="period N T (default 1)")
+    fr.add_argument(
+        "--period",
+        type=int,
+        default=1,
+        metavar="N",
+        help=f"period N T (default 1, at most {MAX_PERIOD})",
+    )
     fr.add_argument(
         "--method",
         choices=("hb", "shooting", "integration", "all"),
@@ -57,14 +84,15 @@ def register(sub) -> None:
         type=int,
         default=50,
         metavar="N",
-        help="integration: periods settled at each frequency before sampling (50)",
+        help=f"integration: periods settled at each frequency before sampling (50, at most "
+        f"{MAX_SETTLE:,}; NUM x (N + --sampled) at most {MAX_INTEGRATED:.0e} periods)",
     )
     fr.add_argument(
         "--sampled",
         type=int,
         default=16,
         metavar="N",
-        help="integration: periods sampled at each frequency (16)",
+        help=f"integration: periods sampled at each frequency (16, at most {MAX_SETTLE:,})",
     )
     fr.add_argument(
         "--physical",
@@ -95,10 +123,37 @@ def _param(text: str):
     return name.strip(), start, stop, num
 
 
+def _bounded(args, system, num: int, methods, cap: int) -> None:
+    """Refuse a size that would make the run take hours (the limits above)."""
+    if args.harmonics > cap:
+        raise Fail(f"--harmonics {args.harmonics}: at most {cap} for {system.name} "
+                   f"({system.n} states x (2H + 1) <= {MAX_UNKNOWNS} unknowns, H <= "
+                   f"{MAX_HARMONICS}); use fewer harmonics, or --tail to raise them only "
+                   "as far as the response needs")  # fmt: skip
+    if args.period > MAX_PERIOD:
+        raise Fail(f"--period {args.period}: at most {MAX_PERIOD}")
+    timed = [m for m in methods if m != "hb"]
+    if num > MAX_POINTS or (timed and num > MAX_POINTS_TIMED):
+        most = MAX_POINTS_TIMED if timed and num > MAX_POINTS_TIMED else MAX_POINTS
+        why = f" with --method {args.method}" if most == MAX_POINTS_TIMED else ""
+        raise Fail(f"--param {args.param}: NUM {num} is more than the {most:,} points a "
+                   f"response takes{why}; give a smaller NUM")  # fmt: skip
+    if "integration" in methods:
+        for option, value in (("--settle", args.settle), ("--sampled", args.sampled)):
+            if value > MAX_SETTLE:
+                raise Fail(f"{option} {value}: at most {MAX_SETTLE:,} periods")
+        total = num * (args.settle + args.sampled)
+        if total > MAX_INTEGRATED:
+            raise Fail(f"--method {args.method}: {num} frequencies x ({args.settle} + "
+                       f"{args.sampled}) periods is {total:.2g} periods a sweep, more than "
+                       f"{MAX_INTEGRATED:.0e}; lower NUM, --settle or --sampled")  # fmt: skip
+
+
 def _cmd_response(args) -> int:
+    from gearsym.derive.open_values import is_open_value
     from gearsym.solver._json import dumps
     from gearsym.solver.periodic import HarmonicBalanceError, ShootingError
-    from gearsym.solver.sweep.frequency import frequency_response
+    from gearsym.solver.sweep.frequency import frequency_response, harmonics_cap
 
     name, start, stop, num = _param(args.param)
     if args.harmonics < 1:
@@ -107,6 +162,10 @@ def _cmd_response(args) -> int:
         raise Fail(f"--period must be >= 1, got {args.period}")
     if args.tail is not None and not (0 < args.tail < 1):
         raise Fail(f"--tail must be a share in (0, 1), got {args.tail}")
+    if is_open_value(name):
+        raise Fail(f"--param {name}: an open value (each value derives its own model), not a "
+                   "parameter to continue; map it with `gearsym map`, or set one value with "
+                   "--set")  # fmt: skip
     refuse_conflicts(args, [name], f"--param {args.param}")
     system = system_of(args.scene, parse_set(args.set))
     for value in (start, stop):
@@ -122,6 +181,7 @@ def _cmd_response(args) -> int:
     if args.settle < 1 or args.sampled < 1:
         raise Fail(f"--settle and --sampled must be >= 1, got {args.settle}, {args.sampled}")
     methods = ("hb", "shooting", "integration") if args.method == "all" else (args.method,)
+    _bounded(args, system, num, methods, harmonics_cap(system))
     if "integration" in methods and name != system.contract.forcing_frequency:
         raise Fail(
             f"--method integration sweeps the forcing frequency "
@@ -152,7 +212,7 @@ def _cmd_response(args) -> int:
         )
     if args.json:
         for rec in resp.records():
-            print(json.dumps(rec))
+            print(dumps(rec))
         return 0
     if system.piecewise and "hb" in methods:
         print(
@@ -182,6 +242,8 @@ def _cmd_response(args) -> int:
             print(f"  {e['kind']:<16} {name} = {e[name]:.8g}{check}")
         for note in c.details.get("notes", []):
             print(f"  note: {note}")
+        if c.details.get("status") in ("boundary", "max-points"):
+            print(f"  {c.details['message']}")
     print(f"wrote {out / 'frequency_response.json'}" + (f" and {figure}" if figure else ""))
     sys.stdout.flush()
     return 0

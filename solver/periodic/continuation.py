@@ -22,6 +22,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..system import System
+from ._bounds import Interval, interval_of
+from ._quiet import quiet
 from .floquet import KINDS, Floquet, bifurcation_tests, floquet
 from .flow import StroboscopicMap
 from .newton import newton
@@ -61,6 +63,10 @@ class Branch:
     multipliers: list = field(default_factory=list)
     bifurcations: list = field(default_factory=list)
     message: str = ""
+    # "complete" (reached the end asked for), "boundary" (stopped at the edge of the
+    # parameter's valid range), "turned" (a fold took it out at the start's side),
+    # "stalled" (the step fell below its minimum), "max-points"
+    status: str = "complete"
     state_names: tuple = ()
     model: dict = field(default_factory=dict)  # name, hash, base values and scales
 
@@ -73,6 +79,7 @@ class Branch:
             "stable": [bool(s) for s in self.stable],
             "max_multiplier": [float(np.max(np.abs(m))) for m in self.multipliers],
             "bifurcations": [b.describe() for b in self.bifurcations],
+            "status": self.status,
             "message": self.message,
         }
 
@@ -107,21 +114,32 @@ class _Problem:
 
     def __init__(self, system: System, parameter: str, n: int):
         self.base, self.parameter, self.n = system, parameter, n
+        self.valid = interval_of(system, parameter)
         self.map = StroboscopicMap(system, n)
 
     def system(self, lam: float) -> System:
+        if lam not in self.valid:
+            raise ValueError(f"{self.parameter} = {lam:g} is outside {self.valid.rule()}")
         return self.base.with_values(**{self.parameter: float(lam)})
 
     def p(self, lam) -> np.ndarray:
         return self.system(lam).p
 
     def G(self, x, lam) -> np.ndarray:
-        return self.map(x, self.p(lam)) - x
+        with quiet():  # CasADi's dump of a failed integration: the error says it
+            return self.map(x, self.p(lam)) - x
 
     def jacobian(self, x, lam):
-        xe, M, q = self.map.jacobian(x, self.p(lam))
+        with quiet():
+            xe, M, q = self.map.jacobian(x, self.p(lam))
         h = 1e-6 * max(1.0, abs(lam))
-        dG = (self.G(x, lam + h) - self.G(x, lam - h)) / (2 * h)
+        # one-sided at an end of the valid range (damping_ratio = 0)
+        up, dn = lam + h, lam - h
+        if up not in self.valid:
+            up = lam
+        elif dn not in self.valid:
+            dn = lam
+        dG = (self.G(x, up) - self.G(x, dn)) / (up - dn)
         return xe - x, M, dG, q
 
 
@@ -168,8 +186,10 @@ def continue_orbit(
 ) -> Branch:
     """Follow the period-n orbit from ``x0`` near ``parameter = start`` toward ``stop``.
 
-    The first orbit is found by shooting; the branch ends at ``stop``, after
-    ``max_points`` points, or when the step falls below ``ds_min``.
+    The first orbit is found by shooting; the branch ends at ``stop``, at the edge of the
+    parameter's valid range (``_bounds.py``: a predictor that would cross it is shortened
+    to land on it), after ``max_points`` points, or when the step falls below ``ds_min``;
+    :attr:`Branch.status` and :attr:`Branch.message` say which.
     """
     if not (ds > 0 and ds_min > 0 and ds_max >= ds_min):
         raise ValueError(
@@ -178,6 +198,8 @@ def continue_orbit(
     if n < 1:
         raise ValueError(f"the period multiple n must be >= 1, got {n}")
     prob = _Problem(system, parameter, n)
+    if start not in prob.valid:
+        raise ValueError(f"{parameter} = {start:g}: outside its valid range {prob.valid.rule()}")
     first = shoot(prob.system(start), x0, n, flow=prob.map.flow)
     z = np.concatenate([first.x0, [start]])
     G, M, dG, q = prob.jacobian(z[:-1], z[-1])
@@ -200,16 +222,39 @@ def continue_orbit(
         branch.stable.append(fl.stable)
         branch.multipliers.append(fl.multipliers)
 
+    def land(end, guess):
+        """Shoot at ``end`` exactly from ``guess`` and end the branch there."""
+        try:
+            last = shoot(prob.system(end), guess, n, flow=prob.map.flow)
+            record(np.concatenate([last.x0, [end]]), last.floquet)
+        except (ShootingError, ValueError, RuntimeError, np.linalg.LinAlgError):
+            pass
+        branch.status, branch.message = ending(parameter, prob.valid, start, stop, lo, hi, end)
+
     record(z, fl)
     tests = bifurcation_tests(M)
-    lo, hi = min(start, stop), max(start, stop)
+    lo, hi = prob.valid.ends(start, stop)
     while len(branch.values) < max_points:
+        end = None
+        if z[-1] + ds * t[-1] not in prob.valid:
+            # the predictor would cross the valid range's edge: land on the range's end
+            end = hi if t[-1] > 0 else lo
+            if abs(end - z[-1]) <= 1e-12 * max(1.0, abs(end)):
+                branch.status, branch.message = ending(
+                    parameter, prob.valid, start, stop, lo, hi, end
+                )
+                break
+            ds = (end - z[-1]) / t[-1]
         try:
             z_new, iters, M_new, q_new, dG_new = _correct(prob, z + ds * t, t)
         except (ShootingError, np.linalg.LinAlgError, RuntimeError, ValueError):
-            # ValueError: the step reached parameter values the model refuses (omega <= 0).
+            # ValueError: the corrector reached values the model refuses
+            if end is not None:
+                land(end, z[:-1] + ds * t[:-1])
+                break
             ds /= 2
             if ds < ds_min:
+                branch.status = "stalled"
                 branch.message = f"step fell below {ds_min:g} at {parameter} = {z[-1]:.6g}"
                 break
             continue
@@ -223,28 +268,42 @@ def continue_orbit(
             found = _locate(prob, z, t, ds, k, kind, tests[k], locate_tol)
             if kind != "neimark-sacker" or abs(abs(found.multiplier) - 1.0) < 1e-3:
                 branch.bifurcations.append(found)
-        if not lo - 1e-12 <= z_new[-1] <= hi + 1e-12:
+        if end is not None or not lo - 1e-12 <= z_new[-1] <= hi + 1e-12:
             # Land on the end of the range: shoot at the end value from the state
             # interpolated between the last two points (the point past it is not kept).
-            end = hi if z_new[-1] > hi else lo
+            end = end if end is not None else hi if z_new[-1] > hi else lo
             w = (end - z[-1]) / (z_new[-1] - z[-1]) if z_new[-1] != z[-1] else 1.0
-            try:
-                last = shoot(
-                    prob.system(end), z[:-1] + w * (z_new[:-1] - z[:-1]), n, flow=prob.map.flow
-                )
-                record(np.concatenate([last.x0, [end]]), last.floquet)
-            except (ShootingError, ValueError, RuntimeError):
-                pass
-            branch.message = f"reached the end of [{lo:g}, {hi:g}] at {parameter} = {end:g}"
-            if end != stop:
-                branch.message += " (the side it started from: the branch turned at a fold)"
+            land(end, z[:-1] + w * (z_new[:-1] - z[:-1]))
             break
         z, t, tests = z_new, t_new, tests_new
         record(z, floquet(M_new, q_new))
         ds = min(ds * 1.5, ds_max) if iters <= 3 else max(ds / 1.5, ds_min)
     else:
-        branch.message = f"stopped after {max_points} points"
+        branch.status, branch.message = "max-points", f"stopped after {max_points} points"
     return branch
+
+
+def ending(parameter: str, valid: Interval, start, stop, lo, hi, end) -> tuple[str, str]:
+    """(status, message) of a branch that ended at ``end`` of ``[lo, hi]``: the end asked
+    for ("complete"), an edge of the valid range ("boundary": short of the end asked
+    for, or that end itself), or the start's side after a fold ("turned")."""
+    toward = hi if stop > start else lo
+    if end == toward == stop and not valid.is_end(end):
+        return "complete", f"reached the end of [{lo:g}, {hi:g}] at {parameter} = {end:g}"
+    if end == toward == stop:
+        return "boundary", (
+            f"stopped at {parameter} = {end:g}, the end asked for and the boundary of the "
+            f"valid range {valid.rule()}"
+        )
+    if end == toward:
+        return "boundary", (
+            f"stopped at the boundary of the valid range {valid.rule()} at {parameter} = "
+            f"{end:.6g}, short of {stop:g}; the branch up to there is kept"
+        )
+    return "turned", (
+        f"reached the end of [{lo:g}, {hi:g}] at {parameter} = {end:g} (the side it "
+        "started from: the branch turned at a fold)"
+    )
 
 
 def _locate(prob, z0, t0, ds, k, kind, f0, tol) -> Bifurcation:

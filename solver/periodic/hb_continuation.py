@@ -16,109 +16,16 @@ bisection along the arclength between the two points.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 
 from ..system import System
+from ._bounds import interval_of
 from .continuation import _tangent as _null_tangent
+from .continuation import ending
 from .harmonic_balance import HarmonicBalance, harmonic_balance, hill
+from .hb_branch import HBBranch, HBPoint
 
 __all__ = ["HBBranch", "HBPoint", "continue_hb"]
-
-
-@dataclass(frozen=True)
-class HBPoint:
-    value: float
-    coefficients: np.ndarray  # (states, 2H + 1)
-    multipliers: np.ndarray | None
-    stable: bool | None
-    stability: str | None
-    tangent_sign: int  # sign of d(parameter)/d(arclength)
-
-
-@dataclass(frozen=True)
-class HBBranch:
-    """A continued branch of harmonic-balance solutions, in the order of arclength, and
-    the folds and stability changes located on it."""
-
-    system: System
-    parameter: str
-    n: int
-    harmonics: int
-    samples: int
-    points: tuple[HBPoint, ...]
-    events: tuple[dict, ...] = ()
-    wall_time: float = 0.0
-    notes: list = field(default_factory=list)
-
-    @property
-    def values(self) -> np.ndarray:
-        return np.array([p.value for p in self.points])
-
-    @property
-    def stable(self) -> np.ndarray:
-        return np.array([bool(p.stable) for p in self.points])
-
-    def _problem(self) -> HarmonicBalance:
-        return HarmonicBalance(self.system, self.harmonics, self.n, self.samples)
-
-    def series(self, name: str, points: int = 512) -> np.ndarray:
-        """``name`` over one period at every point, (len, points)."""
-        i = self.system.index(name)
-        s = 2 * np.pi * np.arange(points) / points
-        prob = self._problem()
-        C = np.array([p.coefficients[i] for p in self.points])
-        return prob.time_series(C, s)
-
-    def mean(self, name: str) -> np.ndarray:
-        i = self.system.index(name)
-        return np.array([p.coefficients[i, 0] for p in self.points])
-
-    def amplitude(self, name: str) -> np.ndarray:
-        """Half peak-to-peak of ``name`` at every point."""
-        y = self.series(name)
-        return (y.max(axis=1) - y.min(axis=1)) / 2
-
-    def maximum(self, name: str) -> np.ndarray:
-        return self.series(name).max(axis=1)
-
-    def minimum(self, name: str) -> np.ndarray:
-        return self.series(name).min(axis=1)
-
-    def rms(self, name: str) -> np.ndarray:
-        i = self.system.index(name)
-        C = np.array([p.coefficients[i] for p in self.points])
-        return np.sqrt(C[:, 0] ** 2 + 0.5 * np.sum(C[:, 1:] ** 2, axis=1))
-
-    def tail_shares(self, top: int | None = None) -> np.ndarray:
-        """Per point, the largest share (RMS sense, over the coordinates) of the response
-        that the highest ``top`` harmonics carry (default a quarter of H)."""
-        top = top or max(1, self.harmonics // 4)
-        out = np.zeros(len(self.points))
-        for c in self.system.coordinates:
-            i = self.system.index(c)
-            C = np.array([p.coefficients[i, 1:] for p in self.points])
-            a2 = C[:, 0::2] ** 2 + C[:, 1::2] ** 2
-            total = a2.sum(axis=1)
-            share = np.sqrt(np.divide(a2[:, -top:].sum(axis=1), total, out=np.zeros_like(total),
-                                      where=total > 0))  # fmt: skip
-            out = np.maximum(out, share)
-        return out
-
-    def records(self) -> list[dict]:
-        """One record per solution point: the parameter under its own name, ``stable``,
-        and per coordinate its ``mean``, ``amplitude`` (half peak-to-peak) and ``rms``."""
-        coords = self.system.coordinates
-        stats = {c: (self.mean(c), self.amplitude(c), self.rms(c)) for c in coords}
-        out = []
-        for k, p in enumerate(self.points):
-            rec = {self.parameter: p.value, "stable": p.stable, "stability": p.stability}
-            for c in coords:
-                m, a, r = stats[c]
-                rec[c] = {"mean": float(m[k]), "amplitude": float(a[k]), "rms": float(r[k])}
-            out.append(rec)
-        return out
 
 
 class _Curve:
@@ -128,18 +35,25 @@ class _Curve:
         self.system, self.parameter, self.problem = system, parameter, problem
         self.shape = (system.n, problem.M)
         self.size = system.n * problem.M
-        system.parameters_with(**{parameter: system.parameter(parameter)})  # name checked
+        self.valid = interval_of(system, parameter)  # a scene or model parameter
 
     def p(self, lam: float) -> np.ndarray:
+        if lam not in self.valid:
+            raise ValueError(f"{self.parameter} = {lam:g} is outside {self.valid.rule()}")
         return self.system.parameters_with(**{self.parameter: lam})
 
     def column(self, z) -> np.ndarray:
-        """dR/d(lambda) by a central difference."""
+        """dR/d(lambda) by a central difference (one-sided at an end of the valid range)."""
         X, lam = z[:-1].reshape(self.shape), float(z[-1])
         h = 1e-7 * max(1.0, abs(lam))
-        up = self.problem.residual(X, self.p(lam + h), jacobian=False)[0]
-        dn = self.problem.residual(X, self.p(lam - h), jacobian=False)[0]
-        return ((up - dn) / (2 * h)).ravel()
+        a, b = lam + h, lam - h
+        if a not in self.valid:
+            a = lam
+        elif b not in self.valid:
+            b = lam
+        up = self.problem.residual(X, self.p(a), jacobian=False)[0]
+        dn = self.problem.residual(X, self.p(b), jacobian=False)[0]
+        return ((up - dn) / (a - b)).ravel()
 
     def __call__(self, z, column=None):
         """(R, [dR/dX, dR/dlambda]); ``column``: a dR/dlambda already at hand (the
@@ -160,9 +74,15 @@ def _correct(curve: _Curve, z_pred, t, tol, max_iter=10):
     """Newton on (R, t.(z - z_pred)); returns (z, iterations, G) with G the last bordered
     Jacobian (for the next tangent), or (None, iterations, None)."""
     z = z_pred.copy()
-    column = curve.column(z_pred)
+    try:
+        column = curve.column(z_pred)
+    except ValueError:  # values the model refuses (past the edge of the valid range)
+        return None, 1, None
     for it in range(1, max_iter + 1):
-        R, G = curve(z, column)
+        try:
+            R, G = curve(z, column)
+        except ValueError:
+            return None, it, None
         if np.max(np.abs(R)) < tol and it > 1:
             return z, it - 1, G
         F = np.r_[R, t @ (z - z_pred)]
@@ -284,16 +204,20 @@ def continue_hb(
     (default 1/20 of the range); ``dlam_max`` caps the parameter's change per step (the
     step is then at most ``dlam_max / |t_lambda|``: even resolution in the parameter
     where the curve runs straight, free steps where it turns).  Stops when the parameter
-    leaves ``[start, stop]`` (the last point is solved at ``stop`` exactly) or after
-    ``max_points`` points.  ``check``: every located event also carries the distance of
-    Hill's multipliers from the monodromy of a time integration there
-    (:func:`monodromy_check`).
+    leaves ``[start, stop]`` (the last point is solved at the end exactly), at the edge
+    of its valid range (``_bounds.py``; a predictor that would cross it is shortened to
+    land on it), or after ``max_points`` points; ``status`` and ``message`` say which.
+    ``check``: every located event also carries the distance of Hill's multipliers from
+    the monodromy of a time integration there (:func:`monodromy_check`).
     """
     import time
 
     started = time.perf_counter()
     if start == stop:
         raise ValueError(f"start and stop are both {start:g}: nothing to continue")
+    valid = interval_of(system, parameter)
+    if start not in valid:
+        raise ValueError(f"{parameter} = {start:g}: outside its valid range {valid.rule()}")
     span = abs(stop - start)
     ds = ds or span / 200
     ds_max = ds_max or span / 20
@@ -313,24 +237,36 @@ def continue_hb(
     events: list[dict] = []
     notes: list[str] = []
     h = ds
-    lo, hi = min(start, stop), max(start, stop)
+    lo, hi = curve.valid.ends(start, stop)
+    status, message = "max-points", f"stopped after {max_points} points"
     while len(points) < max_points:
+        end = None
+        if z[-1] + h * t[-1] not in curve.valid:
+            # the predictor would cross the valid range's edge: land on the range's end
+            end = hi if t[-1] > 0 else lo
+            if abs(end - z[-1]) <= 1e-12 * max(1.0, abs(end)):
+                status, message = ending(parameter, curve.valid, start, stop, lo, hi, end)
+                break
+            h = (end - z[-1]) / t[-1]
         z_new, iters, G = _correct(curve, z + h * t, t, tol)
-        if z_new is None:
+        if z_new is None and end is None:
             h /= 2
             if h < ds_min:
-                notes.append(f"stopped at {parameter} = {z[-1]:.6g}: the corrector failed "
-                             "with the smallest step")  # fmt: skip
+                status = "stalled"
+                message = (f"stopped at {parameter} = {z[-1]:.6g}: the corrector failed "
+                           "with the smallest step")  # fmt: skip
+                notes.append(message)
                 break
             continue
-        lam = float(z_new[-1])
-        if not lo - 1e-12 <= lam <= hi + 1e-12:
+        lam = float(z[-1] + h * t[-1]) if z_new is None else float(z_new[-1])
+        if end is not None or not lo - 1e-12 <= lam <= hi + 1e-12:
             # the last point exactly at the end (natural parameter: lambda fixed)
-            end = stop if abs(lam - stop) <= abs(lam - start) else start
-            if end == start:
+            end = end if end is not None else hi if lam > hi else lo
+            status, message = ending(parameter, curve.valid, start, stop, lo, hi, end)
+            if status == "turned":
                 notes.append(f"the branch turned back and left the range at {parameter} = "
-                             f"{start:g}; continue from there to follow it further")  # fmt: skip
-            sol = _at(curve, z, end, tol)
+                             f"{end:g}; continue from there to follow it further")  # fmt: skip
+            sol = _at(curve, z if z_new is None else z_new, end, tol)
             if sol is not None:
                 _, G = curve(sol)
                 t_end = _tangent(G, t)
@@ -366,7 +302,7 @@ def continue_hb(
             h = min(h, dlam_max / abs(t[-1]))
     return HBBranch(
         system, parameter, n, harmonics, problem.N, tuple(points), tuple(events),
-        time.perf_counter() - started, notes,
+        time.perf_counter() - started, notes, status, message,
     )  # fmt: skip
 
 

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..system import System
+from ._quiet import quiet, reworded
 from .floquet import Floquet, floquet
 from .flow import FlowMap
 from .newton import NewtonError, newton
@@ -140,7 +141,8 @@ def residual(
     blocks = []
     for k in range(segments):
         xk = X[k * N : (k + 1) * N]
-        xe, Mk, q = flow.with_jacobian(xk, dur, t0 + k * dur, p, method=monodromy)
+        with quiet():  # CasADi's dump of a failed integration: the error says it
+            xe, Mk, q = flow.with_jacobian(xk, dur, t0 + k * dur, p, method=monodromy)
         blocks.append((Mk, q))
         nxt = (k + 1) % segments
         R[k * N : (k + 1) * N] = xe - X[nxt * N : (nxt + 1) * N]
@@ -175,11 +177,21 @@ def shoot(
     if x0.shape != (system.n,) or not np.all(np.isfinite(x0)):
         raise ValueError(f"x0 must be {system.n} finite numbers ({', '.join(system.states)})")
     flow = flow or FlowMap(system)
+    try:
+        return _shoot(system, x0, n, t0, segments, tol, max_iter, monodromy, flow)
+    except NewtonError:
+        raise
+    except RuntimeError as err:  # CasADi's: a failed integration, said in one line
+        raise NewtonError(reworded(err), []) from None
+
+
+def _shoot(system, x0, n, t0, segments, tol, max_iter, monodromy, flow) -> Orbit:
     T = n * system.period
     dur = T / segments
     X = [np.asarray(x0, float)]
     for k in range(1, segments):
-        X.append(flow(X[-1], dur, t0 + (k - 1) * dur, system.p))
+        with quiet():
+            X.append(flow(X[-1], dur, t0 + (k - 1) * dur, system.p))
     X = np.concatenate(X)
 
     def fun(X):
@@ -223,7 +235,8 @@ def _minimal_period(flow: FlowMap, system: System, x0, n: int, t0: float, tol: f
     scale = max(1.0, float(np.max(np.abs(x0))))
     for m in range(1, n):
         if n % m == 0:
-            end = flow(x0, m * system.period, t0, system.p)
+            with quiet():
+                end = flow(x0, m * system.period, t0, system.p)
             if np.max(np.abs(end - x0)) <= tol * scale:
                 return m
     return n

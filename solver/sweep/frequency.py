@@ -17,9 +17,29 @@ import numpy as np
 
 from ..system import System
 
-__all__ = ["METHODS", "Curve", "FrequencyResponse", "dynamic_factor", "frequency_response"]
+__all__ = [
+    "MAX_HARMONICS",
+    "MAX_UNKNOWNS",
+    "METHODS",
+    "Curve",
+    "FrequencyResponse",
+    "dynamic_factor",
+    "frequency_response",
+    "harmonics_cap",
+]
 
 METHODS = ("hb", "shooting", "integration")
+# Harmonic balance solves a dense system of n_states (2H + 1) unknowns a few times per
+# point: 4096 unknowns take about a second a solve (and 0.5 GiB), a response of a few
+# hundred points some minutes; more would be hours.
+MAX_UNKNOWNS = 4096
+MAX_HARMONICS = 256
+
+
+def harmonics_cap(system: System) -> int:
+    """The most harmonics the model may take: at most :data:`MAX_HARMONICS` and
+    :data:`MAX_UNKNOWNS` unknowns (n_states (2H + 1))."""
+    return max(1, min(MAX_HARMONICS, (MAX_UNKNOWNS // system.n - 1) // 2))
 
 
 @dataclass(frozen=True)
@@ -189,6 +209,8 @@ def _hb_curve(system, parameter, start, stop, harmonics, n, ds) -> Curve:
             "samples": br.samples,
             "largest_tail_share": tail,
             "notes": list(br.notes),
+            "status": br.status,
+            "message": br.message,
         },  # fmt: skip
         tuple(br._problem().time_series(pt.coefficients, np.zeros(1))[:, 0] for pt in br.points),
     )
@@ -225,7 +247,7 @@ def _shooting_curve(system, parameter, start, stop, n, ds, guess) -> Curve:
         stats,
         events,
         time.perf_counter() - started,
-        {"message": br.message},
+        {"status": br.status, "message": br.message},
         tuple(np.asarray(x, float) for x in br.states),
     )
 
@@ -325,7 +347,8 @@ def frequency_response(
     ``stop`` (two curves of method ``hb``).  ``integration``: up and down stepped sweeps of
     ``points`` frequencies, ``settle`` + ``sampled`` periods each (only over the forcing
     frequency; see :func:`_integration_curves`).  ``tail``: harmonic balance raises H at
-    the start until the top harmonics carry at most this share (``harmonic_balance``);
+    the start (up to :func:`harmonics_cap`) until the top harmonics carry at most this
+    share (``harmonic_balance``);
     the largest share along the branch is reported in the curve's details."""
     unknown = [m for m in methods if m not in METHODS]
     if unknown:
@@ -342,10 +365,11 @@ def frequency_response(
 
                 harmonics = harmonic_balance(system.with_values(**{parameter: start}),
                                              harmonics=harmonics, n=n, tail=tail,
+                                             max_harmonics=harmonics_cap(system),
                                              stability=False).harmonics  # fmt: skip
             curve = _hb_curve(system, parameter, start, stop, harmonics, n, ds)
             curves.append(curve)
-            if abs(curve.values[-1] - stop) > 1e-9 * max(1.0, abs(stop)):
+            if curve.details["status"] not in ("complete", "boundary"):
                 # the branch turned back out of the range: the rest of the range from the
                 # other end (the solution a simulation settles on there)
                 curves.append(_hb_curve(system, parameter, stop, start, harmonics, n, ds))
