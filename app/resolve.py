@@ -6,6 +6,14 @@ other target (a user's scene, or a shipped one edited since it was generated) is
 once into the derivation cache, ``<cache root>/models`` (``gearsym.solver.cache``: the
 same root as the compiled libraries), keyed by the hash of its inputs, and loaded from
 there.  Nothing is ever written into the installed package.
+
+The cache is verified, never trusted: a cached module is imported only when the sha256 of
+its bytes equals the digest written beside it (``<module>.sha256``, written before the
+module, each through a temporary file and a rename).  A module that is empty, cut short,
+edited or not Python, a missing or wrong digest, and a ``digests.json`` of the wrong shape
+are derived or written again, with one warning.  The check guards against corruption, not
+against someone who can write the user's files (docs/user-guide.md, "Who can write the
+cache").
 """
 
 from __future__ import annotations
@@ -14,7 +22,8 @@ import hashlib
 import importlib
 import json
 import os
-import tomllib
+import re
+import warnings
 from pathlib import Path
 from types import ModuleType
 
@@ -22,7 +31,15 @@ from gearsym.solver.cache import cache_root
 from gearsym.solver.contract import CONTRACT_FORMAT, load_generated
 from gearsym.solver.system import System
 
-__all__ = ["cached_module", "load", "model_cache", "module_for", "split_open_values"]
+__all__ = [
+    "cached_module",
+    "load",
+    "load_cached",
+    "model_cache",
+    "module_for",
+    "split_open_values",
+    "store_cached",
+]
 
 
 def model_cache() -> Path:
@@ -44,7 +61,7 @@ def module_for(target: str | Path, open_values: dict | None = None) -> ModuleTyp
     if module is not None:
         return module
     from gearsym.derive import derive_model, load_target, resolve_target
-    from gearsym.derive.emit import emit_module, write_atomic
+    from gearsym.derive.emit import emit_module
     from gearsym.derive.model import inputs_hash
     from gearsym.derive.open_values import with_open_values
 
@@ -61,10 +78,51 @@ def module_for(target: str | Path, open_values: dict | None = None) -> ModuleTyp
     if module is not None and getattr(module, "INPUTS_SHA256", "") == digest:
         return module
     cached = cached_module(name, digest)
-    if not cached.exists():
+    module = load_cached(cached)
+    if module is None:
         model = derive_model(scene)
-        write_atomic(cached, emit_module(model, f"gearsym derive {path}"))
-    return load_generated(cached)
+        store_cached(cached, emit_module(model, f"gearsym derive {path}"))
+        module = load_generated(cached)
+    return module
+
+
+def _stated_digest(module: Path) -> Path:
+    """The file beside a cached module that holds the sha256 of its bytes."""
+    return module.with_suffix(".sha256")
+
+
+def store_cached(module: Path, text: str) -> None:
+    """Write ``text`` as the cached module ``module`` and the digest of its bytes beside
+    it (the digest first: a module is never there without one)."""
+    from gearsym.derive.emit import write_atomic
+
+    data = text.encode("utf-8")  # what write_atomic writes: UTF-8, newlines kept
+    write_atomic(_stated_digest(module), hashlib.sha256(data).hexdigest() + "\n")
+    write_atomic(module, text)
+
+
+def load_cached(module: Path) -> ModuleType | None:
+    """The cached module at ``module`` when the sha256 of its bytes equals the digest
+    beside it; None when there is none, or (with one warning) when it does not match."""
+    try:
+        data = module.read_bytes()
+    except FileNotFoundError:
+        return None
+    except OSError as err:
+        why = f"cannot be read ({err.strerror or err})"
+    else:
+        try:
+            stated = _stated_digest(module).read_text(encoding="ascii").strip()
+        except FileNotFoundError:
+            stated, why = "", f"has no digest beside it ({_stated_digest(module).name})"
+        except (OSError, ValueError):
+            stated, why = "", "has an unreadable digest beside it"
+        else:
+            why = "differs from the digest beside it (empty, cut short or edited)"
+        if stated and hashlib.sha256(data).hexdigest() == stated:
+            return load_generated(module)
+    warnings.warn(f"the cached model {module} {why}; deriving it again", stacklevel=3)
+    return None
 
 
 # -- the fast path: a target whose files are unchanged since its digest was computed ----
@@ -86,11 +144,14 @@ def _fingerprint(target: str | Path) -> str | None:
                     break
             if path.exists():
                 break
+    from gearsym.derive._input import InputError, parse_toml
+
     try:
         data = path.read_bytes()
         parts = [str(path.resolve()).encode(), data]
-        ref = tomllib.loads(data.decode("utf-8")).get("scene", {}).get("topology")
-        if ref:
+        head = parse_toml(data.decode("utf-8"), str(path)).get("scene")
+        ref = head.get("topology") if isinstance(head, dict) else None
+        if isinstance(ref, str) and ref:
             topo = path.parent / ref
             if not topo.exists() and builtin is not None:
                 topo = builtin / "topologies" / f"{ref}.toml"
@@ -100,7 +161,7 @@ def _fingerprint(target: str | Path) -> str | None:
         source = Path(derive_package.__file__).parent
         parts += [f.read_bytes() for f in sorted(source.glob("*.py"))]
         parts += [f.read_bytes() for f in sorted((source / "data").glob("*")) if f.is_file()]
-    except (OSError, ValueError, tomllib.TOMLDecodeError):
+    except (OSError, ValueError, InputError):  # the slow path names what is wrong
         return None
     return hashlib.sha256(b"\0".join(parts)).hexdigest()
 
@@ -109,40 +170,81 @@ def _digests() -> Path:
     return model_cache() / "digests.json"
 
 
+_SHA256 = re.compile(r"[0-9a-f]{64}")
+_MODULE_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
+
+
+def _entry_ok(key, entry) -> bool:
+    """Whether ``key: entry`` of digests.json is a fingerprint: {name, digest}."""
+    return (
+        isinstance(key, str)
+        and _SHA256.fullmatch(key) is not None
+        and isinstance(entry, dict)
+        and set(entry) == {"name", "digest"}
+        and isinstance(entry["name"], str)
+        and _MODULE_NAME.fullmatch(entry["name"]) is not None
+        and isinstance(entry["digest"], str)
+        and _SHA256.fullmatch(entry["digest"]) is not None
+    )
+
+
+def _read_digests() -> tuple[dict, str | None]:
+    """The well-formed entries of digests.json, and what else it held (None: nothing)."""
+    from gearsym.derive._input import shown
+
+    try:
+        known = json.loads(_digests().read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        return {}, None
+    except OSError as err:
+        return {}, f"cannot be read ({err.strerror or err})"
+    except (ValueError, RecursionError):  # not UTF-8, not JSON, nested without end
+        return {}, "is not JSON (empty or cut short)"
+    if not isinstance(known, dict):
+        return {}, f"holds {shown(known)} instead of a table of fingerprints"
+    good = {k: e for k, e in known.items() if _entry_ok(k, e)}
+    if len(good) < len(known):
+        return good, f"has {len(known) - len(good)} entries of the wrong shape"
+    return good, None
+
+
 def _known_current(target) -> ModuleType | None:
     """The shipped generated module of ``target`` when its fingerprint is known and its
-    digest matches; else None (the slow path decides)."""
+    digest matches; else None (the slow path decides, and mends a bad digests.json)."""
     key = _fingerprint(target)
     if key is None:
         return None
-    try:
-        known = json.loads(_digests().read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    entry = known.get(key)
-    if not entry:
+    entry = _read_digests()[0].get(key)
+    if entry is None:
         return None
     try:
         module = importlib.import_module(f"gearsym.generated.{entry['name']}")
-    except (ModuleNotFoundError, KeyError):
+    except ModuleNotFoundError:
         return None
-    return module if getattr(module, "INPUTS_SHA256", "") == entry.get("digest") else None
+    return module if getattr(module, "INPUTS_SHA256", "") == entry["digest"] else None
 
 
 def _remember(path, digest: str) -> None:
     """Record the fingerprint of ``path``'s files and its digest (best effort: a cache
     folder that cannot be written only costs the fast path)."""
+    from gearsym.derive._input import InputError, load_toml
+
     key = _fingerprint(path)
     if key is None:
         return
-    file = _digests()
     try:
-        known = json.loads(file.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        known = {}
-    name = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    name = (name.get("scene") or name.get("topology") or {}).get("name", "")
-    known[key] = {"name": str(name).replace("-", "_"), "digest": digest}
+        data = load_toml(Path(path))
+    except InputError:
+        return
+    head = data.get("scene") or data.get("topology")
+    name = str(head.get("name", "") if isinstance(head, dict) else "").replace("-", "_")
+    if not (_MODULE_NAME.fullmatch(name) and _SHA256.fullmatch(digest)):
+        return
+    known, why = _read_digests()
+    file = _digests()
+    if why is not None:
+        warnings.warn(f"the cache's fingerprint file {file} {why}; writing it anew", stacklevel=3)
+    known[key] = {"name": name, "digest": digest}
     try:
         file.parent.mkdir(parents=True, exist_ok=True)
         tmp = file.with_name(f".{file.name}.{os.getpid()}.tmp")

@@ -18,6 +18,8 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
+from .escape import is_identifier, is_target_name, one_line
+
 __all__ = ["InputError", "Table", "load_toml", "nearest", "parse_expression"]
 
 
@@ -29,7 +31,7 @@ class InputError(ValueError):
         self.key = key
         self.message = message
         where = f"{source}: {key}" if key else source
-        super().__init__(f"{where}: {message}")
+        super().__init__(one_line(f"{where}: {message}"))
 
 
 def nearest(name: str, allowed: Iterable[str]) -> str:
@@ -52,16 +54,64 @@ def load_toml(path: Path) -> dict[str, Any]:
         raise InputError(
             str(path), "", f"is not UTF-8 text (byte {err.start}); save it as UTF-8"
         ) from None
+    return parse_toml(text, str(path))
+
+
+MAX_DEPTH = 32  # scenes nest 3 levels; far below Python's recursion limit, for every reader
+
+
+def parse_toml(text: str, source: str) -> dict[str, Any]:
+    """Parse TOML ``text`` of file ``source``: syntax errors and nesting deeper than
+    :data:`MAX_DEPTH` arrays or tables (tomllib, copies, hashes recurse) are InputErrors."""
+    deep = f"nests arrays or tables deeper than {MAX_DEPTH} levels; flatten it"
     try:
-        return tomllib.loads(text)
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
-        raise InputError(str(path), "", f"is not valid TOML: {err}") from None
+        raise InputError(source, "", f"is not valid TOML: {err}") from None
+    except RecursionError:
+        raise InputError(source, "", deep) from None
+    pending = [(data, 1, "")]
+    while pending:  # iterative: the check must not recurse itself
+        value, depth, key = pending.pop()
+        if depth > MAX_DEPTH:
+            raise InputError(source, key.split(".")[0], deep)
+        items = value.items() if isinstance(value, dict) else enumerate(value)
+        for k, v in items:
+            if isinstance(v, dict | list):
+                pending.append((v, depth + 1, key or str(k)))
+    return data
 
 
 _MISSING = object()
-_TARGET_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
-_IDENTIFIER = re.compile(r"^[A-Za-z][A-Za-z0-9]*$")
 _MAX_EXPRESSION = 200
+
+
+def shown(value: Any) -> str:
+    """What a wrong value is, for a message: ``"an array [1, 2]"``, ``"the text 'x'"``
+    (its ``repr`` cut to 60 characters)."""
+    kinds = (
+        (bool, "true or false"),
+        (int | float, "a number"),
+        (str, "the text"),
+        (list, "an array"),
+        (dict, "a table"),
+    )
+    what = next((w for t, w in kinds if isinstance(value, t)), type(value).__name__)
+    if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+        what = "an array of tables"
+    text = repr(value)
+    return f"{what} {text if len(text) <= 60 else text[:57] + '...'}"
+
+
+def not_a_table(source: str, key: str, value: Any) -> InputError:
+    """The error for ``value`` at ``key`` where a table belongs, saying how to write one."""
+    if key.endswith("]"):  # an entry of an array of tables
+        form = f"one [[{key.rsplit('[', 1)[0]}]] entry with its keys below"
+    else:
+        head = f"[{key}] with its keys below, or " if "[" not in key else ""
+        form = f"{head}{key.rsplit('.', 1)[-1]} = {{ key = value, ... }}"
+    fix = f"; write [{key}] once" if isinstance(value, list) and "[" not in key else ""
+    return InputError(source, key, f"must be a table ({form}), got {shown(value)}{fix}")
 
 
 class Table:
@@ -79,7 +129,7 @@ class Table:
 
     def __init__(self, data: Any, source: str, prefix: str = ""):
         if not isinstance(data, dict):
-            raise InputError(source, prefix or "(top level)", f"must be a table, got {data!r}")
+            raise not_a_table(source, prefix, data)
         self.data = data
         self.source = source
         self.prefix = prefix
@@ -154,7 +204,7 @@ class Table:
         if value is None:
             return value
         if not isinstance(value, str):
-            raise self.error(name, f"must be a string, got {value!r}")
+            raise self.error(name, f'must be text in quotes ("..."), got {shown(value)}')
         if choices is not None:
             choices = list(choices)
             if value not in choices:
@@ -168,10 +218,10 @@ class Table:
     def target_name(self, name: str) -> str:
         """A scene or topology name: it names ``generated/<name>.py`` ('-' becomes '_')."""
         value = self.string(name)
-        if not _TARGET_NAME.match(value):
+        if not is_target_name(value):
             raise self.error(
                 name,
-                f"'{value}' must start with a letter and use only letters, digits, '-' and '_' "
+                f"{value!r} must start with a letter and use only letters, digits, '-' and '_' "
                 "(it names the generated module)",
             )
         return value
@@ -179,10 +229,10 @@ class Table:
     def identifier(self, name: str) -> str:
         """A name that becomes a Python identifier in generated code (letters, digits)."""
         value = self.string(name)
-        if not _IDENTIFIER.match(value) or keyword.iskeyword(value):
+        if not is_identifier(value):
             raise self.error(
                 name,
-                f"'{value}' must be letters and digits starting with a letter, and not a "
+                f"{value!r} must be letters and digits starting with a letter, and not a "
                 "Python keyword (it becomes a name in generated code)",
             )
         return value
@@ -206,7 +256,7 @@ class Table:
             isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
             for v in value
         ):
-            raise self.error(name, f"must be a list of finite numbers, got {value!r}")
+            raise self.error(name, f"must be a list of finite numbers, got {shown(value)}")
         if length is not None and len(value) != length:
             raise self.error(name, f"must have {length} entries, got {len(value)}")
         if low is not None and any(v < low for v in value):
@@ -217,13 +267,19 @@ class Table:
         value = self._get(name, default)
         if value is None:
             return None
+        if not isinstance(value, dict):
+            raise not_a_table(self.source, self.key(name), value)
         return Table(value, self.source, self.key(name))
 
     def tables(self, name: str) -> list[Table]:
         """An array of tables ``[[name]]`` (required, non-empty)."""
         value = self._get(name, _MISSING)
         if not isinstance(value, list) or not value:
-            raise self.error(name, "must be a non-empty array of tables ([[...]] entries)")
+            raise self.error(
+                name,
+                f"must be a non-empty array of tables (one [[{self.key(name)}]] header per "
+                f"entry), got {shown(value)}",
+            )
         return [Table(v, self.source, f"{self.key(name)}[{i}]") for i, v in enumerate(value)]
 
     def raw(self, name: str, default: Any = _MISSING) -> Any:

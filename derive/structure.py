@@ -145,7 +145,7 @@ def _names(topo: Topology, axes: tuple[str, ...], source: str) -> list[tuple[str
 
     seen: set[str] = set()
     for name, kind, owner in out:
-        if kind == "shaft" and (name in _RESERVED or _BACKLASH_NAME.match(name)):
+        if kind == "shaft" and (name in _RESERVED or _BACKLASH_NAME.fullmatch(name)):
             raise InputError(
                 topo.source,
                 "shaft",

@@ -25,7 +25,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from ._input import InputError, Table, load_toml, nearest
+from ._input import InputError, Table, load_toml, nearest, not_a_table, shown
 
 __all__ = ["Bearing", "Shaft", "load_topology_data", "parse_bearings", "parse_shafts"]
 
@@ -128,6 +128,7 @@ def load_topology_data(path: Path | str, _seen: tuple[str, ...] = ()) -> dict:
     """A topology file's tables with ``extends`` resolved (module docstring)."""
     path = Path(path)
     data = load_toml(path)
+    _check_shape(data, _SHAPE, str(path), "")
     head = data.get("topology")
     if not isinstance(head, dict) or "extends" not in head:
         return data
@@ -145,6 +146,52 @@ def load_topology_data(path: Path | str, _seen: tuple[str, ...] = ()) -> dict:
     own = dict(data)
     own["topology"] = {k: v for k, v in head.items() if k != "extends"}
     return _merge(base, own)
+
+
+# The shape of a topology file, checked as soon as it is read (open values edit the raw
+# data before the topology is parsed): {key: shape} a table whose keys, where present, have
+# these shapes ("*": every key); [shape] an array of such tables; "number", "numbers" and
+# "text" plain values.  parse_topology checks everything else.
+_SHAPE = {
+    "topology": {},
+    "materials": {"*": {}},
+    "operating": {},
+    "gear": [{"id": "text", "attached_inertia_kg_m2": "number"}],
+    "mesh": [
+        {
+            "id": "text",
+            "stiffness": {},
+            "transmission_error": {"amplitude_um": "numbers", "phase_deg": "numbers"},
+        }
+    ],
+    **{name: [{}] for name in ("torque", "bearing", "shaft", "reading")},
+}
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, int | float) and not isinstance(v, bool)
+
+
+def _check_shape(value, shape, source: str, key: str) -> None:
+    """Raise :class:`InputError` naming the first value of ``value`` not of ``shape``."""
+    if isinstance(shape, list):
+        if not isinstance(value, list):
+            what = f"an array of tables (one [[{key}]] header per entry)"
+            raise InputError(source, key, f"must be {what}, got {shown(value)}")
+        for i, entry in enumerate(value):
+            _check_shape(entry, shape[0], source, f"{key}[{i}]")
+    elif isinstance(shape, dict):
+        if not isinstance(value, dict):
+            raise not_a_table(source, key, value)
+        for k, v in value.items():
+            if k in shape or "*" in shape:
+                _check_shape(v, shape.get(k, shape.get("*")), source, f"{key}.{k}" if key else k)
+    elif shape == "text" and not isinstance(value, str):
+        raise InputError(source, key, f'must be text in quotes ("..."), got {shown(value)}')
+    elif shape == "number" and not _is_number(value):
+        raise InputError(source, key, f"must be a number, got {shown(value)}")
+    elif shape == "numbers" and not (isinstance(value, list) and all(map(_is_number, value))):
+        raise InputError(source, key, f"must be a list of numbers, got {shown(value)}")
 
 
 _ENTRY_KEYS = {"bearing": "gear"}  # what names an entry of an array of tables (else "id")

@@ -4,12 +4,21 @@ from a user's scene files to ``models/``.
 
 A root that cannot be written (read-only, a file in the way, a full disk) is replaced by
 a folder under the system's temporary directory, with one warning naming both: the work
-goes on, only the cache does not outlive the machine's next clean-up.
+goes on, only the cache does not outlive the machine's next clean-up.  That folder is
+used only when it is the user's own and no one else may write it (``/tmp`` is shared: a
+folder another user made there first, or a link, is passed over for a fresh private one).
+
+What lies in the cache runs with the user's rights: a model is imported as Python, a
+library loaded as machine code.  The resolver (``gearsym/resolve.py``) imports a cached
+model only when its bytes hash to the digest written beside it; that guards against
+corruption, not against someone who can already write the user's files
+(``docs/user-guide.md``, "Who can write the cache").
 """
 
 from __future__ import annotations
 
 import os
+import stat
 import tempfile
 import warnings
 from pathlib import Path
@@ -37,7 +46,7 @@ def _usable(wanted: Path) -> Path:
         return wanted
     user = os.getuid() if hasattr(os, "getuid") else "user"
     fallback = Path(tempfile.gettempdir()) / f"gearsym-cache-{user}"
-    if _unwritable(fallback) is not None:
+    if not _private(fallback) or _unwritable(fallback) is not None:
         fallback = Path(tempfile.mkdtemp(prefix="gearsym-cache-"))
     warnings.warn(
         f"the cache {wanted} cannot be written ({why}); using {fallback} instead "
@@ -45,6 +54,23 @@ def _usable(wanted: Path) -> Path:
         stacklevel=3,
     )
     return fallback
+
+
+def _private(folder: Path) -> bool:
+    """Whether ``folder`` (made now if missing, for this user only) is a real folder of
+    this user that no one else may write."""
+    if not hasattr(os, "getuid"):
+        return True
+    try:
+        folder.mkdir(mode=0o700, exist_ok=True)
+        st = folder.lstat()
+    except OSError:
+        return False
+    return (
+        stat.S_ISDIR(st.st_mode)
+        and st.st_uid == os.getuid()
+        and not st.st_mode & (stat.S_IWGRP | stat.S_IWOTH)
+    )
 
 
 def _unwritable(folder: Path) -> str | None:

@@ -177,8 +177,12 @@ def test_built_in_names_take_underscores_and_user_scenes_derive_into_the_cache(
     code, out, err = run(capsys, "derive", str(scene))
     assert code == 0, err
     written = sorted((tmp_path / "cache" / "models").iterdir())
-    assert [p.suffix for p in written] == [".md", ".py"], written
+    assert [p.suffix for p in written] == [".md", ".py", ".sha256"], written
     assert not (root / "generated" / "my_light.py").exists()
+    import warnings
+
     from gearsym.resolve import module_for
 
-    assert module_for(scene).__file__ == str(written[1])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the module and its digest agree: no re-derivation
+        assert module_for(scene).__file__ == str(written[1])

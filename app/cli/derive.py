@@ -149,9 +149,11 @@ def _cmd_derive(args) -> int:
     if args.dry_run:
         written = []
     elif where is None:
+        from gearsym.resolve import store_cached
+
         written = [Path(p) for p in files]
-        for path, text in files.items():
-            write_atomic(Path(path), text)
+        for path, text in files.items():  # a module goes into the cache with its digest
+            (store_cached if path.endswith(".py") else write_atomic)(Path(path), text)
     else:
         written = write_files(files, where)
         if shipped:

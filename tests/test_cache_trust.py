@@ -1,0 +1,221 @@
+"""The derivation cache is verified, never trusted (issue 23).
+
+A cached model is imported only when the sha256 of its bytes equals the digest written
+beside it; a module that is empty, cut short, edited or not Python, or whose digest is
+missing or wrong, is derived again with one warning and is never run.  A ``digests.json``
+of the wrong shape is written anew with one warning.  The shipped models in ``generated/``
+are part of the package and load as before.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+
+import pytest
+from gearsym import resolve
+
+
+@pytest.fixture(scope="module")
+def seeded(tmp_path_factory, root):
+    """A user's scene (the light-load scene under another name) and a cache folder holding
+    its model, derived once for the whole module: (scene, cache folder, module file)."""
+    folder = tmp_path_factory.mktemp("trust")
+    text = (root / "scenes" / "reference-light.toml").read_text(encoding="utf-8")
+    text = text.replace('topology = "topologies/diso.toml"', 'topology = "diso"')
+    text = text.replace('name = "reference-light"', 'name = "trust-light"')
+    scene = folder / "trust-light.toml"
+    scene.write_text(text, encoding="utf-8")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("GEARSYM_CACHE", str(folder / "seed"))
+        module = resolve.module_for(scene)
+    return scene, folder / "seed", Path(module.__file__)
+
+
+@pytest.fixture
+def cache(seeded, tmp_path, monkeypatch):
+    """A copy of the seeded cache as this test's cache: (scene, module file, digest file)."""
+    scene, seed, module = seeded
+    shutil.copytree(seed, tmp_path / "cache")
+    monkeypatch.setenv("GEARSYM_CACHE", str(tmp_path / "cache"))
+    mine = tmp_path / "cache" / module.relative_to(seed)
+    return scene, mine, mine.with_suffix(".sha256")
+
+
+def loaded(target):
+    """(module, messages of the warnings raised) of ``resolve.module_for(target)``."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        module = resolve.module_for(target)
+    return module, [str(w.message) for w in caught]
+
+
+def test_a_model_is_cached_with_the_digest_of_its_bytes_and_loads_without_deriving(
+    cache, monkeypatch
+):
+    scene, module, digest = cache
+    stated = digest.read_text(encoding="ascii")
+    assert stated == hashlib.sha256(module.read_bytes()).hexdigest() + "\n"
+
+    def derive_model(*args, **kwargs):
+        raise AssertionError("a verified cached model was derived again")
+
+    monkeypatch.setattr("gearsym.derive.derive_model", derive_model)
+    got, messages = loaded(scene)
+    assert messages == []
+    assert got.__file__ == str(module) and got.NAME == "trust_light"
+
+
+def _edited(module: Path, digest: Path) -> None:
+    # Valid Python that would leave a file behind if it were ever run.
+    marker = module.parent / "ran.txt"
+    with module.open("a", encoding="utf-8") as fh:
+        fh.write(f"\nopen({str(marker)!r}, 'w').write('ran')\n")
+
+
+CORRUPTIONS = {
+    "empty": lambda m, d: m.write_bytes(b""),
+    "cut short": lambda m, d: m.write_bytes(m.read_bytes()[: m.stat().st_size // 2]),
+    "edited": _edited,
+    "not Python": lambda m, d: m.write_bytes(b"\x00\xff\xfe not ( Python"),
+    "not UTF-8": lambda m, d: m.write_bytes(b"\xff" + m.read_bytes()[1:]),
+    "no digest": lambda m, d: d.unlink(),
+    "digest of other bytes": lambda m, d: d.write_text(hashlib.sha256(b"x").hexdigest()),
+    "digest not a digest": lambda m, d: d.write_text("[1, 2]\n"),
+    "digest empty": lambda m, d: d.write_bytes(b""),
+    "digest not text": lambda m, d: d.write_bytes(b"\xff\xfe\x00"),
+}
+
+
+@pytest.mark.parametrize("how", CORRUPTIONS)
+def test_a_corrupted_cached_model_is_derived_again_with_one_warning_and_never_run(
+    cache, seeded, how
+):
+    scene, module, digest = cache
+    CORRUPTIONS[how](module, digest)
+    got, messages = loaded(scene)
+    assert len(messages) == 1, messages
+    assert str(module) in messages[0] and "deriving it again" in messages[0]
+    assert "\n" not in messages[0]
+    assert not (module.parent / "ran.txt").exists()  # the edited module never ran
+    assert got.__file__ == str(module) and got.NAME == "trust_light"
+    assert module.read_bytes() == seeded[2].read_bytes()  # derived again, byte for byte
+    assert digest.read_text() == hashlib.sha256(module.read_bytes()).hexdigest() + "\n"
+    assert loaded(scene)[1] == []  # mended: trusted again
+
+
+def test_a_missing_cached_model_is_derived_without_a_warning(cache):
+    scene, module, digest = cache
+    module.unlink()
+    got, messages = loaded(scene)
+    assert messages == [] and got.__file__ == str(module)
+    assert digest.read_text() == hashlib.sha256(module.read_bytes()).hexdigest() + "\n"
+
+
+DIGEST_FILES = {
+    "an array": "[]",
+    "an array of numbers": "[1, 2]",
+    "text": '"x"',
+    "a number": "5",
+    "empty": "",
+    "cut short": '{"a',
+    "not UTF-8": b"\xff\xfe{}",
+    "nested without end": "[" * 100_000 + "]" * 100_000,
+    "an entry that is text": json.dumps({"0" * 64: "reference_light"}),
+    "an entry that is an array": json.dumps({"0" * 64: ["reference_light", "0" * 64]}),
+    "an entry without a digest": json.dumps({"0" * 64: {"name": "reference_light"}}),
+    "an entry naming a dotted module": json.dumps(
+        {"0" * 64: {"name": "reference_light.os", "digest": "0" * 64}}
+    ),
+    "an entry with a digest that is a number": json.dumps(
+        {"0" * 64: {"name": "reference_light", "digest": 5}}
+    ),
+    "a key that is not a fingerprint": json.dumps(
+        {"../x": {"name": "reference_light", "digest": "0" * 64}}
+    ),
+}
+
+
+@pytest.mark.parametrize("how", DIGEST_FILES)
+def test_a_digests_file_of_the_wrong_shape_is_written_anew_with_one_warning(
+    tmp_path, monkeypatch, how
+):
+    import gearsym.generated.reference_light as shipped
+
+    monkeypatch.setenv("GEARSYM_CACHE", str(tmp_path / "cache"))
+    file = tmp_path / "cache" / "models" / "digests.json"
+    file.parent.mkdir(parents=True)
+    content = DIGEST_FILES[how]
+    file.write_bytes(content if isinstance(content, bytes) else content.encode())
+    got, messages = loaded("reference-light")
+    assert got is shipped
+    assert len(messages) == 1, messages
+    assert str(file) in messages[0] and "writing it anew" in messages[0]
+    known = json.loads(file.read_text(encoding="utf-8"))
+    assert isinstance(known, dict) and len(known) == 1
+    assert list(known.values()) == [{"name": "reference_light", "digest": shipped.INPUTS_SHA256}]
+
+    def load_target(*args, **kwargs):
+        raise AssertionError("the fast path was not taken")
+
+    monkeypatch.setattr("gearsym.derive.load_target", load_target)
+    assert loaded("reference-light") == (shipped, [])  # mended: the fast path again
+
+
+def test_the_shipped_models_load_from_the_package_and_nothing_of_them_enters_the_cache(
+    tmp_path, monkeypatch, root
+):
+    import gearsym.generated.reference_light as shipped
+
+    monkeypatch.setenv("GEARSYM_CACHE", str(tmp_path / "cache"))
+    before = Path(shipped.__file__).read_bytes()
+    for _ in range(2):  # the slow path, then the fast one
+        assert loaded("reference-light") == (shipped, [])
+    assert Path(shipped.__file__).read_bytes() == before
+    assert Path(shipped.__file__).parent == root / "generated"
+    assert [p.name for p in (tmp_path / "cache" / "models").iterdir()] == ["digests.json"]
+
+
+def test_on_the_command_line_a_corrupted_model_is_one_warning_line_and_the_run_goes_on(
+    cache, tmp_path
+):
+    scene, module, digest = cache
+    module.write_bytes(b"")
+    env = dict(os.environ, GEARSYM_CACHE=str(tmp_path / "cache"))
+    argv = f"simulate {scene} --method RK45 --transient 0 --periods 1 --lyapunov-periods 0"
+    done = subprocess.run(
+        [sys.executable, "-m", "gearsym", *argv.split()],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=tmp_path,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    lines = done.stderr.splitlines()
+    assert len(lines) == 1, done.stderr
+    assert lines[0].startswith("gearsym: warning: the cached model ")
+    assert "deriving it again" in lines[0]
+    assert "trust_light" in done.stdout
+
+
+@pytest.mark.skipif(not hasattr(os, "getuid"), reason="POSIX owners and modes")
+def test_the_fallback_under_a_shared_temporary_folder_must_be_private(tmp_path):
+    # When the cache root cannot be written, gearsym falls back to a folder under /tmp:
+    # one that others may write (or a link someone planted) is passed over.
+    from gearsym.solver.cache import _private
+
+    assert _private(tmp_path / "new")  # made now, for this user only
+    assert (tmp_path / "new").stat().st_mode & 0o777 == 0o700
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    shared.chmod(0o777)
+    assert not _private(shared)
+    (tmp_path / "link").symlink_to(tmp_path / "new")
+    assert not _private(tmp_path / "link")
