@@ -261,10 +261,13 @@ def fit_dead_zone(
                 f"step {step:g} gives {samples} samples (at most {_MAX_SAMPLES}); use a step "
                 f">= {2.0 * fit_range / (_MAX_SAMPLES - 1):.3g}, or 0 for the continuous fit"
             )
-        if samples <= len(powers):
+        # The fit is odd: only the samples at t > 0 determine it, and the Gram matrix of
+        # len(powers) odd powers needs as many distinct ones.
+        positive = (samples - 1) - (samples - 1) // 2
+        if positive < len(powers):
             raise ValueError(
-                f"step {step} leaves {samples} samples for {len(powers)} "
-                "coefficients; use a smaller step"
+                f"step {step:g} leaves {positive} sample(s) above zero for the {len(powers)} "
+                f"odd coefficients; use a step of at most {fit_range / len(powers):.3g}"
             )
         # Samples t_i = j / M, j = 2i - M (i = 0..M, M = samples - 1).  Both sides are odd
         # in t, so the sums run over t > 0 (j > 0) and the factor 2 cancels; the dead zone

@@ -37,7 +37,7 @@ from ._version import EMITTED_FORMAT, __version__
 from .contract import CONTRACT_FORMAT, model_contract
 from .equations import derive_equations
 from .nondim import NonDim, nondimensionalise
-from .scene import Features, Scene
+from .scene import Features, Scene, limit_text
 from .structure import derive_structure
 
 __all__ = ["CONTRACT_FORMAT", "Model", "Parameter", "derive_model", "operation_count"]
@@ -188,7 +188,16 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
 
     omega_value = scene.omega
     if omega_value is None:  # a topology: from its operating speed and omega_n
-        omega_value = topo.reference_mesh_frequency() / nd.value(nd.omega_n_expr)
+        omega_n = nd.value(nd.omega_n_expr)
+        omega_value = topo.reference_mesh_frequency() / omega_n
+        if (why := limit_text("omega", omega_value)) is not None:
+            raise InputError(
+                topo.source,
+                "operating.speed_rpm",
+                f"gives omega = mesh frequency / omega_n = {omega_value:.3g} (omega_n = "
+                f"{omega_n:.3g} rad/s from the stiffness and inertias), and omega {why}; check "
+                "the speed, the stiffness and the inertias",
+            )
     omega = param(
         "omega",
         omega_value,

@@ -376,7 +376,10 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
 # The one rule per scene parameter: (low, high, low excluded).  The scene file is checked
 # here; the generated module carries the same table (SCENE_PARAMETER_LIMITS, emit.py) and
 # checks every value that reaches parameters(): --set, sweep ranges, map axes, continuation.
-PARAMETER_LIMITS = {"omega": (0.0, None, True), "damping_ratio": (0.0, 1.0, False)}
+# omega (the mesh frequency over omega_n) in [1e-3, 1e3]: below, the excitation is
+# quasi-static and one period costs more than 1000 periods at omega = 1 (bounded work);
+# above, it is a thousand times any mesh-to-natural frequency ratio a gear train runs at.
+PARAMETER_LIMITS = {"omega": (1e-3, 1e3, False), "damping_ratio": (0.0, 1.0, False)}
 
 
 def limit_text(key: str, value: float) -> str | None:

@@ -47,7 +47,7 @@ __all__ = [
 
 # Names the generated code uses itself; coordinates may not take them.
 _RESERVED = {"tau", "x", "p", "np", "ca", "omega", "out", "jac", "rhs"}
-_BACKLASH_NAME = re.compile(r"^g[0-9]+$")
+_BACKLASH_NAME = re.compile(r"g[0-9]+")
 
 
 @dataclass(frozen=True)
@@ -237,9 +237,10 @@ class Topology:
 def _material(t: Table, name: str) -> Material:
     return Material(
         name=name,
-        youngs_modulus=t.number("youngs_modulus_Pa", low=0, low_open=True),
+        # From rubber to past diamond: beyond, the stiffness overflows or vanishes.
+        youngs_modulus=t.number("youngs_modulus_Pa", low=1e6, high=1e13),
         poisson_ratio=t.number("poisson_ratio", low=0, high=0.5, high_open=True),
-        density=t.number("density_kg_m3", low=0, low_open=True),
+        density=t.number("density_kg_m3", low=10.0, high=1e5),
     )
 
 
@@ -304,11 +305,13 @@ def _gear(t: Table, materials: dict[str, Material]) -> Gear:
             "bore_radius_mm",
             f"{bore * 1e3:g} mm must be below the root radius {geometry.root_radius * 1e3:.3f} mm",
         )
-    inertia = t.number("inertia_kg_m2", None, low=0, low_open=True)
-    attached = t.number("attached_inertia_kg_m2", 0.0, low=0.0)
+    # 1e-15 to 1e9 kg m^2: a watch gear to a ship's propeller shaft line many times over;
+    # outside, the modes and scales overflow.
+    inertia = t.number("inertia_kg_m2", None, low=1e-15, high=1e9)
+    attached = t.number("attached_inertia_kg_m2", 0.0, low=0.0, high=1e9)
     mass = t.number("mass_kg", None, low=0, low_open=True, high=1e6)
     attached_mass = t.number("attached_mass_kg", 0.0, low=0.0, high=1e6)
-    diametral = t.number("diametral_inertia_kg_m2", None, low=0, low_open=True)
+    diametral = t.number("diametral_inertia_kg_m2", None, low=1e-15, high=1e9)
     t.finish()
     return Gear(
         gid,
@@ -344,7 +347,8 @@ def _stiffness_of(t: Table, pair: PairGeometry, gears: tuple[Gear, Gear]) -> Mes
     source = t.string("source", choices=("harmonics", "contact-line", "potential-energy"))
     if source == "potential-energy":
         return _pem_stiffness(t, pair, gears)
-    mean = t.number("mean_N_per_m", low=0, low_open=True)
+    # 1 kN/mm-scale plastics down to 1e3 N/m, steel's 1e8-1e10 N/m up to 1e13 N/m.
+    mean = t.number("mean_N_per_m", low=1e3, high=1e13)
     if source == "harmonics":
         cos = t.numbers("cos_N_per_m", [])
         sin = t.numbers("sin_N_per_m", [])
@@ -564,7 +568,7 @@ def parse_topology(data: dict, source: str) -> Topology:
             raise mt.error("driven", f"'{ends[0]}' and '{ends[1]}' cannot mesh: {err}") from None
         _check_contact(mt, pair, ends)
         coordinate = mt.identifier("coordinate")
-        if coordinate in _RESERVED or _BACKLASH_NAME.match(coordinate):
+        if coordinate in _RESERVED or _BACKLASH_NAME.fullmatch(coordinate):
             raise mt.error(
                 "coordinate",
                 f"'{coordinate}' is reserved; avoid {', '.join(sorted(_RESERVED))} and g1, g3, ...",
@@ -631,7 +635,7 @@ def parse_topology(data: dict, source: str) -> Topology:
             raise ot.error("gear", f"names unknown gear '{gid}'" + nearest(gid, by_id))
         operating = Operating(
             gid,
-            ot.number("speed_rpm", low=0, low_open=True) * math.pi / 30,
+            ot.number("speed_rpm", low=0, low_open=True, high=1e6) * math.pi / 30,
             ot.number("damping_ratio", low=0.0, high=1.0),
         )
         ot.finish()

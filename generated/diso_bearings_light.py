@@ -255,7 +255,7 @@ HALF_BACKLASH = {'u': 5e-05, 'v': 5e-05}  # m
 FEATURES = {'stiffness_harmonics': 3, 'backlash': 'polynomial', 'transmission_error': True, 'mesh_phase': True, 'damping_coupling': True, 'degrees_of_freedom': 'lateral-torsional-axial'}
 SCENE_PARAMETERS = {'omega': 0.5, 'damping_ratio': 0.03, 'f1': 0.1, 'lambda': 0.1}
 # (low, high, low excluded): derive/scene.py PARAMETER_LIMITS
-SCENE_PARAMETER_LIMITS = {'omega': (0.0, None, True), 'damping_ratio': (0.0, 1.0, False)}
+SCENE_PARAMETER_LIMITS = {'omega': (0.001, 1000.0, False), 'damping_ratio': (0.0, 1.0, False)}
 # mesh coordinate: ((cos index, sin index, harmonic), ...) of k_hat = 1 + sum ...
 STIFFNESS_TERMS = {'u': ((77, 78, 1), (79, 80, 2), (81, 82, 3)), 'v': ((83, 84, 1), (85, 86, 2), (87, 88, 3))}
 OPERATIONS = {'rhs': 232, 'rhs_and_jacobian': 399}

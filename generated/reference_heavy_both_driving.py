@@ -105,7 +105,7 @@ HALF_BACKLASH = {'u': 5e-05, 'v': 5e-05}  # m
 FEATURES = {'stiffness_harmonics': 3, 'backlash': 'polynomial', 'transmission_error': True, 'mesh_phase': True, 'damping_coupling': True}
 SCENE_PARAMETERS = {'omega': 0.5, 'damping_ratio': 0.03, 'f1': 0.5, 'lambda': 0.1}
 # (low, high, low excluded): derive/scene.py PARAMETER_LIMITS
-SCENE_PARAMETER_LIMITS = {'omega': (0.0, None, True), 'damping_ratio': (0.0, 1.0, False)}
+SCENE_PARAMETER_LIMITS = {'omega': (0.001, 1000.0, False), 'damping_ratio': (0.0, 1.0, False)}
 # mesh coordinate: ((cos index, sin index, harmonic), ...) of k_hat = 1 + sum ...
 STIFFNESS_TERMS = {'u': ((11, 12, 1), (13, 14, 2), (15, 16, 3)), 'v': ((17, 18, 1), (19, 20, 2), (21, 22, 3))}
 OPERATIONS = {'rhs': 91, 'rhs_and_jacobian': 132}

@@ -59,7 +59,7 @@ HALF_BACKLASH = {'u': 5e-05, 'v': 5e-05}  # m
 FEATURES = {'stiffness_harmonics': 0, 'backlash': 'linear', 'transmission_error': False, 'mesh_phase': False, 'damping_coupling': False}
 SCENE_PARAMETERS = {'omega': 0.5, 'damping_ratio': 0.03, 'f1': 0.1, 'lambda': 0.1}
 # (low, high, low excluded): derive/scene.py PARAMETER_LIMITS
-SCENE_PARAMETER_LIMITS = {'omega': (0.0, None, True), 'damping_ratio': (0.0, 1.0, False)}
+SCENE_PARAMETER_LIMITS = {'omega': (0.001, 1000.0, False), 'damping_ratio': (0.0, 1.0, False)}
 # mesh coordinate: ((cos index, sin index, harmonic), ...) of k_hat = 1 + sum ...
 STIFFNESS_TERMS = {}
 OPERATIONS = {'rhs': 14, 'rhs_and_jacobian': 20}

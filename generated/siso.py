@@ -71,7 +71,7 @@ HALF_BACKLASH = {'u': 5e-05}  # m
 FEATURES = {'stiffness_harmonics': 3, 'backlash': 'polynomial', 'transmission_error': True, 'mesh_phase': True, 'damping_coupling': True}
 SCENE_PARAMETERS = {'damping_ratio': 0.03, 'omega': 0.709571332557897}
 # (low, high, low excluded): derive/scene.py PARAMETER_LIMITS
-SCENE_PARAMETER_LIMITS = {'omega': (0.0, None, True), 'damping_ratio': (0.0, 1.0, False)}
+SCENE_PARAMETER_LIMITS = {'omega': (0.001, 1000.0, False), 'damping_ratio': (0.0, 1.0, False)}
 # mesh coordinate: ((cos index, sin index, harmonic), ...) of k_hat = 1 + sum ...
 STIFFNESS_TERMS = {'u': ((4, 5, 1), (6, 7, 2), (8, 9, 3))}
 OPERATIONS = {'rhs': 41, 'rhs_and_jacobian': 55}

@@ -283,7 +283,7 @@ HALF_BACKLASH = {'v': 6e-05, 'u': 5e-05}  # m
 FEATURES = {'stiffness_harmonics': 3, 'backlash': 'polynomial', 'transmission_error': True, 'mesh_phase': True, 'damping_coupling': True, 'degrees_of_freedom': 'lateral-torsional-axial'}
 SCENE_PARAMETERS = {'damping_ratio': 0.03, 'omega': 0.132368546051907}
 # (low, high, low excluded): derive/scene.py PARAMETER_LIMITS
-SCENE_PARAMETER_LIMITS = {'omega': (0.0, None, True), 'damping_ratio': (0.0, 1.0, False)}
+SCENE_PARAMETER_LIMITS = {'omega': (0.001, 1000.0, False), 'damping_ratio': (0.0, 1.0, False)}
 # mesh coordinate: ((cos index, sin index, harmonic), ...) of k_hat = 1 + sum ...
 STIFFNESS_TERMS = {'v': ((89, 90, 1), (91, 92, 2), (93, 94, 3)), 'u': ((95, 96, 1), (97, 98, 2), (99, 100, 3))}
 OPERATIONS = {'rhs': 258, 'rhs_and_jacobian': 439}

@@ -266,19 +266,163 @@ CASES += [
 # -- issue 23: hostile and careless inputs (each block is one class of docs/robustness.md) --
 
 # files of the wrong shape: wrong TOML types at any key, arrays for tables, deep nesting
-CASES += []
+DEEP = 40  # levels of nesting, past derive._input.MAX_DEPTH
+NESTED_ARRAY = "x = " + "[" * DEEP + "]" * DEEP
+NESTED = "x = " + "{a = " * 999 + "1" + "}" * 999  # past tomllib's own recursion
+SCENE_EDITS.update(
+    {
+        "topology_number": ('topology = "diso"', "topology = 5"),
+        "topology_list": ('topology = "diso"', 'topology = ["diso"]'),
+        "topology_table": ('topology = "diso"', 'topology = { file = "diso" }'),
+        "name_number": ('name = "reference-light"', "name = 5"),
+        "scene_array": ("[scene]", "[[scene]]"),
+        "features_array": ("[features]", "[[features]]"),
+        "parameters_array": ("[parameters]", "[[parameters]]"),
+        "loads_array": ("[loads]", "[[loads]]"),
+        "open_array": ("[open]", "[[open]]"),
+        "harmonics_text": ("stiffness_harmonics = 3 ", 'stiffness_harmonics = "3" '),
+        "mesh_phase_text": ("mesh_phase = true", 'mesh_phase = "yes"'),
+        "omega_table": ("omega = 0.5 ", "omega = { value = 0.5 } "),
+        "load_list": ('u = "f1"', 'u = ["f1"]'),
+        "reading_number": ('load_reading = "q-braking"', "load_reading = 1"),
+        "open_text": ("[open]", '[open]\nte_amplitude_um = "5"'),
+        "deep_array": ("mesh_phase = true", "mesh_phase = true\n" + NESTED_ARRAY),
+        "deep_table": ("mesh_phase = true", "mesh_phase = true\n" + NESTED),
+    }
+)
+# One replaced line of scenes/topologies/diso.toml (every occurrence), used by a copy of
+# the light-load scene: the placeholder {topo:KEY}.
+TOPOLOGY_EDITS = {
+    "topology_array": ("[topology]", "[[topology]]"),
+    "extends_number": ('name = "diso"', 'name = "diso"\nextends = 5'),
+    "materials_array": ("[materials.steel]", "[[materials.steel]]"),
+    "gear_table": ("[[gear]]", "[[gear.entry]]"),
+    "gear_id_number": ('id = "p"\n', "id = 1\n"),
+    "teeth_text": ("teeth = 100", 'teeth = "100"'),
+    "flywheel_text": ("attached_inertia_kg_m2 = 10.0", 'attached_inertia_kg_m2 = "10"'),
+    "driver_list": ('driver = "p"', 'driver = ["p"]'),
+    "stiffness_text": (
+        'stiffness = { source = "potential-energy", slices = 200, harmonics = 10 }',
+        'stiffness = "potential-energy"',
+    ),
+    "te_number": ("amplitude_um = [5.0]", "amplitude_um = 5.0"),
+    "reading_text": ('driving = ["p"]\n', 'driving = "p"\n'),
+    "torque_table": ("[[torque]]", "[[torque.entry]]"),
+    "operating_array": ("[operating]", "[[operating]]"),
+    "deep": ("[operating]", NESTED_ARRAY + "\n[operating]"),
+}
+CASES += [
+    ("simulate {scene:topology_number}", "scene.topology: must be text"),
+    ("simulate {scene:topology_list}", "scene.topology: must be text"),
+    ("derive {scene:topology_table}", "scene.topology: must be text"),
+    ("simulate {scene:name_number}", "scene.name: must be text"),
+    ("simulate {scene:scene_array}", "write [scene] once"),
+    ("derive {scene:scene_array}", "scene: must be a table"),
+    ("stiffness {scene:scene_array}", "scene: must be a table"),
+    ("simulate {scene:features_array}", "features: must be a table"),
+    ("simulate {scene:parameters_array}", "parameters: must be a table"),
+    ("simulate {scene:loads_array}", "loads: must be a table"),
+    ("simulate {scene:open_array}", "open: must be a table"),
+    ("simulate {scene:harmonics_text}", "features.stiffness_harmonics"),
+    ("simulate {scene:mesh_phase_text}", "features.mesh_phase"),
+    ("simulate {scene:omega_table}", "parameters.omega"),
+    ("simulate {scene:load_list}", "loads.u"),
+    ("simulate {scene:reading_number}", "open.load_reading: must be text"),
+    ("simulate {scene:open_text}", "open.te_amplitude_um"),
+    ("simulate {scene:deep_array}", "deeper than 32 levels"),
+    ("derive {scene:deep_table}", "deeper than 32 levels"),
+    ("simulate {topo:topology_array}", "write [topology] once"),
+    ("simulate {topo:extends_number}", "topology.extends"),
+    ("simulate {topo:materials_array}", "materials.steel: must be a table"),
+    ("simulate {topo:gear_table}", "gear: must be an array of tables"),
+    ("derive {topo:gear_table}", "gear: must be an array of tables"),
+    ("simulate {topo:gear_id_number}", "gear[0].id: must be text"),
+    ("simulate {topo:teeth_text}", "gear[2].teeth"),
+    ("simulate {topo:flywheel_text}", "gear[2].attached_inertia_kg_m2"),
+    ("simulate {topo:driver_list}", "mesh[0].driver: must be text"),
+    ("simulate {topo:stiffness_text}", "mesh[0].stiffness: must be a table"),
+    ("stiffness {topo:stiffness_text}", "mesh[0].stiffness: must be a table"),
+    ("simulate {topo:te_number}", "mesh[0].transmission_error.amplitude_um"),
+    ("simulate {topo:reading_text}", "reading[0].driving"),
+    ("simulate {topo:torque_table}", "torque: must be an array of tables"),
+    ("simulate {topo:operating_array}", "operating: must be a table"),
+    ("simulate {topo:deep}", "deeper than 32 levels"),
+]
 
 # the derivation cache: a corrupted module or digest is derived again (tests/test_cache_trust.py)
 CASES += []
 
 # continuation parameters and their valid ranges
-CASES += []
+CASES += [
+    (f"{FR} --param load_reading=0:1:3", "open value"),
+    (f"{FR} --param flywheel_inertia_kg_m2=0:1:3", "open value"),
+    ("continue reference-light --param layout_angle_deg --from 0 --to 10", "open value"),
+    (f"{FR} --param nosuch=0:1:3", "nosuch"),
+    (f"{FR} --param damping_ratio=0.03:1.5:3", "damping_ratio"),
+    (f"{FR} --param omega=0.5:-0.1:3", "omega"),
+    ("continue reference-light --param damping_ratio --from 0.03 --to 2", "damping_ratio"),
+    ("continue reference-light --param nosuch --from 0.1 --to 0.2", "nosuch"),
+]
 
 # bounded work: every size that sets the cost
-CASES += []
+CASES += [
+    (f"{SH} --period 100000", "--period"),
+    (f"{SH} --period 65", "--period"),
+    (f"{SH} --segments 257", "--segments"),
+    (f"{SH} --period 2 --tries 101", "--tries"),
+    (f"{SH} --settle 300000", "--settle"),
+    (f"{SH} --period 64 --tries 100", "--tries"),
+    (f"{CO} --from 0.1 --to 0.5 --step 1e300", "--step"),
+    (f"{CO} --from 0.1 --to 0.5 --step 0.5", "--step"),
+    (f"{CO} --from 0.1 --to 0.5 --step 1e-7", "--step"),
+    (f"{CO} --from 0.1 --to 0.5 --period 65", "--period"),
+    (f"{CO} --from 0.1 --to 0.5 --settle 300000", "--settle"),
+    (f"{FR} --param omega=0.4:0.5:20001", "NUM"),
+    (f"{FR} --param omega=0.4:0.5:2001 --method shooting", "NUM"),
+    (f"{FR} --param omega=0.4:0.5:3 --harmonics 300", "--harmonics"),
+    (f"{FR} --param omega=0.4:0.5:3 --period 65", "--period"),
+    (f"{FR} --param omega=0.4:0.5:3 --method integration --settle 10001", "--settle"),
+    (f"{FR} --param omega=0.4:0.5:3 --method integration --sampled 10001", "--sampled"),
+    (f"{FR} --param omega=0.4:0.5:2000 --method integration --settle 10000", "--settle"),
+    (f"{S} --transient 1000001", "--transient"),
+    (f"{S} --periods 1000001", "--periods"),
+    (f"{S} --lyapunov-periods 100001", "--lyapunov-periods"),
+    (f"{SW} --range 0:1:100001", "--range"),
+    (f"{SW} --range 0:1:10000 --transient 200000", "--range"),
+    (f"{MP} {MAPXY} --initial-states 65", "--initial-states"),
+    (f"{MP} {MAPXY} --workers 1025", "--workers"),
+    (f"{MP} {MAPXY} --transient 1000001", "--transient"),
+    (f"{MP} --x lambda=0:1:100 --y f1=0.1:0.2:100 --transient 100000 --periods 1", "hours"),
+]
 
-# strict JSON and Unix manners (tests/test_unix_manners.py)
-CASES += []
+# strict JSON and Unix manners (tests/test_unix_manners.py): values so far outside any
+# gear train that the numbers would overflow are refused before they reach JSON
+TOPOLOGY_EDITS.update(
+    {
+        "young_absurd": ("youngs_modulus_Pa = 2.06e11", "youngs_modulus_Pa = 1e200"),
+        "density_absurd": ("density_kg_m3 = 7850", "density_kg_m3 = 1e-3"),
+        "inertia_tiny": ('id = "p"\n', 'id = "p"\ninertia_kg_m2 = 1e-320\n'),
+        "flywheel_huge": ("attached_inertia_kg_m2 = 10.0", "attached_inertia_kg_m2 = 1e300"),
+        "stiffness_vanishing": (
+            '{ source = "potential-energy", slices = 200, harmonics = 10 }',
+            '{ source = "harmonics", mean_N_per_m = 1e-320 }',
+        ),
+        "speed_tiny": ("speed_rpm = 1500", "speed_rpm = 1.8e-252"),
+        "speed_huge": ("speed_rpm = 1500", "speed_rpm = 1e9"),
+    }
+)
+CASES += [
+    ("stiffness {topo:young_absurd} --json", "youngs_modulus_Pa: must be <= 1e+13"),
+    ("modes {topo:density_absurd} --json", "density_kg_m3: must be >= 10"),
+    ("modes {topo:inertia_tiny} --json", "inertia_kg_m2: must be >= 1e-15"),
+    ("modes {topo:flywheel_huge} --json", "attached_inertia_kg_m2: must be <= 1e+09"),
+    ("simulate {topo:stiffness_vanishing}", "mean_N_per_m: must be >= 1000"),
+    # a topology runs at its own speed: omega within [1e-3, 1e3] (bounded work)
+    ("simulate {topofile:speed_tiny}", "operating.speed_rpm"),
+    ("modes {topofile:speed_huge}", "operating.speed_rpm: must be <= 1e+06"),
+    ("simulate reference-light --set omega=1e-4", "omega must be in [0.001, 1000]"),
+    ("backlash --step 1.5", "use a step of at most 0.75"),
+]
 
 
 def make_files(folder, root) -> dict:
@@ -307,6 +451,14 @@ def make_files(folder, root) -> dict:
         path = folder / f"scene-{key}.toml"
         path.write_text(scene.replace(old, new), encoding="utf-8")
         files[f"scene:{key}"] = str(path)
+    topology = (Path(root) / "scenes" / "topologies" / "diso.toml").read_text(encoding="utf-8")
+    for key, (old, new) in TOPOLOGY_EDITS.items():
+        assert old in topology, old
+        (folder / f"topo-{key}.toml").write_text(topology.replace(old, new), encoding="utf-8")
+        path = folder / f"scene-topo-{key}.toml"
+        path.write_text(scene.replace('"diso"', f'"topo-{key}.toml"'), encoding="utf-8")
+        files[f"topo:{key}"] = str(path)
+        files[f"topofile:{key}"] = str(folder / f"topo-{key}.toml")
     return files
 
 

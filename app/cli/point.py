@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
 from ._common import (
@@ -111,6 +113,8 @@ def _cmd_simulate(args) -> int:
     code = 0 if tr.status == "ok" else 3
     if args.json:
         print(dumps(data, indent=1))
+        if code:  # stdout is for the reading program; the failure is said on stderr too
+            print(f"gearsym: run failed: status {tr.status}: {tr.message}", file=sys.stderr)
         return code
     print(
         f"{system.name}: {tr.method}, rtol {tr.rtol:g}, {tr.transient} + {tr.periods} periods, "
