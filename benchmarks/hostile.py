@@ -68,8 +68,6 @@ def _files(root: Path, tmp: Path) -> dict[str, str]:
     topology("coord_newline", ('coordinate = "u"', 'coordinate = "u\\n"'))
     topology("mesh_newline", ('id = "pg"', 'id = "pg\\n"'))
     topology("desc_quotes", ("description = ", 'description = "x\\"\\"\\"\\nimport os" #'))
-    topology("shape_int", ("[topology]", "topology = 5\n[oops]"))
-    topology("shape_gear_string", ("[[gear]]", 'gear = "p"\n[[geer]]'))
     topology("shape_mesh_table", ("[[mesh]]", "[mesh]"))
     topology("deep", ("[topology]", "deep = " + "[" * 2000 + "]" * 2000 + "\n[topology]"))
     topology("tiny_inertia", ('id = "p"\n', 'id = "p"\ninertia_kg_m2 = 1e-320\n'))
@@ -81,6 +79,14 @@ def _files(root: Path, tmp: Path) -> dict[str, str]:
             "density_kg_m3 = 7850\n[[gear]]",
         ),
     )
+    for key, (old, new) in {
+        "topology_number": ('topology = "diso"', "topology = 5"),
+        "features_list": ("[features]", "features = [1, 2]\n[unused]"),
+        "parameters_text": ("[parameters]", 'parameters = "all"\n[unused2]'),
+    }.items():
+        path = tmp / f"scene-{key}.toml"
+        path.write_text(scene.replace(old, new), encoding="utf-8")
+        files[f"scene_{key}"] = str(path)
     arr = tmp / "array.toml"
     arr.write_text("scene = [1, 2, 3]\n", encoding="utf-8")
     files["scene_array"] = str(arr)
@@ -137,12 +143,9 @@ def cases() -> list[Case]:
             (*S, "{topo_wint}", *SHORT),
             (("CORRUPT", "digest-list"),),
         ),
-        Case("file shape", "topology = 5", (*S, "{topo_shape_int}")),
-        Case(
-            "file shape",
-            "a string where a table array is expected",
-            (*S, "{topo_shape_gear_string}"),
-        ),
+        Case("file shape", "scene with topology = 5", (*S, "{scene_topology_number}")),
+        Case("file shape", "a list where a table is expected", (*S, "{scene_features_list}")),
+        Case("file shape", "a string where a table is expected", (*S, "{scene_parameters_text}")),
         Case(
             "file shape",
             "a table where an array of tables is expected",
@@ -288,8 +291,7 @@ def _run(case: Case, files: dict, cache: Path, work: Path) -> dict:
     )
     timed_out = False
     try:
-        if case.pipe_closed:
-            proc.stdout.readline()
+        if case.pipe_closed:  # the reader is gone before the first line
             proc.stdout.close()
             err = proc.stderr.read()
             proc.wait(timeout=LIMIT_S)
@@ -302,7 +304,7 @@ def _run(case: Case, files: dict, cache: Path, work: Path) -> dict:
         timed_out = True
     lines = [ln for ln in err.splitlines() if ln.strip()]
     strict = True
-    if "--json" in argv and proc.returncode == 0:
+    if "--json" in argv and proc.returncode == 0 and not case.pipe_closed:
         try:
             json.loads(out, parse_constant=lambda c: (_ for _ in ()).throw(ValueError(c)))
         except ValueError:

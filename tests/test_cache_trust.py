@@ -219,3 +219,52 @@ def test_the_fallback_under_a_shared_temporary_folder_must_be_private(tmp_path):
     assert not _private(shared)
     (tmp_path / "link").symlink_to(tmp_path / "new")
     assert not _private(tmp_path / "link")
+
+
+_LIBRARY_RUN = """
+import json, warnings
+import numpy as np
+from gearsym.resolve import load
+from gearsym.solver.integrate import native
+system = load("siso")
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")
+    _, facts = native.library(system.module)
+X0 = np.zeros((1, len(system.module.STATES)))
+run = native.run_batch(system.module, system.p[None, :], X0, transient=2, periods=2)
+print(json.dumps({"path": facts["path"], "compiled": facts["compiled"],
+                  "warnings": [str(w.message) for w in caught], "x": run.x.tolist()}))
+"""
+
+
+@pytest.mark.parametrize("how", ["edited", "cut short", "digest missing"])
+def test_a_compiled_library_that_does_not_match_its_digest_is_built_again(how, tmp_path):
+    """The compiled libraries of the same cache are verified the same way: a library whose
+    bytes do not hash to the digest written beside it when it was built is never loaded;
+    it is built again with one warning, and the run gives the same numbers.  Each step is
+    a process of its own, as a user's runs are (a loaded library is mapped in memory)."""
+    env = {**os.environ, "GEARSYM_CACHE": str(tmp_path / "cache")}
+
+    def run():
+        done = subprocess.run(
+            [sys.executable, "-c", _LIBRARY_RUN], env=env, capture_output=True, text=True
+        )
+        assert done.returncode == 0, done.stderr
+        return json.loads(done.stdout)
+
+    first = run()
+    lib = Path(first["path"])
+    digest = lib.with_suffix(".sha256")
+    assert digest.read_text().strip() == hashlib.sha256(lib.read_bytes()).hexdigest()
+    if how == "edited":
+        lib.write_bytes(lib.read_bytes() + b"\0")
+    elif how == "cut short":
+        lib.write_bytes(lib.read_bytes()[:4096])
+    else:
+        digest.unlink()
+    second = run()
+    assert len(second["warnings"]) == 1, second["warnings"]
+    assert "does not match the digest" in second["warnings"][0]
+    assert second["compiled"]
+    assert second["x"] == first["x"]
+    assert run()["warnings"] == []  # built anew with its digest: trusted next time

@@ -43,6 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..integrate import native
+from ..integrate._quiet import quiet
 from ..integrate.variational import casadi_dae
 from ..system import System
 
@@ -181,13 +182,20 @@ def largest_lyapunov(
         dae,
         0.0,
         T,
-        {"reltol": rtol, "abstol": atol, "max_num_steps": 1_000_000},
+        {
+            "reltol": rtol,
+            "abstol": atol,
+            "max_num_steps": 1_000_000,
+            "show_eval_warnings": False,
+            "disable_internal_warnings": True,
+        },
     )
     z = np.concatenate([np.asarray(x0, dtype=float), v])
     total = 0.0
     running = np.empty(periods)
     for k in range(periods):
-        z = np.asarray(F(x0=z, p=np.concatenate([system.p, [t0 + k * T]]))["xf"]).ravel()
+        with quiet():  # a failed step raises; CasADi's dump of its inputs stays off stderr
+            z = np.asarray(F(x0=z, p=np.concatenate([system.p, [t0 + k * T]]))["xf"]).ravel()
         growth = np.linalg.norm(z[n:])
         if not np.isfinite(growth) or growth == 0:
             raise FloatingPointError(f"tangent vector degenerated after {k + 1} periods")

@@ -21,9 +21,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..integrate._quiet import quiet
 from ..system import System
 from ._bounds import Interval, interval_of
-from ._quiet import quiet
 from .floquet import KINDS, Floquet, bifurcation_tests, floquet
 from .flow import StroboscopicMap
 from .newton import newton

@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..integrate._quiet import quiet
 from ..integrate.events import integrate_located
 from ..integrate.variational import casadi_dae, numpy_rhs, pack, unpack
 from ..system import System
@@ -77,7 +78,7 @@ class FlowMap:
         )
         return unpack(done.y, n, k)
 
-    def _integrator(self, kind: str, duration: float):
+    def _integrator(self, kind: str, duration: float) -> _Quiet:
         key = (kind, round(duration, 14))
         if key in self._cache:
             self._cache.move_to_end(key)
@@ -91,6 +92,8 @@ class FlowMap:
             "abstol": self.atol,
             "max_num_steps": 2_000_000,
             "fsens_err_con": True,
+            "show_eval_warnings": False,
+            "disable_internal_warnings": True,
         }
         F = ca.integrator(f"flow_{kind}", "cvodes", dae, 0.0, duration, opts)
         if kind == "ad":
@@ -99,6 +102,7 @@ class FlowMap:
             out = F(x0=x0, p=pp)
             xf = out["xf"]
             F = ca.Function("flow_ad", [x0, pp], [xf, ca.jacobian(xf, x0), out["qf"]])
+        F = _Quiet(F)  # CasADi's dumps of a failed integration stay off the terminal
         self._cache[key] = F
         if len(self._cache) > _CACHED_INTEGRATORS:
             self._cache.popitem(last=False)
@@ -222,3 +226,15 @@ class StroboscopicMap:
             x = self(x, p)
             out[k] = x
         return out
+
+
+class _Quiet:
+    """A CasADi function called inside :func:`..integrate._quiet.quiet`: a failed integration raises
+    (the caller reports it once) without CasADi's dump of its inputs on stderr."""
+
+    def __init__(self, function):
+        self.function = function
+
+    def __call__(self, *args, **kwargs):
+        with quiet():
+            return self.function(*args, **kwargs)

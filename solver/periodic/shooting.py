@@ -26,8 +26,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..integrate._quiet import quiet, reworded
 from ..system import System
-from ._quiet import quiet, reworded
 from .floquet import Floquet, floquet
 from .flow import FlowMap
 from .newton import NewtonError, newton

@@ -108,6 +108,8 @@ def _run_column(col: _Column, X0: np.ndarray, opts: dict) -> list[RunOutcome]:
                 None if res.lyapunov is None else res.lyapunov[r],
                 tol=opts["tol"],
                 rtol=opts["rtol"],
+                engine=f"{'compiled' if res.backend == 'native' else 'SciPy'} "
+                f"{run_opts['method'].upper()} (map)",
                 atol=opts["atol"],
             )
     return out  # type: ignore[return-value]

@@ -74,9 +74,21 @@ class RunOutcome:
 
 
 def outcome(
-    system, start: str, status: str, poincare, xmin, xmax, running, *, tol, rtol, atol
+    system,
+    start: str,
+    status: str,
+    poincare,
+    xmin,
+    xmax,
+    running,
+    *,
+    tol,
+    rtol,
+    atol,
+    engine: str = "compiled DOP853 (map)",
 ) -> RunOutcome:
-    """Classify one run of a map (``poincare`` (K, n), ``running`` exponent or None)."""
+    """Classify one run of a map (``poincare`` (K, n), ``running`` exponent or None);
+    ``engine`` names what integrated it (the exponent's record says so)."""
     c = system.contract
     lyap = None
     if running is not None and status == "ok" and np.all(np.isfinite(running)):
@@ -88,7 +100,7 @@ def outcome(
             float(half.max() - half.min()),
             rtol,
             atol,
-            "compiled DOP853 (map)",
+            engine,
             system.period,
         )
     motion, period, spread, evidence = {}, {}, {}, {}

@@ -137,6 +137,12 @@ def _bind_to_parent(parent: int | None) -> None:
     whole process group; only the parent acts on it (it kills the workers), so that a
     worker does not print a traceback of its own.
     """
+    import warnings
+
+    from ..integrate.native.batch import NativeFallback
+
+    # The parent said it once already (sweep._decide_native, maps.map_backend).
+    warnings.simplefilter("ignore", NativeFallback)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # discards a pending Ctrl-C too
     if hasattr(signal, "pthread_sigmask"):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})

@@ -65,9 +65,25 @@ def _execute(
         for point in done.points:
             tick(point)
 
+    _decide_native(chains[0])
+
     return map_tasks(
         run_chain, chains, executor=executor, workers=workers, scheduler=scheduler, on_result=ticks
     )
+
+
+def _decide_native(chain: Chain) -> None:
+    """Build the compiled library in this process before the workers start (they find
+    it cached), and say here, once, when it cannot be built: workers ignore the warning."""
+    from ..integrate.methods import get_method
+    from ..integrate.native.maps import map_backend
+    from ..integrate.simulate import fastest_method
+
+    method = chain.settings.get("method") or fastest_method(chain.settings.get("rtol", 1e-8))
+    if get_method(method).family != "native":
+        return
+    module = System.load(chain.module, **chain.base_values).module
+    map_backend(module, lyapunov=bool(chain.settings.get("lyapunov_periods", 0)))
 
 
 def _result(system, parameter, values, direction, settings, points) -> SweepResult:

@@ -32,13 +32,20 @@ STATUS = {0: "ok", 1: "divergent", 2: "too many steps", 3: "not finite", 4: "ste
 _warned: set[str] = set()
 
 
+class NativeFallback(UserWarning):
+    """A run goes without the compiled library (no compiler, or a build that failed).
+
+    Worker processes ignore it (``sweep/executor.py``): the parent process decides once
+    and says it once (``maps.map_backend``)."""
+
+
 def fallback_warning(err: Exception, instead: str = "integrating with NumPy instead") -> None:
     """The one warning line of a run that goes without the compiled library: why, and what
     runs instead; once per reason and session (``native.reset`` forgets)."""
     text = f"{err}; {instead} (slower)"
     if text not in _warned:
         _warned.add(text)
-        warnings.warn(text, stacklevel=3)
+        warnings.warn(text, NativeFallback, stacklevel=3)
 
 
 @dataclass(frozen=True)

@@ -21,6 +21,7 @@ import shutil
 import subprocess
 import tempfile
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -140,6 +141,20 @@ def _bug_report(module, cc: str, path: Path, c_file: Path, done) -> str:
     )
 
 
+def _digest_file(path: Path) -> Path:
+    return path.with_suffix(".sha256")
+
+
+def _verified(path: Path) -> bool:
+    """Whether the library's bytes hash to the digest written beside it when it was built
+    (the cache is verified, never trusted: docs/user-guide.md)."""
+    try:
+        stated = _digest_file(path).read_text(encoding="utf-8").strip()
+        return hashlib.sha256(path.read_bytes()).hexdigest() == stated
+    except (OSError, UnicodeDecodeError):
+        return False
+
+
 def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
     """Compile (or load from the cache) the native library of ``module``.
 
@@ -174,6 +189,13 @@ def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
     if str(path) in _loaded:
         _paths[memo] = path
         return _loaded[str(path)], facts
+    if path.exists() and not _verified(path):
+        warnings.warn(
+            f"the compiled library {path} does not match the digest stored beside it (none, cut "
+            "short or changed); building it again",
+            stacklevel=2,
+        )
+        path.unlink(missing_ok=True)
     if not path.exists():
         started = time.perf_counter()
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -194,6 +216,10 @@ def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
             if done.returncode != 0 or not so.exists():
                 _failed[key] = _bug_report(module, cc, path, c_file, done)
                 raise NativeUnavailable(_failed[key])
+            digest = hashlib.sha256(so.read_bytes()).hexdigest()
+            stated = Path(tmp) / "lib.sha256"
+            stated.write_text(digest + "\n", encoding="utf-8")
+            os.replace(stated, _digest_file(path))  # the digest first, then the library:
             os.replace(so, path)  # atomic: parallel workers never see half a library
         facts.update(compiled=True, seconds=time.perf_counter() - started)
     _paths[memo] = path
