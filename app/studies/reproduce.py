@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -73,6 +74,10 @@ def reproduce(
         )
     on_bearings = bearing_jobs(lam, settings)  # the same sweeps on bearings (issue 15)
     jobs += on_bearings
+    # Each sweep keeps its finished points under out/store: a run stopped by Ctrl-C
+    # resumes from them (the maps of the sensitivity stage do the same).
+    kept = out / "store" / f"sweeps_{'quick' if quick else 'full'}"
+    jobs = [replace(job, store=kept / f"{k:02d}") for k, job in enumerate(jobs)]
     bar = Progress(sum(len(j.values) for j in jobs), "sweeps", enabled=progress)
     sweeps = sweep_many(jobs, executor=executor, workers=workers, progress=bar)
     by_case = {case: sweeps[2 * k : 2 * k + 2] for k, (case, _, _) in enumerate(CASES)}

@@ -139,7 +139,7 @@ def _bind_to_parent(parent: int | None) -> None:
     """
     import warnings
 
-    from ..integrate.native.batch import NativeFallback
+    from ..integrate.native.build import NativeFallback
 
     # The parent said it once already (sweep._decide_native, maps.map_backend).
     warnings.simplefilter("ignore", NativeFallback)

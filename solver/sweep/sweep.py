@@ -123,55 +123,109 @@ def sweep(
     running the same sweep into the same folder again resumes where it stopped, and a
     folder written by another model version or another sweep is refused.
     """
-    direction = ("backward" if backward else "forward") if continuation else "independent"
-    x0_list = None if x0 is None else [float(v) for v in x0]
     values = checked_values(system, parameter, values, x0)  # before any folder is created
-    done: dict[int, SweepPoint] = {}
-    texts: dict[int, str] = {}  # the points' stored JSON, for the sweep's file
-    if store is not None:
-        manifest = {
-            "format": STORE_FORMAT,
-            "model": system.name,
-            "model_hash": system.model_hash,
-            "parameter": parameter,
-            "values": [float(v) for v in values],
-            "direction": direction,
-            "base_values": {k: float(v) for k, v in system.values.items()},
-            "settings": json.loads(dumps(settings)),
-            "x0": x0_list,
-        }
-        done = open_store(Path(store), manifest, texts)
+    run = _Planned.of(system, parameter, values, continuation, backward, x0, settings, store)
     try:
-        chains = plan(
+        if progress is not None:
+            for _ in run.done:
+                progress.step("(stored)")
+        ran = _execute(run.chains, executor, workers, progress, scheduler)
+        return run.result(ran)
+    finally:
+        run.close()
+
+
+def _direction(continuation: bool, backward: bool) -> str:
+    return ("backward" if backward else "forward") if continuation else "independent"
+
+
+@dataclass
+class _Planned:
+    """One sweep planned: its chains, the points its store already holds (``done``, with
+    their stored JSON ``texts``), and how to assemble the result from what the chains ran.
+    :func:`sweep` and :func:`sweep_many` share it, so both resume from a store."""
+
+    system: System
+    parameter: str
+    values: np.ndarray
+    continuation: bool
+    backward: bool
+    settings: dict
+    x0: list | None
+    store: Path | None
+    chains: list
+    done: dict
+    texts: dict
+
+    @classmethod
+    def of(cls, system, parameter, values, continuation, backward, x0, settings, store) -> _Planned:
+        x0_list = None if x0 is None else [float(v) for v in x0]
+        done: dict[int, SweepPoint] = {}
+        texts: dict[int, str] = {}
+        if store is not None:
+            manifest = {
+                "format": STORE_FORMAT,
+                "model": system.name,
+                "model_hash": system.model_hash,
+                "parameter": parameter,
+                "values": [float(v) for v in values],
+                "direction": _direction(continuation, backward),
+                "base_values": {k: float(v) for k, v in system.values.items()},
+                "settings": json.loads(dumps(settings)),
+                "x0": x0_list,
+            }
+            done = open_store(Path(store), manifest, texts)
+        try:
+            chains = plan(
+                system,
+                parameter,
+                values,
+                continuation=continuation,
+                backward=backward,
+                x0=x0,
+                settings=settings,
+                done=done,
+                store=store,
+            )
+        except BaseException:
+            if store is not None:
+                close_store(Path(store))
+            raise
+        where = None if store is None else Path(store)
+        values = np.asarray(values, dtype=float)
+        return cls(
             system,
             parameter,
             values,
-            continuation=continuation,
-            backward=backward,
-            x0=x0,
-            settings=settings,
-            done=done,
-            store=store,
+            continuation,
+            backward,
+            dict(settings),
+            x0_list,
+            where,
+            chains,
+            done,
+            texts,
         )
-        if progress is not None:
-            for _ in done:
-                progress.step("(stored)")
-        found = dict(done)
-        for chain, ran in zip(
-            chains, _execute(chains, executor, workers, progress, scheduler), strict=True
-        ):
-            found.update(zip(chain.indices, ran.points, strict=True))
-            texts.update(zip(chain.indices, ran.texts, strict=True))
-        order = range(values.size)[::-1] if backward else range(values.size)
+
+    def result(self, ran: list[ChainDone]) -> SweepResult:
+        found, texts = dict(self.done), dict(self.texts)
+        for chain, done in zip(self.chains, ran, strict=True):
+            found.update(zip(chain.indices, done.points, strict=True))
+            texts.update(zip(chain.indices, done.texts, strict=True))
+        order = range(self.values.size)
+        order = order[::-1] if self.backward else order
         points = [found[i] for i in order]
         stored = [texts.get(i) for i in order]
-        result = _result(system, parameter, values, direction, dict(settings, x0=x0_list), points)
-        if store is None or None in stored:
+        settings = dict(self.settings, x0=self.x0)
+        direction = _direction(self.continuation, self.backward)
+        result = _result(self.system, self.parameter, self.values, direction, settings, points)
+        if self.store is None or None in stored:
             return result
         return replace(result, texts=stored)
-    finally:
-        if store is not None:
-            close_store(Path(store))  # the lock, for the next writer
+
+    def close(self) -> None:
+        if self.store is not None:
+            close_store(self.store)  # the lock, for the next writer
 
 
 @dataclass(frozen=True)
@@ -184,6 +238,7 @@ class SweepJob:
     backward: bool = False
     x0: Sequence[float] | None = None
     settings: dict = field(default_factory=dict)
+    store: str | Path | None = None  # a folder: finished points kept there, resumed from
 
 
 def sweep_many(
@@ -194,30 +249,33 @@ def sweep_many(
     progress: Progress | None = None,
     scheduler: str | None = None,
 ) -> list[SweepResult]:
-    """Several continuation sweeps run side by side, one chain per worker process."""
-    plans = []
-    for job in jobs:
-        (chain,) = plan(
-            job.system,
-            job.parameter,
-            job.values,
-            continuation=True,
-            backward=job.backward,
-            x0=job.x0,
-            settings=dict(job.settings),
-        )
-        plans.append(chain)
-    results = []
-    for job, ran in zip(jobs, _execute(plans, executor, workers, progress, scheduler), strict=True):
-        points = ran.points
-        results.append(
-            _result(
-                job.system,
-                job.parameter,
-                job.values,
-                "backward" if job.backward else "forward",
-                dict(job.settings),
-                points[::-1] if job.backward else points,
+    """Several continuation sweeps run side by side, one chain per worker process; a job
+    with a ``store`` keeps its finished points there and resumes from them."""
+    runs = []
+    try:
+        for job in jobs:
+            runs.append(
+                _Planned.of(
+                    job.system,
+                    job.parameter,
+                    job.values,
+                    True,
+                    job.backward,
+                    job.x0,
+                    dict(job.settings),
+                    job.store,
+                )
             )
-        )
-    return results
+        pending = [(k, c) for k, run in enumerate(runs) for c in run.chains]
+        if progress is not None:
+            for run in runs:
+                for _ in run.done:
+                    progress.step("(stored)")
+        ran = _execute([c for _, c in pending], executor, workers, progress, scheduler)
+        by_run: dict[int, list[ChainDone]] = {k: [] for k in range(len(runs))}
+        for (k, _), done in zip(pending, ran, strict=True):
+            by_run[k].append(done)
+        return [run.result(by_run[k]) for k, run in enumerate(runs)]
+    finally:
+        for run in runs:
+            run.close()

@@ -21,7 +21,7 @@ import numpy as np
 from ...contract import Contract, load_generated
 from ..events import escape_event
 from ..tableau import RK4, rk_step
-from .build import NativeUnavailable, library
+from .build import NativeFallback, NativeUnavailable, library
 
 __all__ = ["NATIVE_METHODS", "STATUS", "BatchResult", "benettin", "fallback_warning", "run_batch"]
 
@@ -30,13 +30,6 @@ _CODES = {"dopri5": 0, "dop853": 1, "rk4": 2}
 STATUS = {0: "ok", 1: "divergent", 2: "too many steps", 3: "not finite", 4: "step too small",
           5: "left the valid range"}  # fmt: skip
 _warned: set[str] = set()
-
-
-class NativeFallback(UserWarning):
-    """A run goes without the compiled library (no compiler, or a build that failed).
-
-    Worker processes ignore it (``sweep/executor.py``): the parent process decides once
-    and says it once (``maps.map_backend``)."""
 
 
 def fallback_warning(err: Exception, instead: str = "integrating with NumPy instead") -> None:

@@ -44,6 +44,13 @@ _paths: dict[tuple, Path] = {}  # (module file, inputs hash, variational, compil
 _failed: dict[str, str] = {}  # cache key -> why it could not be built (once per session)
 
 
+class NativeFallback(UserWarning):
+    """A run goes without the compiled library (no compiler, or a build that failed).
+
+    Worker processes ignore it (``sweep/executor.py``): the parent process decides once
+    and says it once (``maps.map_backend``, ``sweep._decide_native``)."""
+
+
 class NativeUnavailable(RuntimeError):
     """No C compiler, or the compilation failed: the NumPy path is used instead.  A
     compiler that fails on a model's C text is a bug; its output is saved beside the
