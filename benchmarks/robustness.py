@@ -83,6 +83,84 @@ def _memory_rows() -> list[tuple[str, int, float]]:
     return rows
 
 
+# The classes of hostile and careless input (issue 23) and the tests that hold each.
+HOSTILE_CLASSES = [
+    (
+        "No input text becomes code: paths, names, descriptions in generated files",
+        "`derive/escape.py` (one escaper; model symbols as `m_<name>` in Python and C); "
+        "`tests/test_hostile_text.py`, `tests/test_fuzz.py`",
+    ),
+    (
+        "Identifiers match as whole strings (no trailing newline)",
+        "`tests/test_hostile_text.py`, `tests/derive/test_input_shapes.py`",
+    ),
+    (
+        "C and Python words as names (`int`, `q`, `NAN`, `restrict`, `th0`, ...)",
+        "`tests/test_hostile_text.py` (compiled simulate against SciPy), `tests/test_fuzz.py`",
+    ),
+    (
+        "The cache verified, never trusted: models and compiled libraries",
+        "`tests/test_cache_trust.py`; who can write it: `docs/user-guide.md`",
+    ),
+    (
+        "Files of the wrong shape, nesting past 32 levels",
+        "`tests/bad_inputs.py` (block 'files of the wrong shape'), "
+        "`tests/derive/test_input_shapes.py`",
+    ),
+    ("Maps without a C compiler; a compiler that fails", "`tests/solver/test_map_fallback.py`"),
+    (
+        "Continuations inside the parameters' valid ranges; any scene parameter or a refusal",
+        "`tests/test_cli_limits.py`, `tests/bad_inputs.py` (block 'continuation parameters')",
+    ),
+    (
+        "Strict JSON; values that would overflow refused at the input",
+        "`tests/test_unix_manners.py`, `tests/bad_inputs.py` (block 'strict JSON')",
+    ),
+    (
+        "Bounded work: every size that sets the cost has a stated limit",
+        "`tests/test_cli_limits.py`, `tests/bad_inputs.py` (block 'bounded work')",
+    ),
+    (
+        "Unix manners: a closed pipe ends quietly (SIGPIPE, 141); Ctrl-C one line, work kept",
+        "`tests/test_unix_manners.py`",
+    ),
+]
+
+
+def _hostile_section() -> list[str]:
+    """The classes of issue 23 and the probe (benchmarks/hostile.py) run on this checkout."""
+    from gearsym.benchmarks.hostile import LIMIT_S, rows
+
+    table = rows()
+    bad = [r for r in table if r["problems"]]
+    tracebacks = sum("traceback" in r["problems"] for r in table)
+    return [
+        "## Hostile and careless input",
+        "",
+        "Each class below is held by tests (fixed cases, and a property-based fuzz test of",
+        "names, paths and values with a fixed seed: `tests/test_fuzz.py`).",
+        "",
+        "| class | where it is held |",
+        "|---|---|",
+        *(f"| {_cell(c)} | {_cell(w)} |" for c, w in HOSTILE_CLASSES),
+        "",
+        "The probe (`python benchmarks/hostile.py`) runs each class as a user would, each case",
+        f"its own process with a limit of {LIMIT_S:.0f} s, and counts what goes wrong: a",
+        "traceback, a run past the limit, a refusal of more than one line, a file nobody asked",
+        f"for, JSON that is not strict. On this checkout: **{len(table)} cases, {len(bad)} went",
+        f"wrong, {tracebacks} with a traceback**.",
+        "",
+        "| class | case | exit | seconds | what went wrong | last line on stderr |",
+        "|---|---|---|---|---|---|",
+        *(
+            f"| {r['class']} | {_cell(r['case'])} | {r['exit']} | {r['seconds']:.1f} | "
+            f"{', '.join(r['problems']) or 'nothing'} | {_cell(r['stderr'])} |"
+            for r in table
+        ),
+        "",
+    ]
+
+
 def main() -> None:
     out = output_folder(checkout_docs(), (REPORT,)) / REPORT
     with tempfile.TemporaryDirectory() as tmp:
@@ -143,6 +221,7 @@ def main() -> None:
         "|---|---|---|",
         *(f"| `{_cell(argv)}` | {code} | {_cell(text)} |" for argv, code, text in table),
         "",
+        *_hostile_section(),
         "## Memory of long runs",
         "",
         "Peak resident size of the command's own process (the kernel's count), with the",

@@ -9,6 +9,7 @@ themselves are rows of ``tests/bad_inputs.py``."""
 from __future__ import annotations
 
 import json
+import math
 
 import pytest
 from gearsym.cli import main
@@ -32,15 +33,19 @@ def light():
 
 # -- the valid range, as the model states it ----------------------------------------------
 def test_the_interval_is_what_the_generated_module_states(light):
-    from gearsym.solver.periodic._bounds import interval_of
+    from gearsym.solver.periodic._bounds import Interval, interval_of
 
     omega, zeta = interval_of(light, "omega"), interval_of(light, "damping_ratio")
-    assert omega.rule() == "omega > 0" and 0.0 not in omega and 1e-9 in omega
+    # derive/scene.py PARAMETER_LIMITS: omega in [1e-3, 1e3], damping ratio in [0, 1]
+    assert omega.rule() == "omega in [0.001, 1000]" and 1e-3 in omega and 9.99e-4 not in omega
     assert zeta.rule() == "damping_ratio in [0, 1]" and 0.0 in zeta and -1e-12 not in zeta
     assert interval_of(light, "lambda").rule() == "lambda: any finite value"
-    # an excluded end is kept a thousandth of the range inside; a closed end is reached
-    assert omega.ends(0.5, -1.0) == (pytest.approx(5e-4), 0.5)
+    # a closed end is reached; an excluded end is kept a thousandth of the range inside
+    assert omega.ends(0.5, -1.0) == (1e-3, 0.5)
     assert zeta.ends(0.03, -0.2) == (0.0, 0.03)
+    positive = Interval("omega", 0.0, math.inf, low_open=True)
+    assert positive.rule() == "omega > 0" and 0.0 not in positive
+    assert positive.ends(0.5, -1.0) == (pytest.approx(5e-4), 0.5)
     with pytest.raises(KeyError, match="nosuch"):
         interval_of(light, "nosuch")
 
@@ -49,8 +54,8 @@ def test_hb_continuation_past_a_boundary_stops_there_and_keeps_the_branch(light)
     from gearsym.solver.periodic.hb_continuation import continue_hb
 
     br = continue_hb(light, "omega", 0.3, -1.0, harmonics=3, check=False)
-    assert br.status == "boundary" and "omega > 0" in br.message, br.message
-    assert len(br.points) > 3 and 0 < br.values[-1] < 1e-3 and br.values.min() > 0
+    assert br.status == "boundary" and "omega in [0.001, 1000]" in br.message, br.message
+    assert len(br.points) > 3 and br.values[-1] == 1e-3 and br.values.min() == 1e-3
     br = continue_hb(light, "damping_ratio", 0.03, -0.2, harmonics=3, check=False)
     assert br.status == "boundary" and br.values[-1] == 0.0 and br.values.min() >= 0
 

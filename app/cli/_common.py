@@ -230,8 +230,10 @@ def analysis_settings(args) -> dict:
     for name, most in LIMITS.items():
         if getattr(args, name) > most:
             option = "--" + name.replace("_", "-")
-            raise Fail(f"{option} {getattr(args, name)}: at most {most:,} periods (a longer "
-                       "run takes hours)")  # fmt: skip
+            raise Fail(
+                f"{option} {getattr(args, name)}: at most {most:,} periods (a longer "
+                "run takes hours)"
+            )
     if spp < 64 and not getattr(args, "quiet", False):
         print(f"gearsym: note: {args.periods} periods are sampled {spp} times each (not 64) "
               f"to bound memory; spectra reach {spp // 2} times the excitation frequency",

@@ -163,17 +163,21 @@ def _resolver(scene: str, system, sets: dict, names: tuple[str, str]):
 
 def _bounded(args, runs: int) -> None:
     """Refuse a size that would make the map take hours (the limits above)."""
-    sizes = [("--initial-states", args.initial_states, MAX_INITIAL_STATES),
-             ("--workers", args.workers or 1, MAX_WORKERS)]  # fmt: skip
+    sizes = [
+        ("--initial-states", args.initial_states, MAX_INITIAL_STATES),
+        ("--workers", args.workers or 1, MAX_WORKERS),
+    ]
     sizes += [("--" + k.replace("_", "-"), getattr(args, k), most) for k, most in LIMITS.items()]
     for option, value, most in sizes:
         if value > most:
             raise Fail(f"{option} {value}: at most {most:,}")
     total = runs * (args.transient + args.periods)
     if total > MAX_TOTAL_PERIODS:
-        raise Fail(f"{runs:,} runs of {args.transient} + {args.periods} periods is {total:.2g} "
-                   f"periods, more than {MAX_TOTAL_PERIODS:.0e} (hours of work); map fewer "
-                   "points, initial states or periods")  # fmt: skip
+        raise Fail(
+            f"{runs:,} runs of {args.transient} + {args.periods} periods is {total:.2g} "
+            f"periods, more than {MAX_TOTAL_PERIODS:.0e} (hours of work); map fewer "
+            "points, initial states or periods"
+        )
 
 
 def _cmd_map(args) -> int:

@@ -17,20 +17,15 @@ from ._common import (
     system_of,
     write_json,
 )
+from ._limits import MAX_PERIOD, MAX_SEGMENTS, MAX_SETTLED, MAX_TRIES, MIN_STEP, bounded_shoot
 from ._start import resolve_start, start_options
 
 __all__ = ["register"]
 
+
 # Bounded work (each stated in its option's help).  A period-n orbit costs about n times a
 # period-1 one (0.3 s a period on the reference scenes, minutes for period 64 on the
 # largest model); the guess is settled by CVODES at about a millisecond a period.
-MAX_PERIOD = 64
-MAX_SEGMENTS = 256
-MAX_TRIES = 100
-MAX_SETTLED = 200_000  # periods T settled for the guesses in all: settle x n x (tries + 1)
-MIN_STEP = 1e-5  # continue_orbit's smallest step: a smaller first step ends the branch
-
-
 def register(sub) -> None:
     sh = sub.add_parser(
         "shoot",
@@ -151,22 +146,6 @@ def _guesses(system, n: int, first, tries: int, seed: int, settle: int):
             yield run.x_final
 
 
-def _bounded_shoot(args) -> None:
-    """Refuse a size that would make ``shoot`` run for hours (the limits above)."""
-    for option, value, most in (("--period", args.period, MAX_PERIOD),
-                                ("--segments", args.segments, MAX_SEGMENTS),
-                                ("--tries", args.tries, MAX_TRIES)):  # fmt: skip
-        if value > most:
-            raise Fail(f"{option} {value}: at most {most}")
-    settle = 300 if args.settle is None else args.settle
-    tries = args.tries if args.period > 1 else 0
-    total = settle * args.period + tries * max(settle, 300) * args.period
-    if total > MAX_SETTLED:
-        raise Fail(f"--settle {settle} with --period {args.period} and --tries {tries} settles "
-                   f"up to {total:,} periods T, more than {MAX_SETTLED:,}; lower --settle or "
-                   "--tries")  # fmt: skip
-
-
 def _cmd_shoot(args) -> int:
     from gearsym.solver._json import dumps
     from gearsym.solver.integrate import SimulationError, simulate
@@ -184,7 +163,7 @@ def _cmd_shoot(args) -> int:
     # Newton's matrix on all segments, dense: (n S)^2 numbers, and its factors
     require(24.0 * (system.n * args.segments) ** 2, f"--segments {args.segments}",
             "use fewer segments (one per period is the default; a few suffice)")  # fmt: skip
-    _bounded_shoot(args)
+    bounded_shoot(args)
     if start.x0 is None:
         settle = 300 if args.settle is None else args.settle
         guess = orbit_guess(system, args.period, settle)
@@ -298,20 +277,26 @@ def _cmd_continue(args) -> int:
                    "another end")  # fmt: skip
     span = abs(args.to - args.from_)
     if not MIN_STEP <= args.step <= span:
-        raise Fail(f"--step {args.step:g}: give {MIN_STEP:g} to {span:g} (|--to - --from|; "
-                   "a larger first step leaves the range at once)")  # fmt: skip
+        raise Fail(
+            f"--step {args.step:g}: give {MIN_STEP:g} to {span:g} (|--to - --from|; "
+            "a larger first step leaves the range at once)"
+        )
     if args.period > MAX_PERIOD:
         raise Fail(f"--period {args.period}: at most {MAX_PERIOD}")
     if args.settle * args.period > MAX_SETTLED:
-        raise Fail(f"--settle {args.settle} with --period {args.period} settles "
-                   f"{args.settle * args.period:,} periods T, more than {MAX_SETTLED:,}; "
-                   "lower --settle")  # fmt: skip
+        raise Fail(
+            f"--settle {args.settle} with --period {args.period} settles "
+            f"{args.settle * args.period:,} periods T, more than {MAX_SETTLED:,}; "
+            "lower --settle"
+        )
     from gearsym.derive.open_values import is_open_value
 
     if is_open_value(args.param):
-        raise Fail(f"--param {args.param}: an open value (each value derives its own model), "
-                   "not a parameter to continue; map it with `gearsym map`, or set one value "
-                   "with --set")  # fmt: skip
+        raise Fail(
+            f"--param {args.param}: an open value (each value derives its own model), "
+            "not a parameter to continue; map it with `gearsym map`, or set one value "
+            "with --set"
+        )
     refuse_conflicts(args, [args.param], f"--param {args.param}")
     system = system_of(args.scene, parse_set(args.set))
     from gearsym.solver.integrate.simulate import check_start

@@ -192,10 +192,12 @@ def _cmd_sweep(args) -> int:
             "sweep fewer points or periods")  # fmt: skip
     total = len(values) * (args.transient + args.periods + args.lyapunov_periods)
     if len(values) > MAX_SWEEP_POINTS or total > MAX_TOTAL_PERIODS:
-        raise Fail(f"--range {args.range}: {len(values):,} points of {args.transient} + "
-                   f"{args.periods} + {args.lyapunov_periods} periods; at most "
-                   f"{MAX_SWEEP_POINTS:,} points and {MAX_TOTAL_PERIODS:.0e} periods in all "
-                   "(hours of work); sweep fewer points or periods")  # fmt: skip
+        raise Fail(
+            f"--range {args.range}: {len(values):,} points of {args.transient} + "
+            f"{args.periods} + {args.lyapunov_periods} periods; at most "
+            f"{MAX_SWEEP_POINTS:,} points and {MAX_TOTAL_PERIODS:.0e} periods in all "
+            "(hours of work); sweep fewer points or periods"
+        )
     from gearsym.derive.open_values import is_open_value
 
     if is_open_value(args.param):

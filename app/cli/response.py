@@ -126,27 +126,33 @@ def _param(text: str):
 def _bounded(args, system, num: int, methods, cap: int) -> None:
     """Refuse a size that would make the run take hours (the limits above)."""
     if args.harmonics > cap:
-        raise Fail(f"--harmonics {args.harmonics}: at most {cap} for {system.name} "
-                   f"({system.n} states x (2H + 1) <= {MAX_UNKNOWNS} unknowns, H <= "
-                   f"{MAX_HARMONICS}); use fewer harmonics, or --tail to raise them only "
-                   "as far as the response needs")  # fmt: skip
+        raise Fail(
+            f"--harmonics {args.harmonics}: at most {cap} for {system.name} "
+            f"({system.n} states x (2H + 1) <= {MAX_UNKNOWNS} unknowns, H <= "
+            f"{MAX_HARMONICS}); use fewer harmonics, or --tail to raise them only "
+            "as far as the response needs"
+        )
     if args.period > MAX_PERIOD:
         raise Fail(f"--period {args.period}: at most {MAX_PERIOD}")
     timed = [m for m in methods if m != "hb"]
     if num > MAX_POINTS or (timed and num > MAX_POINTS_TIMED):
         most = MAX_POINTS_TIMED if timed and num > MAX_POINTS_TIMED else MAX_POINTS
         why = f" with --method {args.method}" if most == MAX_POINTS_TIMED else ""
-        raise Fail(f"--param {args.param}: NUM {num} is more than the {most:,} points a "
-                   f"response takes{why}; give a smaller NUM")  # fmt: skip
+        raise Fail(
+            f"--param {args.param}: NUM {num} is more than the {most:,} points a "
+            f"response takes{why}; give a smaller NUM"
+        )
     if "integration" in methods:
         for option, value in (("--settle", args.settle), ("--sampled", args.sampled)):
             if value > MAX_SETTLE:
                 raise Fail(f"{option} {value}: at most {MAX_SETTLE:,} periods")
         total = num * (args.settle + args.sampled)
         if total > MAX_INTEGRATED:
-            raise Fail(f"--method {args.method}: {num} frequencies x ({args.settle} + "
-                       f"{args.sampled}) periods is {total:.2g} periods a sweep, more than "
-                       f"{MAX_INTEGRATED:.0e}; lower NUM, --settle or --sampled")  # fmt: skip
+            raise Fail(
+                f"--method {args.method}: {num} frequencies x ({args.settle} + "
+                f"{args.sampled}) periods is {total:.2g} periods a sweep, more than "
+                f"{MAX_INTEGRATED:.0e}; lower NUM, --settle or --sampled"
+            )
 
 
 def _cmd_response(args) -> int:
@@ -163,9 +169,11 @@ def _cmd_response(args) -> int:
     if args.tail is not None and not (0 < args.tail < 1):
         raise Fail(f"--tail must be a share in (0, 1), got {args.tail}")
     if is_open_value(name):
-        raise Fail(f"--param {name}: an open value (each value derives its own model), not a "
-                   "parameter to continue; map it with `gearsym map`, or set one value with "
-                   "--set")  # fmt: skip
+        raise Fail(
+            f"--param {name}: an open value (each value derives its own model), not a "
+            "parameter to continue; map it with `gearsym map`, or set one value with "
+            "--set"
+        )
     refuse_conflicts(args, [name], f"--param {args.param}")
     system = system_of(args.scene, parse_set(args.set))
     for value in (start, stop):

@@ -92,8 +92,11 @@ class HBBranch:
             C = np.array([p.coefficients[i, 1:] for p in self.points])
             a2 = C[:, 0::2] ** 2 + C[:, 1::2] ** 2
             total = a2.sum(axis=1)
-            share = np.sqrt(np.divide(a2[:, -top:].sum(axis=1), total, out=np.zeros_like(total),
-                                      where=total > 0))  # fmt: skip
+            share = np.sqrt(
+                np.divide(
+                    a2[:, -top:].sum(axis=1), total, out=np.zeros_like(total), where=total > 0
+                )
+            )
             out = np.maximum(out, share)
         return out
 

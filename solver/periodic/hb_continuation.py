@@ -253,8 +253,10 @@ def continue_hb(
             h /= 2
             if h < ds_min:
                 status = "stalled"
-                message = (f"stopped at {parameter} = {z[-1]:.6g}: the corrector failed "
-                           "with the smallest step")  # fmt: skip
+                message = (
+                    f"stopped at {parameter} = {z[-1]:.6g}: the corrector failed "
+                    "with the smallest step"
+                )
                 notes.append(message)
                 break
             continue
@@ -264,8 +266,10 @@ def continue_hb(
             end = end if end is not None else hi if lam > hi else lo
             status, message = ending(parameter, curve.valid, start, stop, lo, hi, end)
             if status == "turned":
-                notes.append(f"the branch turned back and left the range at {parameter} = "
-                             f"{end:g}; continue from there to follow it further")  # fmt: skip
+                notes.append(
+                    f"the branch turned back and left the range at {parameter} = "
+                    f"{end:g}; continue from there to follow it further"
+                )
             sol = _at(curve, z if z_new is None else z_new, end, tol)
             if sol is not None:
                 _, G = curve(sol)

@@ -165,8 +165,23 @@ def _chunk(task) -> MapRun:
     return _run(load_generated(source), P, X0, **opts)
 
 
-def _run(module, P, X0, *, method, rtol, atol, transient, periods, lyapunov_periods, bound,
-         max_steps, group, seed, backend) -> MapRun:  # fmt: skip
+def _run(
+    module,
+    P,
+    X0,
+    *,
+    method,
+    rtol,
+    atol,
+    transient,
+    periods,
+    lyapunov_periods,
+    bound,
+    max_steps,
+    group,
+    seed,
+    backend,
+) -> MapRun:
     if backend == "numpy":
         n = X0.shape[1]
         w0 = _tangent(n, seed) if lyapunov_periods > 0 else None
