@@ -174,7 +174,7 @@ def cases() -> list[Case]:
                 "--set",
                 "damping_ratio=0",
                 "--param",
-                "omega=0.3:0.6:20",
+                "omega=0.05:2:40",
                 "--harmonics",
                 "3",
             ),
@@ -248,8 +248,8 @@ def cases() -> list[Case]:
         ),
         Case(
             "Unix manners",
-            "simulate | head -1",
-            ("simulate", "reference-light", *SHORT),
+            "simulate --json, its reader gone",
+            ("simulate", "reference-light", *SHORT, "--json"),
             pipe_closed=True,
         ),
     ]
@@ -318,6 +318,8 @@ def _run(case: Case, files: dict, cache: Path, work: Path) -> dict:
         problems.append(f"refusal of {len(lines)} lines")
     if not strict:
         problems.append("not strict JSON")
+    if case.pipe_closed and lines:
+        problems.append("spoke after its reader left")
     if list(work.parent.rglob("PWNED")):
         problems.append("text ran as code")
     last = lines[-1] if lines else ""
