@@ -52,13 +52,18 @@ def _parser() -> argparse.ArgumentParser:
 def _one_line_warning(message, category, filename, lineno, line=None) -> str:
     """Warnings on the command line: one line each, without the source line that
     raised them (``--debug`` keeps Python's own format)."""
-    return f"gearsym: warning: {message}\n"
+    from gearsym.derive.escape import one_line
+
+    return f"gearsym: warning: {one_line(message)}\n"
 
 
 def _say(line: str) -> None:
-    """One line on stderr; nothing when stderr itself is a closed pipe."""
+    """One line on stderr (a newline in a user's path or name shown escaped); nothing
+    when stderr itself is a closed pipe."""
+    from gearsym.derive.escape import one_line
+
     try:
-        print(line, file=sys.stderr, flush=True)
+        print(one_line(line), file=sys.stderr, flush=True)
     except (OSError, ValueError):
         pass
 
@@ -171,7 +176,9 @@ def _run(args) -> int:
         # Every store (sweep, map) has its finished points already: the same command
         # resumes from them.  On a terminal the progress line may be half drawn.
         tty = getattr(sys.stderr, "isatty", lambda: False)()
-        _say(("\n" if tty else "") + "gearsym: interrupted")
+        if tty:
+            _say("")  # end the half-drawn progress line
+        _say("gearsym: interrupted")
         return 130
     finally:
         warnings.formatwarning = shown
