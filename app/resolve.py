@@ -120,7 +120,7 @@ def load_cached(module: Path) -> ModuleType | None:
         else:
             why = "differs from the digest beside it (empty, cut short or edited)"
         if stated and hashlib.sha256(data).hexdigest() == stated:
-            return load_generated(module)
+            return load_generated(module, source=data)  # the bytes verified, not a reread
     warnings.warn(f"the cached model {module} {why}; deriving it again", stacklevel=3)
     return None
 

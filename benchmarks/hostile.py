@@ -320,6 +320,8 @@ def _run(case: Case, files: dict, cache: Path, work: Path) -> dict:
         problems.append("not strict JSON")
     if case.pipe_closed and lines:
         problems.append("spoke after its reader left")
+    if case.cls == "C identifiers" and lines:  # a valid model: compiled, nothing to say
+        problems.append("the C did not compile: " + lines[0][:60])
     if list(work.parent.rglob("PWNED")):
         problems.append("text ran as code")
     last = lines[-1] if lines else ""

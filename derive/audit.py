@@ -188,7 +188,8 @@ def audit_page(model: Model, command: str) -> str:
         w(
             "The scene sets the loads directly: "
             + ", ".join(
-                f"$f_{{{c}}}$ = `{scene.load_expressions[c]}` = {_num(scene.loads[c])}"
+                f"$f_{{{c}}}$ = `{markdown(scene.load_expressions[c], code=True)}` = "
+                f"{_num(scene.loads[c])}"
                 for c in model.coordinates
             )
             + " (the torque form above converts torques to loads).\n"

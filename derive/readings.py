@@ -147,7 +147,7 @@ def reading_section(model) -> str:
         lines.append(
             f"| {c} | {me.id} | {'+1 forward' if me.orientation > 0 else '-1 reversed'} | "
             f"{gear} | {'+1 driving' if sigma > 0 else '-1 braking'} | {slope:+d} | "
-            f"`{scene.load_expressions[c]}` | {values[f'f_{c}']:.6g} |"
+            f"`{markdown(scene.load_expressions[c], code=True)}` | {values[f'f_{c}']:.6g} |"
         )
     coupling = [
         f"`{n}` = {values[n]:.6g}"

@@ -10,8 +10,8 @@ this; it never parses generated source or guesses from names.
 
 from __future__ import annotations
 
+import hashlib
 import importlib
-import importlib.util
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -156,15 +156,31 @@ class Contract:
         return [(self.states.index(c), a) for c, a in self.valid_range.items()]
 
 
-def load_generated(name_or_path: str | Path) -> ModuleType:
-    """Import ``generated/<name>.py`` by model name, or a generated file by path."""
+def load_generated(name_or_path: str | Path, source: bytes | None = None) -> ModuleType:
+    """Import ``generated/<name>.py`` by model name, or a generated file by path.
+
+    A file is run from the bytes read here (``source``: bytes already read and verified
+    by the caller), never from a ``__pycache__`` copy that nobody checked; when a digest
+    file ``<name>.sha256`` stands beside it (the derivation cache writes one), the bytes
+    must hash to it, so a worker process that loads a cached model by path verifies it
+    too."""
     path = Path(name_or_path)
     if path.suffix == ".py":
-        if not path.exists():
-            raise FileNotFoundError(f"{path}: no such generated model file")
-        spec = importlib.util.spec_from_file_location(f"gearsym_generated_{path.stem}", path)
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
+        try:
+            data = path.read_bytes() if source is None else source
+        except FileNotFoundError:
+            raise FileNotFoundError(f"{path}: no such generated model file") from None
+        stated = path.with_suffix(".sha256")
+        if source is None and stated.exists():
+            digest = stated.read_text(encoding="ascii", errors="replace").strip()
+            if hashlib.sha256(data).hexdigest() != digest:
+                raise ValueError(
+                    f"{path} does not match the digest beside it ({stated.name}); derive "
+                    "it again (`gearsym derive` on its scene)"
+                )
+        module = ModuleType(f"gearsym_generated_{path.stem}")
+        module.__file__ = str(path)
+        exec(compile(data, str(path), "exec", dont_inherit=True), module.__dict__)
     else:
         try:
             # Built-in names may be written with hyphens, as the scene files are.

@@ -11,6 +11,7 @@ the study leaves open are those of the shipped scenes, stated in their files.
 
 from __future__ import annotations
 
+import hashlib
 import sys
 import time
 from dataclasses import replace
@@ -74,10 +75,10 @@ def reproduce(
         )
     on_bearings = bearing_jobs(lam, settings)  # the same sweeps on bearings (issue 15)
     jobs += on_bearings
-    # Each sweep keeps its finished points under out/store: a run stopped by Ctrl-C
-    # resumes from them (the maps of the sensitivity stage do the same).
-    kept = out / "store" / f"sweeps_{'quick' if quick else 'full'}"
-    jobs = [replace(job, store=kept / f"{k:02d}") for k, job in enumerate(jobs)]
+    # Each sweep keeps its finished points under out/store, in a folder named by what
+    # defines it (model, values, settings): a run stopped by Ctrl-C resumes from them,
+    # and a run with other settings or another model starts a folder of its own.
+    jobs = [replace(job, store=out / "store" / f"sweep_{_job_key(job)}") for job in jobs]
     bar = Progress(sum(len(j.values) for j in jobs), "sweeps", enabled=progress)
     sweeps = sweep_many(jobs, executor=executor, workers=workers, progress=bar)
     by_case = {case: sweeps[2 * k : 2 * k + 2] for k, (case, _, _) in enumerate(CASES)}
@@ -214,6 +215,19 @@ def _continue_case(args):
             if len(br.values) > 1:
                 branches.append(br)
     return branches
+
+
+def _job_key(job: SweepJob) -> str:
+    """16 hex digits of the sha256 of everything that defines a sweep job."""
+    defining = {
+        "model": job.system.model_hash,
+        "base": job.system.values,
+        "parameter": job.parameter,
+        "values": [float(v) for v in job.values],
+        "backward": job.backward,
+        "settings": job.settings,
+    }
+    return hashlib.sha256(dumps(defining, sort_keys=True).encode()).hexdigest()[:16]
 
 
 def _continue_cases(systems, by_case, quick, executor, workers):

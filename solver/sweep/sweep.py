@@ -57,6 +57,8 @@ def _execute(
         if progress:
             progress.step(f"{chains[0].parameter}={point.value:.4g}")
 
+    if not chains:  # everything was in the store
+        return []
     if executor == "serial" or (executor == "processes" and len(chains) <= 1):
         # In this process: progress point by point, also inside a chain.
         return map_tasks(partial(run_chain, on_point=tick), chains)
@@ -65,25 +67,32 @@ def _execute(
         for point in done.points:
             tick(point)
 
-    _decide_native(chains[0])
+    _decide_native(chains)
 
     return map_tasks(
         run_chain, chains, executor=executor, workers=workers, scheduler=scheduler, on_result=ticks
     )
 
 
-def _decide_native(chain: Chain) -> None:
-    """Build the compiled library in this process before the workers start (they find
-    it cached), and say here, once, when it cannot be built: workers ignore the warning."""
+def _decide_native(chains: list[Chain]) -> None:
+    """Build the compiled libraries of every model the chains run in this process before
+    the workers start (they find them cached), and say here, once per reason, when one
+    cannot be built: workers ignore that warning."""
     from ..integrate.methods import get_method
     from ..integrate.native.maps import map_backend
     from ..integrate.simulate import fastest_method
 
-    method = chain.settings.get("method") or fastest_method(chain.settings.get("rtol", 1e-8))
-    if get_method(method).family != "native":
-        return
-    module = System.load(chain.module, **chain.base_values).module
-    map_backend(module, lyapunov=bool(chain.settings.get("lyapunov_periods", 0)))
+    seen = set()
+    for chain in chains:
+        settings = chain.settings
+        method = settings.get("method") or fastest_method(settings.get("rtol", 1e-8))
+        tangent = bool(settings.get("lyapunov_periods", 0))
+        if get_method(method).family != "native" or (chain.module, tangent) in seen:
+            continue
+        seen.add((chain.module, tangent))
+        module = System.load(chain.module, **chain.base_values).module
+        if map_backend(module, lyapunov=False) == "native" and tangent:
+            map_backend(module, lyapunov=True)
 
 
 def _result(system, parameter, values, direction, settings, points) -> SweepResult:

@@ -197,11 +197,12 @@ def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
         _paths[memo] = path
         return _loaded[str(path)], facts
     if path.exists() and not _verified(path):
-        warnings.warn(
-            f"the compiled library {path} does not match the digest stored beside it (none, cut "
-            "short or changed); building it again",
-            stacklevel=2,
-        )
+        if _digest_file(path).exists():  # without one: built before digests, rebuilt quietly
+            warnings.warn(
+                f"the compiled library {path} does not match the digest stored beside it "
+                "(cut short or changed); building it again",
+                stacklevel=2,
+            )
         path.unlink(missing_ok=True)
     if not path.exists():
         started = time.perf_counter()
