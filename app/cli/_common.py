@@ -176,6 +176,14 @@ def system_of(scene_arg: str, sets: dict[str, float]):
         raise Fail(f"--set {given}: {err}" if given else f"{scene_arg}: {err}") from None
 
 
+def at_most(*sizes: tuple[str, float, float], unit: str = "") -> None:
+    """Refuse the first ``(option, value, most)`` whose value is above its limit, in one
+    line that names the option and the limit (bounded work: each limit is in --help)."""
+    for option, value, most in sizes:
+        if value > most:
+            raise Fail(f"{option} {value}: at most {most:,}{unit}")
+
+
 def require(nbytes: float, what: str, fix: str) -> None:
     """:func:`gearsym.solver._memory.require` as a one-line failure."""
     from gearsym.solver._memory import MemoryRefused

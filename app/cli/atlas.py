@@ -9,6 +9,7 @@ from ._common import (
     LIMITS,
     MAX_TOTAL_PERIODS,
     Fail,
+    at_most,
     out_folder,
     parse_range,
     parse_set,
@@ -168,9 +169,7 @@ def _bounded(args, runs: int) -> None:
         ("--workers", args.workers or 1, MAX_WORKERS),
     ]
     sizes += [("--" + k.replace("_", "-"), getattr(args, k), most) for k, most in LIMITS.items()]
-    for option, value, most in sizes:
-        if value > most:
-            raise Fail(f"{option} {value}: at most {most:,}")
+    at_most(*sizes)
     total = runs * (args.transient + args.periods)
     if total > MAX_TOTAL_PERIODS:
         raise Fail(

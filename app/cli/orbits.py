@@ -9,6 +9,7 @@ import numpy as np
 from ._common import (
     Fail,
     RunFailed,
+    at_most,
     orbit_guess,
     out_folder,
     parse_set,
@@ -281,8 +282,7 @@ def _cmd_continue(args) -> int:
             f"--step {args.step:g}: give {MIN_STEP:g} to {span:g} (|--to - --from|; "
             "a larger first step leaves the range at once)"
         )
-    if args.period > MAX_PERIOD:
-        raise Fail(f"--period {args.period}: at most {MAX_PERIOD}")
+    at_most(("--period", args.period, MAX_PERIOD))
     if args.settle * args.period > MAX_SETTLED:
         raise Fail(
             f"--settle {args.settle} with --period {args.period} settles "

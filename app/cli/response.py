@@ -6,7 +6,17 @@ from __future__ import annotations
 import math
 import sys
 
-from ._common import Fail, RunFailed, out_folder, parse_set, refuse_conflicts, require, system_of
+from ._common import (
+    Fail,
+    RunFailed,
+    at_most,
+    out_folder,
+    parse_set,
+    refuse_conflicts,
+    require,
+    system_of,
+)
+from ._limits import MAX_PERIOD
 
 __all__ = ["register"]
 
@@ -16,7 +26,6 @@ __all__ = ["register"]
 # integration point a settled run: 2,000 of them is some minutes on the smallest model.
 MAX_POINTS = 20_000
 MAX_POINTS_TIMED = 2_000
-MAX_PERIOD = 64  # subharmonics beyond period 64 are not resolved by 15 harmonics anyway
 MAX_SETTLE = 10_000
 MAX_INTEGRATED = 1e7  # periods a sweep of --method integration (up and down run together)
 # solver/sweep/frequency.py's MAX_HARMONICS and MAX_UNKNOWNS (imported only when a command
@@ -132,8 +141,7 @@ def _bounded(args, system, num: int, methods, cap: int) -> None:
             f"{MAX_HARMONICS}); use fewer harmonics, or --tail to raise them only "
             "as far as the response needs"
         )
-    if args.period > MAX_PERIOD:
-        raise Fail(f"--period {args.period}: at most {MAX_PERIOD}")
+    at_most(("--period", args.period, MAX_PERIOD))
     timed = [m for m in methods if m != "hb"]
     if num > MAX_POINTS or (timed and num > MAX_POINTS_TIMED):
         most = MAX_POINTS_TIMED if timed and num > MAX_POINTS_TIMED else MAX_POINTS
@@ -143,9 +151,11 @@ def _bounded(args, system, num: int, methods, cap: int) -> None:
             f"response takes{why}; give a smaller NUM"
         )
     if "integration" in methods:
-        for option, value in (("--settle", args.settle), ("--sampled", args.sampled)):
-            if value > MAX_SETTLE:
-                raise Fail(f"{option} {value}: at most {MAX_SETTLE:,} periods")
+        at_most(
+            ("--settle", args.settle, MAX_SETTLE),
+            ("--sampled", args.sampled, MAX_SETTLE),
+            unit=" periods",
+        )
         total = num * (args.settle + args.sampled)
         if total > MAX_INTEGRATED:
             raise Fail(
