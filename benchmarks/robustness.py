@@ -100,17 +100,21 @@ HOSTILE_CLASSES = [
     ),
     (
         "The cache verified, never trusted: models and compiled libraries",
-        "`tests/test_cache_trust.py`; who can write it: `docs/user-guide.md`",
+        "`tests/test_cache_trust.py`, `tests/test_fuzz.py`; who can write it: `docs/user-guide.md`",
     ),
     (
         "Files of the wrong shape, nesting past 32 levels",
         "`tests/bad_inputs.py` (block 'files of the wrong shape'), "
         "`tests/derive/test_input_shapes.py`",
     ),
-    ("Maps without a C compiler; a compiler that fails", "`tests/solver/test_map_fallback.py`"),
+    (
+        "Maps without a C compiler; a compiler that fails",
+        "`tests/solver/test_map_fallback.py`, `tests/test_fuzz.py`",
+    ),
     (
         "Continuations inside the parameters' valid ranges; any scene parameter or a refusal",
-        "`tests/test_cli_limits.py`, `tests/bad_inputs.py` (block 'continuation parameters')",
+        "`tests/test_cli_limits.py`, `tests/test_fuzz.py`, `tests/bad_inputs.py` (block "
+        "'continuation parameters')",
     ),
     (
         "Strict JSON; values that would overflow refused at the input",
