@@ -20,6 +20,7 @@ states, of order 1):
 """
 
 import os
+import re
 import subprocess
 import sys
 import warnings
@@ -60,7 +61,9 @@ def test_fallback_fills_every_field_as_the_compiled_engine(no_compiler, monkeypa
     )
     X0 = np.tile([1.0, 0.0, 0.0, 0.0], (len(P), 1))
     kw = dict(transient=20, periods=10, lyapunov_periods=20, rtol=RTOL, atol=1e-10)
-    with pytest.warns(UserWarning, match="no C compiler found.*NumPy instead"):
+    with pytest.warns(
+        UserWarning, match="GEARSYM_CC='none' turns the C compiler off.*NumPy instead"
+    ):
         got = run_map(s.module, P, X0, **kw)
     with pytest.raises(native.NativeUnavailable):
         run_map(s.module, P, X0, backend="native", **kw)
@@ -114,8 +117,7 @@ def test_a_map_without_a_compiler_gives_the_compiled_verdicts(no_compiler, monke
         warnings.simplefilter("always")
         got = regime_map(s, *axes, **kw)
     assert [str(w.message) for w in caught if "NumPy instead" in str(w.message)] == [
-        "no C compiler found (install gcc or clang, or set GEARSYM_CC); integrating with "
-        "NumPy instead (slower)"
+        "GEARSYM_CC='none' turns the C compiler off; integrating with NumPy instead (slower)"
     ]
     monkeypatch.delenv("GEARSYM_CC")
     ref = _compiled(lambda: regime_map(s, *axes, **kw))
@@ -142,8 +144,8 @@ def test_map_cli_without_a_compiler_is_one_warning_line(tmp_path):
     code, lines = _cli_map(tmp_path, "none")
     assert code == 0, lines
     assert lines == [
-        "gearsym: warning: no C compiler found (install gcc or clang, or set GEARSYM_CC); "
-        "integrating with NumPy instead (slower)"
+        "gearsym: warning: GEARSYM_CC='none' turns the C compiler off; integrating with "
+        "NumPy instead (slower)"
     ]
     assert (tmp_path / "map" / "map.json").exists()
 
@@ -159,3 +161,24 @@ def test_a_compiler_that_fails_is_one_bug_report_line_and_still_a_map(tmp_path):
     log = line.split("the compiler's full output is in ")[1].split(")")[0]
     assert log.startswith(str(tmp_path / "cache")) and os.path.isfile(log)
     assert (tmp_path / "map" / "map.json").exists()
+
+
+@pytest.mark.parametrize(
+    "cc,says",
+    [
+        ("none", "GEARSYM_CC='none' turns the C compiler off"),
+        ("gcc; touch PWNED", "GEARSYM_CC='gcc; touch PWNED' is not a program on PATH"),
+    ],
+)
+def test_the_fallback_says_why_there_is_no_compiler(cc, says, monkeypatch, tmp_path):
+    """A GEARSYM_CC that names no program is said as such (it is never run through a
+    shell: the text after ';' does nothing)."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("GEARSYM_CC", cc)
+    native.reset()
+    try:
+        with pytest.raises(native.NativeUnavailable, match=re.escape(says)):
+            native.library(System.load("reference_light").module)
+    finally:
+        native.reset()
+    assert not (tmp_path / "PWNED").exists()

@@ -71,6 +71,19 @@ def compiler() -> str | None:
     return None
 
 
+def _no_compiler() -> str:
+    """Why there is no compiler, naming GEARSYM_CC when it is set."""
+    env = os.environ.get("GEARSYM_CC")
+    if env is None:
+        return "no C compiler found (install gcc or clang, or set GEARSYM_CC)"
+    if env.strip().lower() in ("", "none", "0"):
+        return f"GEARSYM_CC={env!r} turns the C compiler off"
+    return (
+        f"GEARSYM_CC={env!r} is not a program on PATH nor a file; set it to a C compiler "
+        "(gcc, clang, or its path), or to none"
+    )
+
+
 def cache_dir() -> Path:
     """Where compiled libraries are kept: ``native/`` under the cache root."""
     return cache_root() / "native"
@@ -170,7 +183,7 @@ def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
     """
     cc = compiler()
     if cc is None:
-        raise NativeUnavailable("no C compiler found (install gcc or clang, or set GEARSYM_CC)")
+        raise NativeUnavailable(_no_compiler())
     memo = (
         getattr(module, "__file__", module.NAME),
         getattr(module, "INPUTS_SHA256", ""),
