@@ -22,6 +22,7 @@ import json
 import math
 import os
 import traceback
+import warnings
 from pathlib import Path
 
 import pytest
@@ -102,14 +103,24 @@ def _run(argv: list[str]) -> tuple[int, str, str]:
     from gearsym.cli import main
 
     out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+    # pytest holds warnings back from stderr: record them, and write each as the command
+    # line would (gearsym.cli's one-line format), so that they count as stderr lines.
+    with (
+        contextlib.redirect_stdout(out),
+        contextlib.redirect_stderr(err),
+        warnings.catch_warnings(record=True) as caught,
+    ):
+        warnings.simplefilter("always")
         try:
             code = main(argv)
         except SystemExit as stop:
             code = stop.code
         except BaseException:  # a traceback: what the test exists to catch
             pytest.fail(f"gearsym {' '.join(argv)} raised:\n{traceback.format_exc()}")
-    return code, out.getvalue(), err.getvalue()
+    from gearsym.cli import _one_line_warning
+
+    shown = "".join(_one_line_warning(w.message, w.category, w.filename, w.lineno) for w in caught)
+    return code, out.getvalue(), shown + err.getvalue()
 
 
 def _files(top: Path, skip: tuple[Path, ...]) -> set[Path]:
