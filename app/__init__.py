@@ -21,7 +21,7 @@ import importlib as _importlib
 # Names resolve on first use (PEP 562), so that `gearsym <command>` imports only what the
 # command needs: a sweep of a shipped scene never loads SymPy or the derivation.
 _EXPORTS = {
-    "InputError": "gearsym.derive._input",
+    "InputError": "gearsym.derive.input.reader",
     "derive_model": "gearsym.derive",
     "load_target": "gearsym.derive",
     "save": "gearsym.solver.export",

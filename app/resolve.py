@@ -56,14 +56,14 @@ def cached_module(name: str, digest: str) -> Path:
 def module_for(target: str | Path, open_values: dict | None = None) -> ModuleType:
     """The generated module of a scene or topology (built-in name or path), derived into
     the cache first when ``generated/`` has no current one.  ``open_values`` (see
-    ``gearsym.derive.open_values``) give a variant, derived once into the cache."""
+    ``gearsym.derive.input.open_values``) give a variant, derived once into the cache."""
     module = None if open_values else _known_current(target)
     if module is not None:
         return module
     from gearsym.derive import derive_model, load_target, resolve_target
-    from gearsym.derive.emit import emit_module
+    from gearsym.derive.emit.python import emit_module
+    from gearsym.derive.input.open_values import with_open_values
     from gearsym.derive.model import inputs_hash
-    from gearsym.derive.open_values import with_open_values
 
     path = resolve_target(str(target))
     scene = with_open_values(load_target(path), **(open_values or {}))
@@ -94,7 +94,7 @@ def _stated_digest(module: Path) -> Path:
 def store_cached(module: Path, text: str) -> None:
     """Write ``text`` as the cached module ``module`` and the digest of its bytes beside
     it (the digest first: a module is never there without one)."""
-    from gearsym.derive.emit import write_atomic
+    from gearsym.derive.emit.python import write_atomic
 
     data = text.encode("utf-8")  # what write_atomic writes: UTF-8, newlines kept
     write_atomic(_stated_digest(module), hashlib.sha256(data).hexdigest() + "\n")
@@ -144,7 +144,7 @@ def _fingerprint(target: str | Path) -> str | None:
                     break
             if path.exists():
                 break
-    from gearsym.derive._input import InputError, parse_toml
+    from gearsym.derive.input.reader import InputError, parse_toml
 
     try:
         data = path.read_bytes()
@@ -190,7 +190,7 @@ def _entry_ok(key, entry) -> bool:
 
 def _read_digests() -> tuple[dict, str | None]:
     """The well-formed entries of digests.json, and what else it held (None: nothing)."""
-    from gearsym.derive._input import shown
+    from gearsym.derive.input.reader import shown
 
     try:
         known = json.loads(_digests().read_text(encoding="utf-8"))
@@ -227,7 +227,7 @@ def _known_current(target) -> ModuleType | None:
 def _remember(path, digest: str) -> None:
     """Record the fingerprint of ``path``'s files and its digest (best effort: a cache
     folder that cannot be written only costs the fast path)."""
-    from gearsym.derive._input import InputError, load_toml
+    from gearsym.derive.input.reader import InputError, load_toml
 
     key = _fingerprint(path)
     if key is None:
@@ -274,7 +274,7 @@ def split_open_values(values: dict) -> tuple[dict, dict]:
     """(open values, the rest) of named values: the first need a derivation."""
     if not values:
         return {}, {}
-    from gearsym.derive.open_values import is_open_value
+    from gearsym.derive.input.open_values import is_open_value
 
     opened = {k: v for k, v in values.items() if is_open_value(k)}
     return opened, {k: v for k, v in values.items() if k not in opened}

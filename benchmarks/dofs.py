@@ -18,8 +18,8 @@ __all__ = ["dof_cost", "dof_section"]
 def _models(tmp: Path) -> list[tuple[str, object, str]]:
     """(label, generated module, swept parameter) in table order."""
     from gearsym.derive import derive_model, load_target, variant
-    from gearsym.derive.emit import emit_module, write_atomic
-    from gearsym.derive.scene import builtin_root
+    from gearsym.derive.emit.python import emit_module, write_atomic
+    from gearsym.derive.input.scene import builtin_root
     from gearsym.resolve import module_for
     from gearsym.solver import load_generated
 

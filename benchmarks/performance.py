@@ -414,8 +414,8 @@ FEATURES = [
 def _variant(tmp: Path, name: str, changes: dict) -> Path:
     """The light-load scene with some [features] changed, derived into tmp."""
     from gearsym.derive import derive_model, load_target, variant
-    from gearsym.derive.emit import emit_module, write_atomic
-    from gearsym.derive.scene import builtin_root
+    from gearsym.derive.emit.python import emit_module, write_atomic
+    from gearsym.derive.input.scene import builtin_root
 
     scene = load_target(builtin_root() / "reference-light.toml")
     model = derive_model(variant(scene, name.replace("_", "-"), **changes))

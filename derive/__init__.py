@@ -7,28 +7,28 @@ audit pages.
 
 import importlib as _importlib
 
-from ._input import InputError
 from ._version import __version__
+from .input.reader import InputError
 
 # The rest resolves on first use (PEP 562): SymPy and SciPy load only when a derivation
 # (or the scene reader) is asked for.
 _EXPORTS = {
-    "DeadZone": "backlash",
-    "LinearContact": "backlash",
-    "PolynomialFit": "backlash",
-    "SmoothDeadZone": "backlash",
-    "dead_zone": "backlash",
-    "fit_dead_zone": "backlash",
+    "DeadZone": "mesh.backlash",
+    "LinearContact": "mesh.backlash",
+    "PolynomialFit": "mesh.backlash",
+    "SmoothDeadZone": "mesh.backlash",
+    "dead_zone": "mesh.backlash",
+    "fit_dead_zone": "mesh.backlash",
     "Model": "model",
     "derive_model": "model",
-    "Features": "scene",
-    "Scene": "scene",
-    "load_scene": "scene",
-    "load_target": "scene",
-    "resolve_target": "scene",
-    "variant": "scene",
-    "Topology": "topology",
-    "load_topology": "topology",
+    "Features": "input.scene",
+    "Scene": "input.scene",
+    "load_scene": "input.scene",
+    "load_target": "input.scene",
+    "resolve_target": "input.scene",
+    "variant": "input.scene",
+    "Topology": "input.topology",
+    "load_topology": "input.topology",
 }
 
 

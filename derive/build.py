@@ -13,14 +13,14 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
-from ._input import InputError
-from ._paths import display_path, project_root  # re-exported: callers import them here
-from .audit import audit_page, index_page
-from .emit import emit_module, write_atomic
+from .emit.audit import audit_page, index_page
+from .emit.python import emit_module, write_atomic
+from .emit.stiffness_report import stiffness_page
+from .input.paths import display_path, project_root  # re-exported: callers import them here
+from .input.reader import InputError
+from .input.scene import builtin_root, load_target
+from .input.topology import load_topology
 from .model import Model, derive_model
-from .scene import builtin_root, load_target
-from .stiffness_report import stiffness_page
-from .topology import load_topology
 
 __all__ = [
     "Built",
@@ -53,7 +53,7 @@ def build_files(
     """Derive every target in ``paths``; return the models and the files' text.
     ``overrides`` set scene parameters, or open values (``derive.open_values``), which
     give each target's variant."""
-    from .open_values import is_open_value, with_open_values
+    from .input.open_values import is_open_value, with_open_values
 
     models, files = [], {}
     opened = {k: v for k, v in (overrides or {}).items() if is_open_value(k)}
@@ -92,7 +92,7 @@ def _reference_topology() -> Path:
 
 def write_stiffness_figure(root: Path) -> Path:
     """Draw ``docs/stiffness.png`` (k(t) of the reference stage's first mesh)."""
-    from .stiffness_report import _pem, plot_mesh
+    from .emit.stiffness_report import _pem, plot_mesh
 
     topology = load_topology(_reference_topology())
     mesh = topology.meshes[0]

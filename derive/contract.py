@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from .backlash import DEAD_ZONE_EDGES
+from .mesh.backlash import DEAD_ZONE_EDGES
 
 __all__ = ["CONTRACT_FORMAT", "model_contract"]
 

@@ -32,13 +32,13 @@ from functools import cached_property
 
 import sympy as sp
 
-from ._input import InputError, expression_source
 from ._version import EMITTED_FORMAT, __version__
 from .contract import CONTRACT_FORMAT, model_contract
-from .equations import derive_equations
-from .nondim import NonDim, nondimensionalise
-from .scene import Features, Scene, limit_text
-from .structure import derive_structure
+from .equations.nondim import NonDim, nondimensionalise
+from .equations.structure import derive_structure
+from .equations.torsion import derive_equations
+from .input.reader import InputError, expression_source
+from .input.scene import Features, Scene, limit_text
 
 __all__ = ["CONTRACT_FORMAT", "Model", "Parameter", "derive_model", "operation_count"]
 
@@ -137,7 +137,7 @@ def inputs_hash(scene: Scene) -> str:
     }
     if scene.variations:  # a variant of the files (derive.scene.variant)
         payload["variant"] = {"name": scene.name, "features": scene.variations}
-    from .supports import load_topology_data
+    from .input.supports import load_topology_data
 
     payload["scene"] = tomllib.loads(Path(scene.source).read_text(encoding="utf-8"))
     payload["topology"] = load_topology_data(scene.topology.source)
@@ -158,7 +158,7 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
         nd = nondimensionalise(topo, scene.damping_ratio, eq, scene.damping_normalisation)
         orientation = eq.orientation
         disp = coords
-    else:  # bearings or shafts: derive/structure.py
+    else:  # bearings or shafts: derive/equations/structure.py
         structure = derive_structure(
             topo, feats.degrees_of_freedom, scene.damping_ratio, scene.source
         )
@@ -207,7 +207,7 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
     # Static loads.
     signs = {c: 1 for c in coords}
     if scene.load_reading is not None and scene.loads is not None:  # sizes; signs derived
-        from .readings import load_signs
+        from .input.readings import load_signs
 
         for c, (_, slope, sigma) in load_signs(nd, topo, scene.load_reading, scene.source).items():
             signs[c] = slope * sigma

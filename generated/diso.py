@@ -104,7 +104,7 @@ OMEGA_N = 11068.6287249826  # rad/s; tau = OMEGA_N * t
 HALF_BACKLASH = {'u': 5e-05, 'v': 5e-05}  # m
 FEATURES = {'stiffness_harmonics': 3, 'backlash': 'polynomial', 'transmission_error': True, 'mesh_phase': True, 'damping_coupling': True}
 SCENE_PARAMETERS = {'damping_ratio': 0.03, 'omega': 0.709571332557897}
-# (low, high, low excluded): derive/scene.py PARAMETER_LIMITS
+# (low, high, low excluded): derive/input/scene.py PARAMETER_LIMITS
 SCENE_PARAMETER_LIMITS = {'omega': (0.001, 1000.0, False), 'damping_ratio': (0.0, 1.0, False)}
 # mesh coordinate: ((cos index, sin index, harmonic), ...) of k_hat = 1 + sum ...
 STIFFNESS_TERMS = {'u': ((11, 12, 1), (13, 14, 2), (15, 16, 3)), 'v': ((17, 18, 1), (19, 20, 2), (21, 22, 3))}
@@ -127,7 +127,7 @@ CONTRACT = {
 }
 
 # The linear, time-averaged model in physical coordinates, for the modal analysis
-# (derive/structure.py physical_data; solver/analysis/modes.py).
+# (derive/equations/structure.py physical_data; solver/analysis/modes.py).
 STRUCTURE = {
     'physical': ('theta_p', 'theta_q', 'theta_g'),
     'mass': (0.0650477378225243, 0.0650477378225243, 11.0449007721764),

@@ -254,7 +254,7 @@ OMEGA_N = 11068.6287249826  # rad/s; tau = OMEGA_N * t
 HALF_BACKLASH = {'u': 5e-05, 'v': 5e-05}  # m
 FEATURES = {'stiffness_harmonics': 3, 'backlash': 'polynomial', 'transmission_error': True, 'mesh_phase': True, 'damping_coupling': True, 'degrees_of_freedom': 'lateral-torsional-axial'}
 SCENE_PARAMETERS = {'omega': 0.5, 'damping_ratio': 0.03, 'f1': 0.1, 'lambda': 0.1}
-# (low, high, low excluded): derive/scene.py PARAMETER_LIMITS
+# (low, high, low excluded): derive/input/scene.py PARAMETER_LIMITS
 SCENE_PARAMETER_LIMITS = {'omega': (0.001, 1000.0, False), 'damping_ratio': (0.0, 1.0, False)}
 # mesh coordinate: ((cos index, sin index, harmonic), ...) of k_hat = 1 + sum ...
 STIFFNESS_TERMS = {'u': ((77, 78, 1), (79, 80, 2), (81, 82, 3)), 'v': ((83, 84, 1), (85, 86, 2), (87, 88, 3))}
@@ -277,7 +277,7 @@ CONTRACT = {
 }
 
 # The linear, time-averaged model in physical coordinates, for the modal analysis
-# (derive/structure.py physical_data; solver/analysis/modes.py).
+# (derive/equations/structure.py physical_data; solver/analysis/modes.py).
 STRUCTURE = {
     'physical': ('theta_p', 'theta_q', 'theta_g', 'x_p', 'y_p', 'z_p', 'x_q', 'y_q', 'z_q', 'x_g', 'y_g', 'z_g'),
     'mass': (0.0650477378225243, 0.0650477378225243, 11.0449007721764, 11.6043614619649, 11.6043614619649, 11.6043614619649, 11.6043614619649, 11.6043614619649, 11.6043614619649, 210.773828476047, 210.773828476047, 210.773828476047),

@@ -154,7 +154,7 @@ OMEGA_N = 11068.6287249826  # rad/s; tau = OMEGA_N * t
 HALF_BACKLASH = {'u': 5e-05}  # m
 FEATURES = {'stiffness_harmonics': 3, 'backlash': 'polynomial', 'transmission_error': True, 'mesh_phase': True, 'damping_coupling': True, 'degrees_of_freedom': 'lateral-torsional-axial'}
 SCENE_PARAMETERS = {'damping_ratio': 0.03, 'omega': 0.709571332557897}
-# (low, high, low excluded): derive/scene.py PARAMETER_LIMITS
+# (low, high, low excluded): derive/input/scene.py PARAMETER_LIMITS
 SCENE_PARAMETER_LIMITS = {'omega': (0.001, 1000.0, False), 'damping_ratio': (0.0, 1.0, False)}
 # mesh coordinate: ((cos index, sin index, harmonic), ...) of k_hat = 1 + sum ...
 STIFFNESS_TERMS = {'u': ((40, 41, 1), (42, 43, 2), (44, 45, 3))}
@@ -177,7 +177,7 @@ CONTRACT = {
 }
 
 # The linear, time-averaged model in physical coordinates, for the modal analysis
-# (derive/structure.py physical_data; solver/analysis/modes.py).
+# (derive/equations/structure.py physical_data; solver/analysis/modes.py).
 STRUCTURE = {
     'physical': ('theta_p', 'theta_g', 'x_p', 'y_p', 'z_p', 'x_g', 'y_g', 'z_g'),
     'mass': (0.0650477378225243, 11.0449007721764, 11.6043614619649, 11.6043614619649, 11.6043614619649, 210.773828476047, 210.773828476047, 210.773828476047),

@@ -146,7 +146,7 @@ OMEGA_N = 11068.6287249826  # rad/s; tau = OMEGA_N * t
 HALF_BACKLASH = {'u': 5e-05, 'v': 5e-05, 'w': 4e-05}  # m
 FEATURES = {'stiffness_harmonics': 3, 'backlash': 'polynomial', 'transmission_error': True, 'mesh_phase': True, 'damping_coupling': True}
 SCENE_PARAMETERS = {'damping_ratio': 0.03, 'omega': 0.709571332557897}
-# (low, high, low excluded): derive/scene.py PARAMETER_LIMITS
+# (low, high, low excluded): derive/input/scene.py PARAMETER_LIMITS
 SCENE_PARAMETER_LIMITS = {'omega': (0.001, 1000.0, False), 'damping_ratio': (0.0, 1.0, False)}
 # mesh coordinate: ((cos index, sin index, harmonic), ...) of k_hat = 1 + sum ...
 STIFFNESS_TERMS = {'u': ((22, 23, 1), (24, 25, 2), (26, 27, 3)), 'v': ((28, 29, 1), (30, 31, 2), (32, 33, 3)), 'w': ((34, 35, 1), (36, 37, 2), (38, 39, 3))}
@@ -169,7 +169,7 @@ CONTRACT = {
 }
 
 # The linear, time-averaged model in physical coordinates, for the modal analysis
-# (derive/structure.py physical_data; solver/analysis/modes.py).
+# (derive/equations/structure.py physical_data; solver/analysis/modes.py).
 STRUCTURE = {
     'physical': ('theta_p', 'theta_q', 'theta_r', 'theta_g'),
     'mass': (0.0650477378225243, 0.0650477378225243, 0.0212858166346716, 11.0449007721764),

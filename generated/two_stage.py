@@ -282,7 +282,7 @@ OMEGA_N = 14833.5497144741  # rad/s; tau = OMEGA_N * t
 HALF_BACKLASH = {'v': 6e-05, 'u': 5e-05}  # m
 FEATURES = {'stiffness_harmonics': 3, 'backlash': 'polynomial', 'transmission_error': True, 'mesh_phase': True, 'damping_coupling': True, 'degrees_of_freedom': 'lateral-torsional-axial'}
 SCENE_PARAMETERS = {'damping_ratio': 0.03, 'omega': 0.132368546051907}
-# (low, high, low excluded): derive/scene.py PARAMETER_LIMITS
+# (low, high, low excluded): derive/input/scene.py PARAMETER_LIMITS
 SCENE_PARAMETER_LIMITS = {'omega': (0.001, 1000.0, False), 'damping_ratio': (0.0, 1.0, False)}
 # mesh coordinate: ((cos index, sin index, harmonic), ...) of k_hat = 1 + sum ...
 STIFFNESS_TERMS = {'v': ((89, 90, 1), (91, 92, 2), (93, 94, 3)), 'u': ((95, 96, 1), (97, 98, 2), (99, 100, 3))}
@@ -305,7 +305,7 @@ CONTRACT = {
 }
 
 # The linear, time-averaged model in physical coordinates, for the modal analysis
-# (derive/structure.py physical_data; solver/analysis/modes.py).
+# (derive/equations/structure.py physical_data; solver/analysis/modes.py).
 STRUCTURE = {
     'physical': ('theta_a', 'theta_b', 'theta_c', 'theta_d', 'x_a', 'y_a', 'z_a', 'x_b', 'y_b', 'z_b', 'x_c', 'y_c', 'z_c', 'x_d', 'y_d', 'z_d'),
     'mass': (0.00417498864214517, 0.13819854705345, 0.0295721109323195, 6.1527991779709, 2.93057785567289, 2.93057785567289, 2.93057785567289, 16.6611161955619, 16.6611161955619, 16.6611161955619, 9.19784884521427, 9.19784884521427, 9.19784884521427, 136.836488597865, 136.836488597865, 136.836488597865),

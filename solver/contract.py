@@ -1,7 +1,7 @@
 """What the solver knows about a model: the generated module's ``CONTRACT``, checked.
 
 A generated module states as data everything the solver needs (``derive/model.py`` builds
-it, ``derive/emit.py`` prints it): the state and parameter order, where each coordinate's
+it, ``derive/emit/python.py`` prints it): the state and parameter order, where each coordinate's
 velocity is, which parameter sets the excitation period, which parameters are static
 loads, the contact edges of each mesh coordinate, the switching surfaces (kinks) of a
 piecewise force law and the range where the force law is valid.  The solver reads only

@@ -36,7 +36,7 @@ def test_the_interval_is_what_the_generated_module_states(light):
     from gearsym.solver.periodic._bounds import Interval, interval_of
 
     omega, zeta = interval_of(light, "omega"), interval_of(light, "damping_ratio")
-    # derive/scene.py PARAMETER_LIMITS: omega in [1e-3, 1e3], damping ratio in [0, 1]
+    # derive/input/scene.py PARAMETER_LIMITS: omega in [1e-3, 1e3], damping ratio in [0, 1]
     assert omega.rule() == "omega in [0.001, 1000]" and 1e-3 in omega and 9.99e-4 not in omega
     assert zeta.rule() == "damping_ratio in [0, 1]" and 0.0 in zeta and -1e-12 not in zeta
     assert interval_of(light, "lambda").rule() == "lambda: any finite value"

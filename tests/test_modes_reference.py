@@ -2,9 +2,9 @@
 
 Issue 15: the frequencies of ``gearsym modes helical-pair-bearings`` equal an independent
 eigen-analysis of a mass and stiffness matrix assembled by hand, to 1e-8.  This file is the
-independent side: it was written without reading the derivation (derive/structure.py) or the
-modes analysis, and takes only data (masses, inertias, base radii, stiffnesses, angles) from
-the topology loader.
+independent side: it was written without reading the derivation
+(derive/equations/structure.py) or the modes analysis, and takes only data (masses,
+inertias, base radii, stiffnesses, angles) from the topology loader.
 
 Model (8 degrees of freedom q = theta_p, theta_g, x_p, y_p, z_p, x_g, y_g, z_g): each gear a
 rigid body of mass m and polar inertia I on a bearing (k_r along x and y, k_a along z); the
@@ -25,8 +25,8 @@ import numpy as np
 import pytest
 import scipy.linalg
 from gearsym.cli import main
-from gearsym.derive.scene import builtin_root
-from gearsym.derive.topology import load_topology
+from gearsym.derive.input.scene import builtin_root
+from gearsym.derive.input.topology import load_topology
 
 # Double-precision symmetric eigensolvers on an 8x8 problem this well conditioned agree to
 # about 1e-12 relative, so 1e-8 (the issue's tolerance) leaves room only for rounding, not

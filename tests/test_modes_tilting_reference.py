@@ -4,8 +4,8 @@ The frequencies of ``gearsym modes`` for helical-pair-bearings.toml with
 ``degrees_of_freedom = "lateral-torsional-axial-tilting"`` equal an independent
 eigen-analysis of a 12x12 mass and stiffness matrix assembled here from vectors, to 1e-8.
 This file is the independent side: it was written without reading the derivation
-(derive/structure.py, derive/audit_structure.py) or the modes analysis, and takes only data
-(masses, inertias, base radii, stiffnesses, angles) from the topology loader.
+(derive/equations/structure.py, derive/emit/audit_structure.py) or the modes analysis, and
+takes only data (masses, inertias, base radii, stiffnesses, angles) from the topology loader.
 
 Model (12 degrees of freedom, per gear k = p, g: theta_k, x_k, y_k, z_k, a_k, c_k).  Each
 gear is a rigid body of mass m, polar inertia I and diametral inertia J on a bearing (k_r
@@ -37,8 +37,8 @@ import numpy as np
 import pytest
 import scipy.linalg
 from gearsym.cli import main
-from gearsym.derive.scene import builtin_root
-from gearsym.derive.topology import load_topology
+from gearsym.derive.input.scene import builtin_root
+from gearsym.derive.input.topology import load_topology
 
 # Double-precision symmetric eigensolvers on a 12x12 problem this well conditioned agree to
 # about 1e-12 relative, so 1e-8 leaves room only for rounding, not for a wrong lever arm, a

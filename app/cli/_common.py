@@ -106,8 +106,8 @@ def figure_file(path, option: str) -> Path:
 
 def parse_set(items: list[str]) -> dict[str, float | str]:
     """``--set key=value`` items: numbers, except the open values that take text
-    (``load_reading``, ``damping_normalisation``: ``gearsym.derive.open_values.CHOICES``)."""
-    from gearsym.derive.open_values import CHOICES
+    (``load_reading``, ``damping_normalisation``: ``gearsym.derive.input.open_values.CHOICES``)."""
+    from gearsym.derive.input.open_values import CHOICES
 
     out = {}
     for item in items or []:
@@ -164,8 +164,8 @@ def system_of(scene_arg: str, sets: dict[str, float]):
     try:
         return System.load(module, **rest)
     except KeyError as err:
-        from gearsym.derive._input import nearest
-        from gearsym.derive.open_values import OPEN_VALUE_BASES
+        from gearsym.derive.input.open_values import OPEN_VALUE_BASES
+        from gearsym.derive.input.reader import nearest
 
         unknown = [k for k in rest if k not in module.PARAMETERS]
         hint = nearest(unknown[0], OPEN_VALUE_BASES) if unknown else ""

@@ -139,7 +139,7 @@ def _resolver(scene: str, system, sets: dict, names: tuple[str, str]):
     (those the derivation needs, when the derive layer knows them) through the resolver's
     derivation cache, one model per distinct set of open values."""
     try:
-        from gearsym.derive.open_values import is_open_value
+        from gearsym.derive.input.open_values import is_open_value
     except ImportError:  # a derive layer without open values
 
         def is_open_value(_name: str) -> bool:

@@ -118,8 +118,8 @@ def _cmd_derive(args) -> int:
         write_files,
         write_stiffness_figure,
     )
-    from gearsym.derive.emit import write_atomic
-    from gearsym.derive.scene import resolve_target
+    from gearsym.derive.emit.python import write_atomic
+    from gearsym.derive.input.scene import resolve_target
 
     if args.check:
         if args.targets or args.set or args.out or args.dry_run:
@@ -220,7 +220,7 @@ def _summary(model) -> None:
 
 
 def _cmd_backlash(args) -> int:
-    from gearsym.derive.backlash import fit_dead_zone
+    from gearsym.derive.mesh.backlash import fit_dead_zone
 
     if args.continuous and args.step is not None:
         raise Fail(f"--step {args.step:g} sets the samples of a discrete fit and --continuous "
@@ -274,10 +274,10 @@ def _cmd_backlash(args) -> int:
 def _cmd_stiffness(args) -> int:
     import warnings
 
-    from gearsym.derive._input import load_toml, nearest
-    from gearsym.derive.scene import load_scene, resolve_target
-    from gearsym.derive.stiffness_report import mesh_report, plot_mesh
-    from gearsym.derive.topology import load_topology
+    from gearsym.derive.emit.stiffness_report import mesh_report, plot_mesh
+    from gearsym.derive.input.reader import load_toml, nearest
+    from gearsym.derive.input.scene import load_scene, resolve_target
+    from gearsym.derive.input.topology import load_topology
 
     if args.slices < 1 or args.slices > 100000:
         raise Fail(f"--slices {args.slices}: give a number of slices from 1 to 100000")

@@ -289,7 +289,7 @@ def _cmd_continue(args) -> int:
             f"{args.settle * args.period:,} periods T, more than {MAX_SETTLED:,}; "
             "lower --settle"
         )
-    from gearsym.derive.open_values import is_open_value
+    from gearsym.derive.input.open_values import is_open_value
 
     if is_open_value(args.param):
         raise Fail(

@@ -198,7 +198,7 @@ def _cmd_sweep(args) -> int:
             f"{MAX_SWEEP_POINTS:,} points and {MAX_TOTAL_PERIODS:.0e} periods in all "
             "(hours of work); sweep fewer points or periods"
         )
-    from gearsym.derive.open_values import is_open_value
+    from gearsym.derive.input.open_values import is_open_value
 
     if is_open_value(args.param):
         raise Fail(

@@ -166,7 +166,7 @@ def _bounded(args, system, num: int, methods, cap: int) -> None:
 
 
 def _cmd_response(args) -> int:
-    from gearsym.derive.open_values import is_open_value
+    from gearsym.derive.input.open_values import is_open_value
     from gearsym.solver._json import dumps
     from gearsym.solver.periodic import HarmonicBalanceError, ShootingError
     from gearsym.solver.sweep.frequency import frequency_response, harmonics_cap

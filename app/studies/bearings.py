@@ -5,7 +5,7 @@ The scene ``diso-bearings-light`` is ``reference-light`` with every gear on bear
 free to move across and along its axis (``scenes/topologies/diso-bearings.toml`` states
 the bearing values and why); the heavy case is the same scene at f1 = 0.5, as
 ``reference-heavy`` is ``reference-light`` at f1 = 0.5.  Both models share the time scale
-(``derive/structure.py``), so the same omega is the same speed.  The sweeps run with the
+(``derive/equations/structure.py``), so the same omega is the same speed.  The sweeps run with the
 torsional ones, at the same lambda values and settings, forward from the same kind of
 start.
 """

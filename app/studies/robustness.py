@@ -67,8 +67,8 @@ def harmonics_models(folder: Path) -> dict[str, Path]:
     """Generate the reference light-load model with 0 and with 10 stiffness harmonics
     (variants of the scene, derived into ``folder/generated``)."""
     from gearsym.derive import derive_model, load_target, variant
-    from gearsym.derive.emit import emit_module, write_atomic
-    from gearsym.derive.scene import builtin_root
+    from gearsym.derive.emit.python import emit_module, write_atomic
+    from gearsym.derive.input.scene import builtin_root
 
     scene = load_target(builtin_root() / "reference-light.toml")
     out = {}

@@ -1,6 +1,6 @@
 """Where the study's findings live in the values it leaves open (issue 12, point 6).
 
-For each open value the derive layer offers (``gearsym.derive.open_values``), a regime map
+For each open value the derive layer offers (``gearsym.derive.input.open_values``), a regime map
 over lambda by that value, at both loads and in both readings of the loads, from three
 initial states so that coexisting attractors show.  Each value is a new derivation
 (cached); the built-in scenes keep their stated values, which are always among the values

@@ -11,7 +11,7 @@ integral of ``trace J`` rides along for Liouville's formula ``det W = exp(int tr
 * :func:`numpy_rhs` -- the same right-hand side on the generated NumPy functions, for the
   SciPy event loop (``events.py``) that locates switching surfaces.
 
-The compiled Lyapunov run uses the C variational right-hand side that ``derive/emit_c.py``
+The compiled Lyapunov run uses the C variational right-hand side that ``derive/emit/c.py``
 prints from the same SymPy Jacobian.
 """
 

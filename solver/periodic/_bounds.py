@@ -1,7 +1,7 @@
 """Where a continuation parameter may go: the valid range the model states for it.
 
 A generated module states the valid range of each scene parameter as data,
-``SCENE_PARAMETER_LIMITS = {name: (low, high, low excluded)}`` (``derive/scene.py``),
+``SCENE_PARAMETER_LIMITS = {name: (low, high, low excluded)}`` (``derive/input/scene.py``),
 and the System requires the forcing frequency to be > 0.  A continuation reads them
 here, before it steps: a predictor that would cross a boundary is shortened to land on
 it (an excluded end: a thousandth of the range inside it, where the model is still

@@ -70,7 +70,7 @@ def _brute_force_fit(order, fit_range, step):
     # Reference: the definition of the discrete fit, summed sample by sample in rationals.
     from fractions import Fraction
 
-    from gearsym.derive.backlash import _solve_exact
+    from gearsym.derive.mesh.backlash import _solve_exact
 
     n = int(round(2.0 * fit_range / step)) + 1
     a, m = Fraction(fit_range), n - 1

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 import sympy as sp
 from gearsym.derive import DeadZone, LinearContact, SmoothDeadZone, derive_model, load_target
-from gearsym.derive.backlash import BACKLASH_MODELS, fit_dead_zone
 from gearsym.derive.build import shipped_targets
+from gearsym.derive.mesh.backlash import BACKLASH_MODELS, fit_dead_zone
 from gearsym.derive.model import CONTRACT_FORMAT
 
 KEYS = (

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from gearsym.derive import derive_model, load_target
 from gearsym.derive.build import project_root, shipped_targets
-from gearsym.derive.emit import emit_module
+from gearsym.derive.emit.python import emit_module
 from gearsym.solver import load_generated
 
 NAMES = [
@@ -158,7 +158,7 @@ def test_c_printer_keeps_reciprocals_of_sums_and_leaves_state_trig_alone():
     # 1/(a + b u) must not print as 1.0/a + b*u; sin of a state is not a parameter-only
     # term to hoist; a frequency set by another parameter is not reduced.
     import sympy as sp
-    from gearsym.derive.emit_c import _Printer, _reduce_trig
+    from gearsym.derive.emit.c import _Printer, _reduce_trig
 
     a, b, u, omega, r, tau = sp.symbols("a b u omega r tau")
     text = _Printer().doprint(1 / (a + b * u))

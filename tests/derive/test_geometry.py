@@ -4,15 +4,15 @@ import math
 import tomllib
 
 import pytest
-from gearsym.derive.geometry import (
+from gearsym.derive.input.topology import parse_topology
+from gearsym.derive.mesh.geometry import (
     CentreDistanceError,
     backlash_free_shift_sum,
     gear_geometry,
     pair_geometry,
     with_tip_radius,
 )
-from gearsym.derive.stiffness import contact_line_stiffness
-from gearsym.derive.topology import parse_topology
+from gearsym.derive.mesh.stiffness import contact_line_stiffness
 
 
 def study_pair(shift=(0.0, 0.0)):

@@ -14,7 +14,7 @@ import tomllib
 import pytest
 from gearsym import resolve
 from gearsym.derive import InputError, load_target
-from gearsym.derive._input import MAX_DEPTH, parse_toml
+from gearsym.derive.input.reader import MAX_DEPTH, parse_toml
 
 
 def dump(value) -> str:

@@ -3,8 +3,8 @@
 import math
 
 import pytest
-from gearsym.derive.geometry import gear_geometry, pair_geometry, with_tip_radius
-from gearsym.derive.iso6336 import iso_stiffness
+from gearsym.derive.mesh.geometry import gear_geometry, pair_geometry, with_tip_radius
+from gearsym.derive.mesh.iso6336 import iso_stiffness
 
 deg = math.radians
 

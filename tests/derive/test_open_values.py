@@ -1,4 +1,4 @@
-"""Open values (derive/open_values.py): each carried through the derivation consistently.
+"""Open values (derive/input/open_values.py): each carried through the derivation consistently.
 
 References: closed forms of the reduced torsional model -- the coupling between two meshes
 on one gear goes through that gear's inertia alone, so kappa_uv omega_n^2 I_g is the same
@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 from gearsym.derive import InputError, derive_model, load_target, resolve_target
-from gearsym.derive.open_values import is_open_value, with_open_values
+from gearsym.derive.input.open_values import is_open_value, with_open_values
 
 
 @pytest.fixture(scope="module")
@@ -180,12 +180,12 @@ def test_the_load_sign_follows_the_torque_sign():
     # as T_q > 0 loads q's flank; the couplings stay positive.
     from dataclasses import replace
 
-    from gearsym.derive.readings import Reading
+    from gearsym.derive.input.readings import Reading
 
     base = load_target(resolve_target("reference-light"))
     odd = Reading("q-driving-forward", "", ("p", "q"), (), ())
     topo = replace(base.topology, readings=base.topology.readings | {odd.id: odd})
-    from gearsym.derive.readings import apply_reading
+    from gearsym.derive.input.readings import apply_reading
 
     scene = replace(base, topology=apply_reading(topo, odd.id, "test"), load_reading=odd.id)
     model = derive_model(scene)
@@ -218,7 +218,7 @@ def test_modal_damping_gives_each_mode_the_damping_ratio(scene):
 
 def test_choice_names_are_open_values():
     assert is_open_value("load_reading") and is_open_value("damping_normalisation")
-    from gearsym.derive.open_values import OPEN_VALUE_BASES
+    from gearsym.derive.input.open_values import OPEN_VALUE_BASES
 
     assert {"load_reading", "te_amplitude_um", "flywheel_inertia_kg_m2"} <= OPEN_VALUE_BASES
 

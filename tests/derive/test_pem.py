@@ -5,9 +5,9 @@ import warnings
 
 import numpy as np
 import pytest
-from gearsym.derive.geometry import gear_geometry, pair_geometry
-from gearsym.derive.iso6336 import iso_stiffness
-from gearsym.derive.pem import (
+from gearsym.derive.mesh.geometry import gear_geometry, pair_geometry
+from gearsym.derive.mesh.iso6336 import iso_stiffness
+from gearsym.derive.mesh.pem import (
     FOUNDATION_TABLE,
     fourier_fit,
     hertz_compliance,
@@ -16,7 +16,7 @@ from gearsym.derive.pem import (
     sliced_stiffness,
     tooth_compliance,
 )
-from gearsym.derive.stiffness import contact_line_stiffness
+from gearsym.derive.mesh.stiffness import contact_line_stiffness
 from scipy.integrate import quad
 
 E, NU = 2.06e11, 0.3

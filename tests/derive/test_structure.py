@@ -1,4 +1,4 @@
-"""Models beyond torsion (derive/structure.py, issue 15): the very-stiff limit against the
+"""Models beyond torsion (derive/equations/structure.py, issue 15): the very-stiff limit against the
 torsional model, energy conservation of the linear undamped model, and the generated
 coefficients against the physical matrices the modal analysis uses."""
 
@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from gearsym.derive.scene import builtin_root
+from gearsym.derive.input.scene import builtin_root
 from gearsym.resolve import module_for
 from gearsym.solver import System
 from gearsym.solver.integrate import simulate
@@ -180,7 +180,7 @@ def test_an_anisotropic_bearing_across_the_line_of_action_rings_alone(tmp_path):
     mass on a spring, and the x motions stay coupled to the mesh."""
     import math
 
-    from gearsym.derive.topology import load_topology
+    from gearsym.derive.input.topology import load_topology
     from gearsym.solver.analysis.modes import modes
 
     base = load_topology(TOPOLOGIES / "helical-pair-bearings.toml")
@@ -217,7 +217,7 @@ def test_a_spur_pair_tilts_free_of_the_mesh(tmp_path):
     tilting modes move."""
     import math
 
-    from gearsym.derive.topology import load_topology
+    from gearsym.derive.input.topology import load_topology
     from gearsym.solver.analysis.modes import modes
 
     base = TOPOLOGIES / "helical-pair-bearings.toml"

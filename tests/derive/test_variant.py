@@ -2,8 +2,8 @@
 
 import pytest
 from gearsym.derive import InputError, derive_model, load_target, variant
+from gearsym.derive.input.scene import builtin_root
 from gearsym.derive.model import inputs_hash
-from gearsym.derive.scene import builtin_root
 
 
 @pytest.fixture(scope="module")

@@ -1,7 +1,7 @@
 """Build and cache the native library of a generated model.
 
 The generated module carries its right-hand side as C (``C_SOURCE``, printed by
-``derive/emit_c.py`` from the same SymPy expressions as the NumPy and CasADi code, with
+``derive/emit/c.py`` from the same SymPy expressions as the NumPy and CasADi code, with
 the excitation's harmonics reduced to one ``sincos`` per step stage).  It is compiled with
 the system C compiler (``cc``, or ``$GEARSYM_CC``) together with the integrators of
 ``_native.c`` and the checked tableaux of ``../tableau.py`` into a shared library, loaded

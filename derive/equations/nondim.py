@@ -34,8 +34,8 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-from .equations import Equations, derive_equations
-from .topology import Topology
+from ..input.topology import Topology
+from .torsion import Equations, derive_equations
 
 __all__ = ["DAMPING_NORMALISATIONS", "NonDim", "nondimensionalise"]
 

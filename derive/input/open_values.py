@@ -20,9 +20,9 @@ E = amplitude / half backlash; a layout angle becomes the stiffness phase phi.  
 ``..._<mesh>``                            (the mean k_m kept)
 ``load_reading``                          a ``[[reading]]`` of the topology (text):
                                           ``q-braking`` or ``both-driving`` for the
-                                          reference stage (``derive/readings.py``)
+                                          reference stage (``derive/input/readings.py``)
 ``damping_normalisation``                 ``mesh`` or ``modal`` (text,
-                                          ``derive/nondim.py``)
+                                          ``derive/equations/nondim.py``)
 ========================================  ============================================
 
 A scene file sets them in an ``[open]`` table; ``gearsym.load(scene, **values)`` and the
@@ -39,7 +39,7 @@ import copy
 import math
 from dataclasses import replace
 
-from ._input import InputError, nearest
+from .reader import InputError, nearest
 
 __all__ = [
     "CHOICES",
@@ -156,7 +156,7 @@ def apply_open_values(data: dict, values: dict, where: str) -> dict:
 
 def check_damping(value: str, where: str) -> None:
     """Raise :class:`InputError` unless ``value`` is a damping normalisation."""
-    from .nondim import DAMPING_NORMALISATIONS
+    from ..equations.nondim import DAMPING_NORMALISATIONS
 
     if value not in DAMPING_NORMALISATIONS:
         known = DAMPING_NORMALISATIONS
@@ -174,7 +174,7 @@ def with_open_values(scene, **values):
     import hashlib
     import json
 
-    from ._input import load_toml
+    from .reader import load_toml
     from .supports import load_topology_data
     from .topology import parse_topology
 

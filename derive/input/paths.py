@@ -13,7 +13,7 @@ __all__ = ["display_path", "project_root"]
 
 def project_root() -> Path:
     """The folder holding ``derive/``, ``generated/`` and ``docs/`` (the checkout)."""
-    return Path(__file__).resolve().parent.parent
+    return Path(__file__).resolve().parents[2]
 
 
 def display_path(path: Path | str) -> str:

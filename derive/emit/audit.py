@@ -13,15 +13,15 @@ import math
 
 import sympy as sp
 
-from ._markdown import math_block as _math
-from ._markdown import number as _num
-from ._paths import display_path
+from ..equations.nondim import DAMPING_TEXT
+from ..escape import markdown
+from ..input.paths import display_path
+from ..input.readings import reading_section
+from ..mesh.backlash import fit_dead_zone
+from ..model import Model
 from .audit_structure import structure_sections
-from .backlash import fit_dead_zone
-from .escape import markdown
-from .model import Model
-from .nondim import DAMPING_TEXT
-from .readings import reading_section
+from .markdown import math_block as _math
+from .markdown import number as _num
 
 __all__ = ["audit_page", "index_page"]
 
@@ -387,7 +387,8 @@ def index_page(models: list[Model], command: str) -> str:
         "## Beyond torsion: bearings and shafts\n",
         "A scene may ask for lateral-torsional or lateral-torsional-axial models "
         "(`degrees_of_freedom`), and a topology may join gears by shafts "
-        "(`derive/structure.py`). Each gear then also moves across ($x, y$) and along ($z$) "
+        "(`derive/equations/structure.py`). Each gear then also moves across ($x, y$) "
+        "and along ($z$) "
         "its axis on its bearing. The coordinates are $\\eta = R q$: the mesh "
         "deflections along the normal line of action (now with the translations' "
         "projections, $\\cos\\beta_b\\,(\\Delta x\\cos\\psi + \\Delta y\\sin\\psi)"

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from .topology import Topology
+from ..input.topology import Topology
 
 __all__ = ["Equations", "derive_equations"]
 

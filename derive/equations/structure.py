@@ -61,8 +61,8 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ._input import InputError
-from .topology import Topology
+from ..input.reader import InputError
+from ..input.topology import Topology
 
 __all__ = ["DEGREES_OF_FREEDOM", "Structure", "derive_structure", "physical_data"]
 
@@ -141,7 +141,7 @@ def _names(topo: Topology, axes: tuple[str, ...], source: str) -> list[tuple[str
     out = [(m.coordinate, "mesh", m.id) for m in topo.meshes]
     out += [(s.id, "shaft", s.id) for s in topo.shafts]
     out += [(f"{a}{g.id}", a, g.id) for g in topo.gears for a in axes]
-    from .topology import _BACKLASH_NAME, _RESERVED
+    from ..input.topology import _BACKLASH_NAME, _RESERVED
 
     seen: set[str] = set()
     for name, kind, owner in out:

@@ -18,7 +18,7 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
-from .escape import is_identifier, is_target_name, one_line
+from ..escape import is_identifier, is_target_name, one_line
 
 __all__ = ["InputError", "Table", "load_toml", "nearest", "parse_expression"]
 

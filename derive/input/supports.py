@@ -25,7 +25,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from ._input import InputError, Table, load_toml, nearest, not_a_table, shown
+from .reader import InputError, Table, load_toml, nearest, not_a_table, shown
 
 __all__ = ["Bearing", "Shaft", "load_topology_data", "parse_bearings", "parse_shafts"]
 

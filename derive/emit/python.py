@@ -20,11 +20,11 @@ from pathlib import Path
 import sympy as sp
 from sympy.printing.str import StrPrinter
 
-from .emit_c import c_source
-from .escape import code_name, code_names, text
-from .model import Model, operation_count  # operation_count re-exported
-from .scene import PARAMETER_LIMITS
-from .structure import physical_data
+from ..equations.structure import physical_data
+from ..escape import code_name, code_names, text
+from ..input.scene import PARAMETER_LIMITS
+from ..model import Model, operation_count  # operation_count re-exported
+from .c import c_source
 
 __all__ = ["CodePrinter", "emit_module", "operation_count", "write_atomic"]
 
@@ -277,7 +277,7 @@ def emit_module(model: Model, command: str) -> str:
         "SCENE_PARAMETERS = {"
         + ", ".join(f"{k!r}: {fmt(v)}" for k, v in model.scene_parameters.items())
         + "}",
-        "# (low, high, low excluded): derive/scene.py PARAMETER_LIMITS",
+        "# (low, high, low excluded): derive/input/scene.py PARAMETER_LIMITS",
         "SCENE_PARAMETER_LIMITS = {"
         + ", ".join(
             f"{k!r}: {v!r}" for k, v in PARAMETER_LIMITS.items() if k in model.scene_parameters
@@ -294,7 +294,7 @@ def emit_module(model: Model, command: str) -> str:
         "}",
         "",
         "# The linear, time-averaged model in physical coordinates, for the modal analysis",
-        "# (derive/structure.py physical_data; solver/analysis/modes.py).",
+        "# (derive/equations/structure.py physical_data; solver/analysis/modes.py).",
         "STRUCTURE = {",
         *(f"    {k!r}: {v!r}," for k, v in physical_data(model).items()),
         "}",

@@ -1,4 +1,4 @@
-"""The audit page's sections 2-6 for a model beyond torsion (``derive/structure.py``):
+"""The audit page's sections 2-6 for a model beyond torsion (``derive/equations/structure.py``):
 bodies and supports, the mesh geometry, the coordinates ``eta = R q``, the compliance
 ``W = R M^-1 R^T`` and the scales, written from the same SymPy objects as the code."""
 
@@ -8,8 +8,8 @@ import math
 
 import sympy as sp
 
-from ._markdown import math_block as _math
-from ._markdown import number as _num
+from .markdown import math_block as _math
+from .markdown import number as _num
 
 __all__ = ["structure_sections"]
 

@@ -20,8 +20,7 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
 
-from ._input import Table, nearest
-from .geometry import (
+from ..mesh.geometry import (
     CentreDistanceError,
     GearGeometry,
     PairGeometry,
@@ -29,9 +28,10 @@ from .geometry import (
     pair_geometry,
     with_tip_radius,
 )
-from .pem import pem_stiffness
+from ..mesh.pem import pem_stiffness
+from ..mesh.stiffness import MeshStiffness, contact_line_stiffness
+from .reader import Table, nearest
 from .readings import ORIENTATIONS, parse_readings
-from .stiffness import MeshStiffness, contact_line_stiffness
 from .supports import Bearing, Shaft, load_topology_data, parse_bearings, parse_shafts
 
 __all__ = [
@@ -333,7 +333,7 @@ def _gear(t: Table, materials: dict[str, Material]) -> Gear:
 
 
 def _stiffness(t: Table, pair: PairGeometry, gears: tuple[Gear, Gear]) -> MeshStiffness:
-    # An open value (derive/open_values.py): a factor on every harmonic, the mean kept.
+    # An open value (derive/input/open_values.py): a factor on every harmonic, the mean kept.
     scale = t.number("harmonic_scale", 1.0, low=0.0)
     k = _stiffness_of(t, pair, gears)
     if scale == 1.0:
@@ -364,7 +364,7 @@ def _stiffness_of(t: Table, pair: PairGeometry, gears: tuple[Gear, Gear]) -> Mes
 
 
 def _pem_stiffness(t: Table, pair: PairGeometry, gears: tuple[Gear, Gear]) -> MeshStiffness:
-    """Sliced potential-energy stiffness (``derive/pem.py``); the Fourier coefficients are
+    """Sliced potential-energy stiffness (``derive/mesh/pem.py``); the Fourier coefficients are
     rounded to 9 significant digits so that generated files do not depend on the last bits
     of the FFT."""
     slices = t.integer("slices", 200, low=1, high=100000)

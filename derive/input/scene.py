@@ -12,13 +12,13 @@ A scene names the features the model must carry; the derivation emits only their
 frequency of the reference mesh, required), ``damping_ratio`` (required) and any others
 that ``[loads]`` uses.  ``[loads]`` gives the non-dimensional static load ``f_i`` of each
 mesh coordinate as a number or an arithmetic expression of the parameters (``u = "f1"``,
-``v = "-lambda*f1"``); with a ``load_reading`` (``[open]``, ``derive/readings.py``) it gives
+``v = "-lambda*f1"``); with a ``load_reading`` (``[open]``, ``derive/input/readings.py``) it gives
 the size of each load and the derivation gives its sign (the reference scenes:
 ``v = "lambda*f1"``).  Without ``[loads]`` the loads come from the topology's torques.
 
-``[open]`` sets the values the reference study leaves open (``derive/open_values.py``):
+``[open]`` sets the values the reference study leaves open (``derive/input/open_values.py``):
 numbers such as ``te_amplitude_um`` and the choices ``load_reading`` and
-``damping_normalisation`` (``"mesh"`` or ``"modal"``, ``derive/nondim.py``).
+``damping_normalisation`` (``"mesh"`` or ``"modal"``, ``derive/equations/nondim.py``).
 
 A topology file may be derived on its own: it then stands for a default scene with every
 feature on, 3 harmonics, the reference study's backlash polynomial, and ``omega`` and the
@@ -30,8 +30,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from ._input import InputError, Table, load_toml, nearest, parse_expression
-from .backlash import (
+from ..mesh.backlash import (
     BACKLASH_MODELS,
     Backlash,
     DeadZone,
@@ -39,6 +38,7 @@ from .backlash import (
     SmoothDeadZone,
     fit_dead_zone,
 )
+from .reader import InputError, Table, load_toml, nearest, parse_expression
 from .supports import load_topology_data
 from .topology import Topology, load_topology, parse_topology
 
@@ -69,7 +69,7 @@ class Features:
     transmission_error: bool = True
     mesh_phase: bool = True
     damping_coupling: bool = True
-    # Which degrees of freedom each gear has (derive/structure.py DEGREES_OF_FREEDOM).
+    # Which degrees of freedom each gear has (derive/equations/structure.py DEGREES_OF_FREEDOM).
     degrees_of_freedom: str = "torsional"
 
     def flags(self) -> dict:
@@ -109,8 +109,8 @@ class Scene:
     source: str
     kind: str = "scene"  # "scene" or "topology" (a topology derived with default features)
     variations: dict = field(default_factory=dict)  # [features] changed by variant()
-    # The study's open choices (derive/open_values.py, derive/readings.py): the reading of
-    # the loads (None: [loads] carry their own signs) and the damping normalisation.
+    # The study's open choices (derive/input/open_values.py, derive/input/readings.py): the
+    # reading of the loads (None: [loads] carry their own signs) and the damping normalisation.
     load_reading: str | None = None
     damping_normalisation: str = "mesh"
 
@@ -175,7 +175,7 @@ def _features(t: Table | None) -> Features:
 
 
 def _degrees_of_freedom(t: Table) -> str:
-    from .structure import DEGREES_OF_FREEDOM
+    from ..equations.structure import DEGREES_OF_FREEDOM
 
     dofs = t.string("degrees_of_freedom", "torsional", choices=tuple(DEGREES_OF_FREEDOM))
     if dofs != "torsional" and not t.data.get("damping_coupling", True):
@@ -269,7 +269,7 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
     if open_t is None:
         topology = load_topology(topo_path)
     else:
-        # the study's open values, set in the scene (derive/open_values.py)
+        # the study's open values, set in the scene (derive/input/open_values.py)
         from .open_values import CHOICES, apply_open_values
 
         for key in CHOICES:

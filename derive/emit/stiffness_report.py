@@ -1,8 +1,8 @@
 """Mesh stiffness reports: the numbers behind `gearsym stiffness` and ``docs/stiffness.md``.
 
 For each mesh of a topology: the pair's geometry, the sliced potential-energy stiffness
-(``derive/pem.py``) with its Fourier fit and convergence in the number of slices, the
-ISO 6336-1 method B figures (``derive/iso6336.py``) and their ratio to the mean, the
+(``derive/mesh/pem.py``) with its Fourier fit and convergence in the number of slices, the
+ISO 6336-1 method B figures (``derive/mesh/iso6336.py``) and their ratio to the mean, the
 contact-line model's harmonic ratios for comparison, the layout phase and the transmission
 error.
 """
@@ -15,11 +15,11 @@ import warnings
 
 import numpy as np
 
-from .escape import markdown
-from .iso6336 import iso_stiffness
-from .pem import PemResult, foundation_parameters, pair_compliance, pem_stiffness
-from .stiffness import contact_line_stiffness
-from .topology import Mesh, Topology
+from ..escape import markdown
+from ..input.topology import Mesh, Topology
+from ..mesh.iso6336 import iso_stiffness
+from ..mesh.pem import PemResult, foundation_parameters, pair_compliance, pem_stiffness
+from ..mesh.stiffness import contact_line_stiffness
 
 __all__ = ["CONVERGENCE_SLICES", "mesh_report", "plot_mesh", "stiffness_page"]
 
@@ -226,7 +226,7 @@ def stiffness_page(topology: Topology, command: str, figure: str | None) -> str:
         "the teeth, module and angles alone: a time-varying mesh stiffness k(t) by the "
         "potential-energy method (PEM) on a sliced helical pair, fitted by a Fourier series, "
         "with ISO 6336-1 method B as an independent check of its mean. Code: "
-        "`derive/geometry.py`, `derive/pem.py`, `derive/iso6336.py`; command: "
+        "`derive/mesh/geometry.py`, `derive/mesh/pem.py`, `derive/mesh/iso6336.py`; command: "
         "`gearsym stiffness diso [--slices N] [--harmonics H] [--json] [--plot FILE]`.",
         "",
         "## Formulas",

@@ -23,8 +23,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from ._input import InputError, Table, nearest
-from .escape import markdown
+from ..escape import markdown
+from .reader import InputError, Table, nearest
 
 __all__ = [
     "ORIENTATIONS",

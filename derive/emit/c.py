@@ -17,8 +17,8 @@ from __future__ import annotations
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
-from .escape import code_names, text
-from .model import Model
+from ..escape import code_names, text
+from ..model import Model
 
 __all__ = ["c_source"]
 

@@ -1,0 +1,1 @@
+"""Reading what a user writes: TOML topologies and scenes, checked once, with one-line errors."""
