@@ -21,7 +21,7 @@ _EXPORTS = {
     "fit_dead_zone": "mesh.backlash",
     "Model": "model",
     "derive_model": "model",
-    "Features": "input.scene",
+    "Features": "input.features",
     "Scene": "input.scene",
     "load_scene": "input.scene",
     "load_target": "input.scene",

@@ -92,14 +92,14 @@ def _reference_topology() -> Path:
 
 def write_stiffness_figure(root: Path) -> Path:
     """Draw ``docs/stiffness.png`` (k(t) of the reference stage's first mesh)."""
-    from .emit.stiffness_report import _pem, plot_mesh
+    from .emit.stiffness_figures import mesh_pem, plot_mesh
 
     topology = load_topology(_reference_topology())
     mesh = topology.meshes[0]
     path = Path(root) / STIFFNESS_FIGURE
     path.parent.mkdir(parents=True, exist_ok=True)
     plot_mesh(
-        _pem(topology, mesh, 200, 3),
+        mesh_pem(topology, mesh, 200, 3),
         path,
         f"{topology.name}: mesh {mesh.id} ({mesh.driver} drives {mesh.driven})",
     )

@@ -6,16 +6,9 @@ its state Jacobian as SymPy expressions, the ordered state and parameter names, 
 scene's parameter values, the scales, and the derivation objects for the audit.
 
 State order: the mesh coordinates ``u_1..u_m`` in mesh order, then their derivatives
-``du_1..du_m``.  Parameter order (only the ones the features need):
-
-1. ``omega`` -- excitation frequency of the reference mesh over ``omega_n``;
-2. ``f_<i>`` -- static load of each coordinate;
-3. ``xi_<i>_<j>`` -- damping coefficients (off-diagonal only with damping coupling);
-4. ``kappa_<i>_<j>`` -- mean stiffness coefficients ``K_ij`` (structural zeros omitted);
-5. ``kc_<j>_<h>``, ``ks_<j>_<h>`` -- stiffness harmonics of mesh j over its mean;
-6. ``phi_<j>`` -- stiffness/TE phase lag of mesh j (mesh phase on, non-reference meshes);
-7. ``E_<j>_<h>``, ``psi_<j>_<h>`` -- transmission-error harmonics over ``b_j``, and phases;
-8. backlash parameters (``g1, g3, ...`` or ``eps_g``).
+``du_1..du_m``.  Parameter order: ``derive/parameters.py`` (omega, loads, damping, mean
+stiffness, stiffness harmonics, phases, transmission error, backlash), only the ones the
+features need and the equations use.
 
 :attr:`Model.contract` states, as plain Python literals, what a solver needs to know about
 the model (format :data:`CONTRACT_FORMAT`); every generated module carries it as
@@ -26,7 +19,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -38,7 +30,8 @@ from .equations.nondim import NonDim, nondimensionalise
 from .equations.structure import derive_structure
 from .equations.torsion import derive_equations
 from .input.reader import InputError, expression_source
-from .input.scene import Features, Scene, limit_text
+from .input.scene import Features, Scene
+from .parameters import Parameter, model_parameters
 
 __all__ = ["CONTRACT_FORMAT", "Model", "Parameter", "derive_model", "operation_count"]
 
@@ -49,14 +42,6 @@ def operation_count(expressions) -> int:
     return int(
         sum(sp.count_ops(e) for _, e in replacements) + sum(sp.count_ops(e) for e in reduced)
     )
-
-
-@dataclass(frozen=True)
-class Parameter:
-    name: str
-    value: float
-    meaning: str
-    latex: str
 
 
 @dataclass(frozen=True)
@@ -173,142 +158,11 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
     ratios = topo.mesh_frequency_ratios()
     freq = tuple(sp.Rational(ratios[me.id].numerator, ratios[me.id].denominator) for me in meshes)
 
-    params: list[Parameter] = []
-
-    def param(name: str, value: float, meaning: str, latex: str) -> sp.Symbol:
-        if not math.isfinite(value):
-            raise InputError(
-                topo.source,
-                "mesh",
-                f"the data give {name} = {value}, which is not finite; check the stiffness, "
-                "backlash and inertia values for extreme magnitudes",
-            )
-        params.append(Parameter(name, float(value), meaning, latex))
-        return sp.Symbol(name, real=True)
-
-    omega_value = scene.omega
-    if omega_value is None:  # a topology: from its operating speed and omega_n
-        omega_n = nd.value(nd.omega_n_expr)
-        omega_value = topo.reference_mesh_frequency() / omega_n
-        if (why := limit_text("omega", omega_value)) is not None:
-            raise InputError(
-                topo.source,
-                "operating.speed_rpm",
-                f"gives omega = mesh frequency / omega_n = {omega_value:.3g} (omega_n = "
-                f"{omega_n:.3g} rad/s from the stiffness and inertias), and omega {why}; check "
-                "the speed, the stiffness and the inertias",
-            )
-    omega = param(
-        "omega",
-        omega_value,
-        "excitation (mesh) frequency of the reference mesh over omega_n",
-        r"\bar\omega",
-    )
-    # Static loads.
-    signs = {c: 1 for c in coords}
-    if scene.load_reading is not None and scene.loads is not None:  # sizes; signs derived
-        from .input.readings import load_signs
-
-        for c, (_, slope, sigma) in load_signs(nd, topo, scene.load_reading, scene.source).items():
-            signs[c] = slope * sigma
-    if scene.loads is not None:
-        f_values = [signs[c] * scene.loads[c] for c in coords]
-        f_meaning = "static load (from the scene's [loads])"
-        if scene.load_reading is not None:
-            f_meaning = f"static load (size from [loads], sign from reading {scene.load_reading})"
-    else:
-        f_values = [nd.value(nd.load[i]) for i in range(m)]
-        f_meaning = "static load (from the topology's torques)"
-    f = [param(f"f_{c}", f_values[i], f_meaning, f"f_{{{c}}}") for i, c in enumerate(coords)]
-    # Beyond the meshes: a shaft's load from the torques; none on a translation.
-    for i in range(m, N):
-        load = nd.value(nd.load[i])
-        meaning = "static load (from the topology's torques)"
-        f.append(
-            param(f"f_{disp[i]}", load, meaning, f"f_{{{disp[i]}}}") if load else sp.Integer(0)
-        )
-    f = tuple(f)
-
-    def what(j: int) -> str:
-        return f"g({disp[j]})" if j < m else disp[j]
-
-    xi = {}
-    for i in range(N):
-        for j in range(N):
-            if nd.xi[i, j] == 0 or (i != j and not feats.damping_coupling):
-                continue
-            xi[i, j] = param(
-                f"xi_{disp[i]}_{disp[j]}",
-                nd.value(nd.xi[i, j]),
-                f"damping coefficient of d{disp[j]} in the {disp[i]} equation",
-                rf"\xi_{{{disp[i]}{disp[j]}}}",
-            )
-    kappa = {}
-    for i in range(N):
-        for j in range(N):
-            if nd.kappa[i, j] == 0:
-                continue
-            kappa[i, j] = param(
-                f"kappa_{disp[i]}_{disp[j]}",
-                nd.value(nd.kappa[i, j]),
-                f"mean stiffness coefficient of {what(j)} in the {disp[i]} equation",
-                rf"K_{{{disp[i]}{disp[j]}}}",
-            )
+    pars = model_parameters(scene, nd, disp)
+    omega, omega_value, signs, f = pars.omega, pars.omega_value, pars.signs, pars.loads
+    xi, kappa, kc, ks, phi = pars.xi, pars.kappa, pars.kc, pars.ks, pars.phi
+    te_amp, te_phase = pars.te_amp, pars.te_phase
     H = feats.stiffness_harmonics
-    kc, ks = {}, {}
-    for j, me in enumerate(meshes):
-        if H > me.stiffness.harmonics:
-            raise InputError(
-                scene.source,
-                "features.stiffness_harmonics",
-                f"asks for {H} harmonics but mesh '{me.id}' of {topo.source} gives only "
-                f"{me.stiffness.harmonics}; lower it or give more harmonics",
-            )
-        cs, ss = me.stiffness.normalised(H)
-        for h in range(1, H + 1):
-            kc[j, h] = param(
-                f"kc_{coords[j]}_{h}",
-                cs[h - 1],
-                f"cosine stiffness harmonic {h} of mesh {me.id} over its mean",
-                rf"\alpha_{{{coords[j]},{h}}}",
-            )
-            ks[j, h] = param(
-                f"ks_{coords[j]}_{h}",
-                ss[h - 1],
-                f"sine stiffness harmonic {h} of mesh {me.id} over its mean",
-                rf"\beta_{{{coords[j]},{h}}}",
-            )
-    phi = {}
-    if feats.mesh_phase:
-        for j, me in enumerate(meshes[1:], start=1):
-            phi[j] = param(
-                f"phi_{coords[j]}",
-                me.phase,
-                f"stiffness/TE phase lag of mesh {me.id}, rad ({me.phase_source})",
-                rf"\varphi_{{{coords[j]}}}",
-            )
-    te_amp, te_phase = {}, {}
-    if feats.transmission_error:
-        for j, me in enumerate(meshes):
-            te = me.transmission_error
-            if not any(a != 0 for a in te.amplitudes):
-                continue
-            for h, (a, ph) in enumerate(zip(te.amplitudes, te.phases, strict=True), start=1):
-                te_amp[j, h] = param(
-                    f"E_{coords[j]}_{h}",
-                    a / me.half_backlash,
-                    f"transmission-error harmonic {h} of mesh {me.id} over its half backlash",
-                    rf"E_{{{coords[j]},{h}}}",
-                )
-                te_phase[j, h] = param(
-                    f"psi_{coords[j]}_{h}",
-                    ph,
-                    f"transmission-error phase {h} of mesh {me.id}, rad",
-                    rf"\psi_{{{coords[j]},{h}}}",
-                )
-    # The backlash expression refers to its parameters by name; register them in order.
-    for pname, value, meaning in feats.backlash.parameters():
-        param(pname, value, meaning, _latex_backlash(pname))
 
     # Assemble the non-dimensional equations.
     phase_arg = [freq[j] * omega * tau - phi.get(j, 0) for j in range(m)]
@@ -364,7 +218,9 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
     used = set().union(*(e.free_symbols for e in rhs))
     # A parameter no term uses (a phase with constant stiffness and no transmission
     # error, say) is not emitted; omega stays: it sets the forcing period for the solver.
-    params = [p for p in params if p.name == "omega" or sp.Symbol(p.name, real=True) in used]
+    params = [
+        p for p in pars.parameters if p.name == "omega" or sp.Symbol(p.name, real=True) in used
+    ]
     names = [p.name for p in params]
     stray = used - set(state_symbols) - {sp.Symbol(n, real=True) for n in names} - {tau}
     if stray:
@@ -445,9 +301,3 @@ def _check_structural_scene(scene: Scene) -> None:
             "a train with shafts takes its loads from the topology's torques (a shaft's "
             "twist needs them too); remove [loads]",
         )
-
-
-def _latex_backlash(name: str) -> str:
-    if name == "eps_g":
-        return r"\varepsilon_g"
-    return f"a_{{{name[1:]}}}"

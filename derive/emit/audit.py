@@ -3,7 +3,8 @@
 ``audit_page(model)`` gives ``docs/derivation/<name>.md``: data, Newton's equations, mesh
 deflections and forces, the elimination of the rigid-body rotation, the reduced and the
 non-dimensional equations, and every coefficient as a closed form in the gear data with
-its value.  ``index_page(models)`` gives ``docs/derivation.md``.  Display equations are
+its value.  Sections 2-6 come from ``audit_torsion.py`` or, beyond torsion,
+``audit_structure.py``.  ``index_page(models)`` gives ``docs/derivation.md``.  Display equations are
 fenced ```` ```math ```` blocks, which Git hosts render as LaTeX.
 """
 
@@ -13,21 +14,18 @@ import math
 
 import sympy as sp
 
-from ..equations.nondim import DAMPING_TEXT
 from ..escape import markdown
 from ..input.paths import display_path
 from ..input.readings import reading_section
 from ..mesh.backlash import fit_dead_zone
 from ..model import Model
 from .audit_structure import structure_sections
+from .audit_torsion import torsional_sections
+from .markdown import latex
 from .markdown import math_block as _math
 from .markdown import number as _num
 
 __all__ = ["audit_page", "index_page"]
-
-
-def _latex(expr, names: dict | None = None) -> str:
-    return sp.latex(expr, symbol_names=names or {}, long_frac_ratio=3)
 
 
 def _closed(nd, expr) -> str:
@@ -35,7 +33,7 @@ def _closed(nd, expr) -> str:
     value = _num(nd.value(expr), 8)
     if sp.sympify(expr).is_number:
         return value
-    return _latex(expr) + " = " + value
+    return latex(expr) + " = " + value
 
 
 def _names(model: Model) -> dict:
@@ -111,7 +109,7 @@ def audit_page(model: Model, command: str) -> str:
     if model.structure is not None:
         w(structure_sections(model))
     else:
-        _torsional_sections(model, w)
+        w(torsional_sections(model))
 
     w("## 7. Non-dimensional equations\n")
     lhs = []
@@ -140,13 +138,13 @@ def audit_page(model: Model, command: str) -> str:
         for j, cj in enumerate(disp):
             if model.kappa_t[i, j] != 0 and j < m:
                 defs.append(
-                    f"\\kappa_{{{c}{cj}}}(\\tau) &= " + _latex(model.kappa_t[i, j], names) + r" \\"
+                    f"\\kappa_{{{c}{cj}}}(\\tau) &= " + latex(model.kappa_t[i, j], names) + r" \\"
                 )
     for i, c in enumerate(model.coordinates):
         if model.ebar[i] != 0:
-            defs.append(f"\\bar e_{{{c}}}(\\tau) &= " + _latex(model.ebar[i], names) + r" \\")
+            defs.append(f"\\bar e_{{{c}}}(\\tau) &= " + latex(model.ebar[i], names) + r" \\")
     x = sp.Symbol("x", real=True)
-    defs.append("g(x) &= " + _latex(scene.features.backlash.expression(x), names) + r" \\")
+    defs.append("g(x) &= " + latex(scene.features.backlash.expression(x), names) + r" \\")
     w(_math(r"\begin{aligned}", *defs, r"\end{aligned}"))
     if model.valid_range is not None:
         w(f"The backlash model is valid for $|x| \\le {_num(model.valid_range)}$ only.\n")
@@ -159,7 +157,7 @@ def audit_page(model: Model, command: str) -> str:
         _math(
             r"\begin{aligned}",
             *(
-                f"F_{{{c}}} &= " + _latex(model.mesh_forces[i], names) + r" \\"
+                f"F_{{{c}}} &= " + latex(model.mesh_forces[i], names) + r" \\"
                 for i, c in enumerate(model.coordinates)
             ),
             r"\end{aligned}",
@@ -224,107 +222,6 @@ def audit_page(model: Model, command: str) -> str:
     )
     w(_contract_paragraph(model))
     return "\n".join(out)
-
-
-def _torsional_sections(model: Model, w) -> None:
-    """Sections 2-6 of a torsional model's page."""
-    scene, nd = model.scene, model.nondim
-    eq = nd.equations
-    w("## 2. Newton's second law for each gear\n")
-    w(
-        "Rotations $\\theta_k$ are positive in each gear's operating direction; "
-        "$F$ is the mesh force along the normal line of action, whose transverse component "
-        "$F\\cos\\beta_b$ acts at the base radius.\n"
-    )
-    w(
-        _math(
-            r"\begin{aligned}",
-            *[_latex(e.lhs) + " &= " + _latex(e.rhs) + r" \\" for e in eq.newton],
-            r"\end{aligned}",
-        )
-    )
-
-    w("## 3. Mesh deflections and mesh forces\n")
-    w(
-        "Deflection along the normal line of action, with the composite transmission error "
-        "$e$ (positive for excess material), and the mesh force with backlash function $g$ "
-        "of unit half backlash:\n"
-    )
-    w(
-        _math(
-            r"\begin{aligned}",
-            *[
-                _latex(e.lhs) + " &= " + _latex(e.rhs) + r" \\"
-                for e in eq.deflection + eq.force_law
-            ],
-            r"\end{aligned}",
-        )
-    )
-
-    w("## 4. Eliminating the rigid-body rotation\n")
-    w(
-        "Differentiating each deflection twice and substituting $\\ddot\\theta$ from "
-        "section 2 (SymPy, expanded):\n"
-    )
-    w(
-        _math(
-            r"\begin{aligned}",
-            *[_latex(e.lhs) + " &= " + _latex(e.rhs) + r" \\" for e in eq.substituted],
-            r"\end{aligned}",
-        )
-    )
-    w(
-        "No $\\theta$ is left: the rigid-body rotation has dropped out (checked in the "
-        "derivation). The compliance $W_{ij} = -\\partial\\ddot x_i/\\partial F_j$ equals "
-        "$C A I^{-1} A^T C$ with the incidence matrix $A$ (base radii with sign) and "
-        "$C = \\mathrm{diag}(\\cos\\beta_b)$:\n"
-    )
-    w(_math("A = " + _latex(eq.incidence) + r",\qquad W = " + _latex(eq.compliance)))
-    Wn = eq.compliance.subs(nd.values).evalf(10)
-    w(
-        _math(
-            "W = "
-            + _latex(sp.Matrix(Wn).applyfunc(lambda v: sp.Float(v, 6)))
-            + r"\ \mathrm{kg^{-1}}"
-        )
-    )
-
-    w("## 5. Reduced equations\n")
-    w(
-        _math(
-            r"\begin{aligned}",
-            *[_latex(e.lhs) + " &= " + _latex(e.rhs) + r" \\" for e in eq.reduced],
-            r"\end{aligned}",
-        )
-    )
-
-    w("## 6. Scales\n")
-    w(
-        "Each mesh is scaled by its half backlash, $u_i = x_i/b_i$; time by the natural "
-        "frequency of the reference mesh (the first), $\\tau = \\omega_n t$; "
-        + DAMPING_TEXT[nd.damping]
-        + ":\n"
-    )
-    w(
-        _math(
-            r"\begin{aligned}",
-            r"\omega_n &= "
-            + _latex(nd.omega_n_expr)
-            + " = "
-            + _num(model.scales["omega_n_rad_per_s"], 8)
-            + r"\ \mathrm{rad/s} \\",
-            *[
-                f"{_latex(eq.damping[j])} &= {_latex(nd.damping_expr[j])} = "
-                f"{_num(nd.value(nd.damping_expr[j]))}" + r"\ \mathrm{N\,s/m} \\"
-                for j in range(len(eq.meshes))
-            ],
-            r"\end{aligned}",
-        )
-    )
-    w(
-        f"with $\\zeta = {_num(scene.damping_ratio)}$. "
-        f"One unit of $\\tau$ is {_num(model.scales['time_unit_s'])} s.\n"
-    )
 
 
 def _contract_paragraph(model: Model) -> str:

@@ -49,8 +49,10 @@ def structure_sections(model) -> str:
         )
         + ".\n"
     )
-    w("| gear | turning sense | $m$ (kg) | $I$ (kg m²) | radial bearing (N/m, N s/m) | "
-      "axial bearing (N/m, N s/m) |")  # fmt: skip
+    w(
+        "| gear | turning sense | $m$ (kg) | $I$ (kg m²) | radial bearing (N/m, N s/m) | "
+        "axial bearing (N/m, N s/m) |"
+    )
     w("|---|---|---|---|---|---|")
     senses = topo.senses()
     for g in topo.gears:
@@ -79,8 +81,10 @@ def structure_sections(model) -> str:
         "sign). The contact is lumped at the pitch point in the face's centre plane; with "
         "tilting, a tilt moves it along $z$, so the axial force tilts the gears.\n"
     )
-    w("| mesh | $\\phi$ (deg) | $\\alpha_{wt}$ (deg) | $\\psi$ (deg) | $\\sigma$ | "
-      "$\\beta_b$ (deg) | orientation $s$ |")  # fmt: skip
+    w(
+        "| mesh | $\\phi$ (deg) | $\\alpha_{wt}$ (deg) | $\\psi$ (deg) | $\\sigma$ | "
+        "$\\beta_b$ (deg) | orientation $s$ |"
+    )
     w("|---|---|---|---|---|---|---|")
     for me in topo.meshes:
         a = st.angles[me.id]

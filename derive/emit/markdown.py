@@ -1,8 +1,16 @@
-"""The audit pages' two Markdown helpers: a display-math block and a number."""
+"""The audit pages' Markdown helpers: LaTeX of an expression, a display-math block and a
+number."""
 
 from __future__ import annotations
 
-__all__ = ["math_block", "number"]
+import sympy as sp
+
+__all__ = ["latex", "math_block", "number"]
+
+
+def latex(expr, names: dict | None = None) -> str:
+    """LaTeX of a SymPy expression, with ``names`` mapping symbols to their LaTeX."""
+    return sp.latex(expr, symbol_names=names or {}, long_frac_ratio=3)
 
 
 def math_block(*lines: str) -> str:

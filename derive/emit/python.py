@@ -7,8 +7,8 @@ to know as the literal ``CONTRACT`` (:attr:`Model.contract`), and is written to 
 temporary name and renamed so that a reader never sees half a file.
 
 Both back ends print the same common-subexpression-eliminated SymPy expressions through
-one printer that differs only in its namespace (``np`` or ``ca``) and in how a
-``Piecewise`` is written (``np.where`` or ``ca.if_else``).
+one printer (``printer.py``) that differs only in its namespace (``np`` or ``ca``) and in
+how a ``Piecewise`` is written (``np.where`` or ``ca.if_else``).
 """
 
 from __future__ import annotations
@@ -17,92 +17,14 @@ import os
 import tempfile
 from pathlib import Path
 
-import sympy as sp
-from sympy.printing.str import StrPrinter
-
 from ..equations.structure import physical_data
 from ..escape import code_name, code_names, text
 from ..input.scene import PARAMETER_LIMITS
 from ..model import Model, operation_count  # operation_count re-exported
 from .c import c_source
+from .printer import CodePrinter, function_body
 
 __all__ = ["CodePrinter", "emit_module", "operation_count", "write_atomic"]
-
-
-class CodePrinter(StrPrinter):
-    """Python source for an expression, with functions from namespace ``ns`` and each
-    model symbol printed as its namespaced identifier (``names``: ``escape.code_names``)."""
-
-    _FUNCTIONS = ("sin", "cos", "tan", "exp", "log", "sqrt")
-
-    def __init__(self, ns: str, names: dict | None = None):
-        super().__init__({"full_prec": True})
-        self.ns = ns
-        self.names = names or {}
-
-    def _print_Symbol(self, expr):
-        return self.names.get(expr, expr.name)
-
-    def _print_Function(self, expr):
-        name = expr.func.__name__
-        if name not in self._FUNCTIONS:
-            raise ValueError(f"no code printer for function {name}")
-        return f"{self.ns}.{name}({', '.join(self._print(a) for a in expr.args)})"
-
-    _print_sin = _print_cos = _print_tan = _print_exp = _print_log = _print_Function
-
-    def _print_Abs(self, expr):
-        fn = "abs" if self.ns == "np" else "fabs"
-        return f"{self.ns}.{fn}({self._print(expr.args[0])})"
-
-    def _print_Pow(self, expr, rational=False):
-        base, exp = expr.args
-        if exp == sp.S.Half:
-            return f"{self.ns}.sqrt({self._print(base)})"
-        if exp == -sp.S.Half:
-            return f"1/{self.ns}.sqrt({self._print(base)})"
-        return super()._print_Pow(expr, rational)
-
-    def _print_Float(self, expr):
-        return repr(float(expr))
-
-    def _print_Rational(self, expr):
-        return f"({expr.p}/{expr.q})"
-
-    def _print_Relational(self, expr):
-        return f"({self._print(expr.lhs)} {expr.rel_op} {self._print(expr.rhs)})"
-
-    def _print_Piecewise(self, expr):
-        where = "np.where" if self.ns == "np" else "ca.if_else"
-        *pairs, (last, cond) = expr.args
-        if cond != sp.true:
-            raise ValueError("a Piecewise needs a final 'otherwise' branch")
-        out = self._print(last)
-        for value, cond in reversed(pairs):
-            out = f"{where}({self._print(cond)}, {self._print(value)}, {out})"
-        return out
-
-
-def _body(model: Model, outputs, printer: CodePrinter, indent: str = "    ") -> tuple[list, list]:
-    """Lines unpacking states/parameters and computing CSE temporaries; printed outputs."""
-    replacements, reduced = sp.cse(
-        list(outputs), symbols=sp.numbered_symbols("_t"), order="canonical"
-    )
-    used = (
-        set().union(*(e.free_symbols for _, e in replacements), *(e.free_symbols for e in reduced))
-        if (replacements or reduced)
-        else set()
-    )
-    lines = []
-    for k, s in enumerate(model.state_symbols):
-        if s in used:
-            lines.append(f"{indent}{printer.doprint(s)} = x[{k}]")
-    for k, s in enumerate(model.parameter_symbols):
-        if s in used:
-            lines.append(f"{indent}{printer.doprint(s)} = p[{k}]")
-    for sym, expr in replacements:
-        lines.append(f"{indent}{sym.name} = {printer.doprint(expr)}")
-    return lines, [printer.doprint(e) for e in reduced]
 
 
 def _stiffness_terms(names) -> dict:
@@ -221,12 +143,12 @@ def emit_module(model: Model, command: str) -> str:
     rhs = list(model.rhs)
     jac = list(model.jacobian)
     n, m_par = len(model.states), len(model.parameters)
-    rhs_lines, rhs_out = _body(model, rhs, np_printer)
-    jac_lines, jac_out = _body(model, jac, np_printer)
-    ca_lines, ca_out = _body(model, rhs, ca_printer)
-    force_lines, force_out = _body(model, list(model.mesh_forces), np_printer)
+    rhs_lines, rhs_out = function_body(model, rhs, np_printer)
+    jac_lines, jac_out = function_body(model, jac, np_printer)
+    ca_lines, ca_out = function_body(model, rhs, ca_printer)
+    force_lines, force_out = function_body(model, list(model.mesh_forces), np_printer)
     m_mesh = len(model.displacements)
-    static_lines, static_out = _body(
+    static_lines, static_out = function_body(
         model, list(model.static_kappa) + list(model.loads), np_printer
     )
     static_rows = ", ".join(
@@ -281,7 +203,7 @@ def emit_module(model: Model, command: str) -> str:
         "SCENE_PARAMETER_LIMITS = {"
         + ", ".join(
             f"{k!r}: {v!r}" for k, v in PARAMETER_LIMITS.items() if k in model.scene_parameters
-        )  # fmt: skip
+        )
         + "}",
         "# mesh coordinate: ((cos index, sin index, harmonic), ...) of k_hat = 1 + sum ...",
         f"STIFFNESS_TERMS = {stiffness_terms!r}",

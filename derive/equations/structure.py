@@ -141,16 +141,16 @@ def _names(topo: Topology, axes: tuple[str, ...], source: str) -> list[tuple[str
     out = [(m.coordinate, "mesh", m.id) for m in topo.meshes]
     out += [(s.id, "shaft", s.id) for s in topo.shafts]
     out += [(f"{a}{g.id}", a, g.id) for g in topo.gears for a in axes]
-    from ..input.topology import _BACKLASH_NAME, _RESERVED
+    from ..input.meshes import BACKLASH_NAME, RESERVED_NAMES
 
     seen: set[str] = set()
     for name, kind, owner in out:
-        if kind == "shaft" and (name in _RESERVED or _BACKLASH_NAME.fullmatch(name)):
+        if kind == "shaft" and (name in RESERVED_NAMES or BACKLASH_NAME.fullmatch(name)):
             raise InputError(
                 topo.source,
                 "shaft",
                 f"shaft id '{name}' is reserved (it names the twist coordinate); avoid "
-                f"{', '.join(sorted(_RESERVED))} and g1, g3, ...",
+                f"{', '.join(sorted(RESERVED_NAMES))} and g1, g3, ...",
             )
         if name in seen or f"d{name}" in seen:
             raise InputError(
@@ -207,15 +207,19 @@ def derive_structure(
     theta = [sp.Symbol(rf"\theta_{{{g}}}", real=True) for g in gears]
     trans = [sp.Symbol(f"{a}_{{{g}}}", real=True) for g in gears for a in axes]
     q = tuple(theta + trans)
-    tcol = {(g, a): len(gears) + k * len(axes) + j for k, g in enumerate(gears)
-            for j, a in enumerate(axes)}  # fmt: skip
+    tcol = {
+        (g, a): len(gears) + k * len(axes) + j
+        for k, g in enumerate(gears)
+        for j, a in enumerate(axes)
+    }
     inertia = [sym(f"I_{{{g.id}}}", g.inertia, positive=True) for g in topo.gears]
     mass = [sym(f"m_{{{g.id}}}", g.mass, positive=True) for g in topo.gears]
     radius = [sym(f"r_{{b,{g.id}}}", g.base_radius, positive=True) for g in topo.gears]
     torque = [sym(f"T_{{{g}}}", topo.torques.get(g, 0.0), real=True) for g in gears]
     tilt_inertia = [sym(f"J_{{{g.id}}}", g.diametral_inertia, positive=True) for g in topo.gears]
-    masses = tuple(inertia + [(tilt_inertia if a in _TILTS else mass)[col[g]]
-                              for g in gears for a in axes])  # fmt: skip
+    masses = tuple(
+        inertia + [(tilt_inertia if a in _TILTS else mass)[col[g]] for g in gears for a in axes]
+    )
     forces = tuple(torque + [sp.Integer(0)] * len(trans))
 
     b1 = sym(f"b_{{{topo.meshes[0].id}}}", topo.meshes[0].half_backlash, positive=True)
@@ -248,15 +252,17 @@ def derive_structure(
                 # centre along z by a py - b px; the contact is taken at the pitch point,
                 # r_w = r_b / cos(alpha_wt) from each centre along the centre line.
                 phi = sym(rf"\phi_{{{owner}}}", me.driver_position, real=True)
-                awt = sym(rf"\alpha_{{wt,{owner}}}", me.pair.working_pressure_angle,
-                          positive=True)  # fmt: skip
+                awt = sym(rf"\alpha_{{wt,{owner}}}", me.pair.working_pressure_angle, positive=True)
                 for gear, sign, side in ((me.driver, 1, -1), (me.driven, -1, 1)):
                     rw = radius[col[gear]] / sp.cos(awt)
                     px, py = side * rw * sp.cos(phi), side * rw * sp.sin(phi)
                     row[tcol[gear, "tx"]] += sign * s * sigma * sb * py
                     row[tcol[gear, "ty"]] -= sign * s * sigma * sb * px
-            b = b1 if me is topo.meshes[0] else sym(f"b_{{{owner}}}", me.half_backlash,
-                                                     positive=True)  # fmt: skip
+            b = (
+                b1
+                if me is topo.meshes[0]
+                else sym(f"b_{{{owner}}}", me.half_backlash, positive=True)
+            )
             k = sym(f"k_{{m,{owner}}}", me.stiffness.mean, positive=True)
             coords.append(Coordinate(name, kind, owner, b, k, sp.Integer(0)))  # damping below
             angles[owner] = {"psi": psi, "sigma": sigma, "beta_b": beta}
@@ -302,33 +308,33 @@ def derive_structure(
         else:
             damping.append(c.damping)
     N = len(coords)
-    if not simplify_coefficients:
-        return Structure(topo, dofs, tuple(coords), q, masses, forces, R, W, Wt, zeta,
-                         omega_n, tuple(damping), None, None, (), values, angles)  # fmt: skip
+    # Without simplification (physical_data), the coefficients are not needed.
+    kappa = xi = None
+    load: tuple = ()
+    if simplify_coefficients:
+        # W is symmetric and mostly zero: simplify each distinct entry once (cos^2 + sin^2 of
+        # the line of action and the helix), then only factor the coefficients built on it;
+        # simplifying every coefficient afresh took 10 s a model.
+        Ws: dict[tuple[int, int], sp.Expr] = {}
+        for i in range(N):
+            for j in range(i, N):
+                Ws[i, j] = Ws[j, i] = sp.simplify(W[i, j]) if W[i, j] != 0 else sp.Integer(0)
+        W = sp.ImmutableMatrix(N, N, lambda i, j: Ws[i, j])
 
-    # W is symmetric and mostly zero: simplify each distinct entry once (cos^2 + sin^2 of
-    # the line of action and the helix), then only factor the coefficients built on it;
-    # simplifying every coefficient afresh took 10 s a model.
-    Ws: dict[tuple[int, int], sp.Expr] = {}
-    for i in range(N):
-        for j in range(i, N):
-            Ws[i, j] = Ws[j, i] = sp.simplify(W[i, j]) if W[i, j] != 0 else sp.Integer(0)
-    W = sp.ImmutableMatrix(N, N, lambda i, j: Ws[i, j])
+        def simplify(expr):
+            # Every factor is positive, so absolute values that sqrt() leaves behind can go.
+            expr = sp.factor(expr)
+            return expr.replace(lambda e: isinstance(e, sp.Abs), lambda e: e.args[0])
 
-    def simplify(expr):
-        # Every factor is positive, so absolute values that sqrt() leaves behind can go.
-        expr = sp.factor(expr)
-        return expr.replace(lambda e: isinstance(e, sp.Abs), lambda e: e.args[0])
-
-    L = [c.scale for c in coords]
-    K = [c.stiffness for c in coords]
-    kappa = sp.ImmutableMatrix(
-        N, N, lambda i, j: simplify(W[i, j] * K[j] * L[j] / (L[i] * omega_n**2))
-    )
-    xi = sp.ImmutableMatrix(
-        N, N, lambda i, j: simplify(W[i, j] * damping[j] * L[j] / (2 * L[i] * omega_n))
-    )
-    load = tuple(simplify(load_dim[i] / (L[i] * omega_n**2)) for i in range(N))
+        L = [c.scale for c in coords]
+        K = [c.stiffness for c in coords]
+        kappa = sp.ImmutableMatrix(
+            N, N, lambda i, j: simplify(W[i, j] * K[j] * L[j] / (L[i] * omega_n**2))
+        )
+        xi = sp.ImmutableMatrix(
+            N, N, lambda i, j: simplify(W[i, j] * damping[j] * L[j] / (2 * L[i] * omega_n))
+        )
+        load = tuple(simplify(load_dim[i] / (L[i] * omega_n**2)) for i in range(N))
     return Structure(
         topology=topo,
         dofs=dofs,

@@ -98,8 +98,13 @@ def apply_open_values(data: dict, values: dict, where: str) -> dict:
         split = _split(name)
         if split is None:
             allowed = [*OPEN_VALUES, *CHOICES] + [f"{k}_{m}" for k in _PER_MESH for m in mesh_ids]
-            raise InputError(where, name, "is not an open value" + nearest(name, allowed)
-                             + f"; open values: {', '.join([*OPEN_VALUES, *CHOICES])}")  # fmt: skip
+            raise InputError(
+                where,
+                name,
+                "is not an open value"
+                + nearest(name, allowed)
+                + f"; open values: {', '.join([*OPEN_VALUES, *CHOICES])}",
+            )
         base, which = split
         unit, meaning, low, high = OPEN_VALUES[base]
         try:
@@ -113,21 +118,30 @@ def apply_open_values(data: dict, values: dict, where: str) -> dict:
                 carriers = [g for g in gears if g.get("attached_inertia_kg_m2", 0) > 0]
                 if len(carriers) != 1:
                     raise InputError(
-                        where, name, f"needs exactly one gear with an attached inertia, found "
-                        f"{len(carriers)}; set attached_inertia_kg_m2_<gear> instead"
-                    )  # fmt: skip
+                        where,
+                        name,
+                        f"needs exactly one gear with an attached inertia, found "
+                        f"{len(carriers)}; set attached_inertia_kg_m2_<gear> instead",
+                    )
                 targets = carriers
             else:
                 if which not in gear_ids:
-                    raise InputError(where, name, f"names no gear{nearest(which, gear_ids)}; "
-                                     f"gears: {', '.join(map(str, gear_ids))}")  # fmt: skip
+                    raise InputError(
+                        where,
+                        name,
+                        f"names no gear{nearest(which, gear_ids)}; "
+                        f"gears: {', '.join(map(str, gear_ids))}",
+                    )
                 targets = [gears[gear_ids.index(which)]]
             for g in targets:
                 g["attached_inertia_kg_m2"] = value
             continue
         if which is not None and which not in mesh_ids:
-            raise InputError(where, name, f"names no mesh{nearest(which, mesh_ids)}; "
-                             f"meshes: {', '.join(map(str, mesh_ids))}")  # fmt: skip
+            raise InputError(
+                where,
+                name,
+                f"names no mesh{nearest(which, mesh_ids)}; meshes: {', '.join(map(str, mesh_ids))}",
+            )
         chosen = meshes if which is None else [meshes[mesh_ids.index(which)]]
         if base == "layout_angle_deg":
             chosen = [m for m in chosen if "layout_angle_deg" in m] if which is None else chosen

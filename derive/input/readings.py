@@ -73,8 +73,10 @@ def parse_readings(top: Table, gear_ids: list[str], mesh_ids: list[str]) -> dict
                 raise rt.error(key, f"must be a list of {what} ids, got {names!r}")
             for n in names:
                 if n not in known:
-                    raise rt.error(key, f"names no {what} '{n}'{nearest(n, known)}; "
-                                   f"{what}s: {', '.join(known)}")  # fmt: skip
+                    raise rt.error(
+                        key,
+                        f"names no {what} '{n}'{nearest(n, known)}; {what}s: {', '.join(known)}",
+                    )
             lists[key] = tuple(names)
         both = set(lists["driving"]) & set(lists["braking"])
         if both:
@@ -111,9 +113,13 @@ def load_signs(nd, topology, reading_id: str, where: str) -> dict[str, tuple[str
     for i, mesh in enumerate(topology.meshes):
         inputs = [g for g in (mesh.driver, mesh.driven) if reading.role(g)]
         if len(inputs) != 1:
-            raise InputError(where, "load_reading", f"reading '{reading_id}' must name exactly "
-                             f"one input gear of mesh '{mesh.id}' in driving or braking, "
-                             f"names {len(inputs)}")  # fmt: skip
+            raise InputError(
+                where,
+                "load_reading",
+                f"reading '{reading_id}' must name exactly "
+                f"one input gear of mesh '{mesh.id}' in driving or braking, "
+                f"names {len(inputs)}",
+            )
         gear = inputs[0]
         slope = nd.value(nd.load[i].diff(nd.torque_symbol(gear)))
         out[mesh.coordinate] = (gear, 1 if slope > 0 else -1, reading.role(gear))

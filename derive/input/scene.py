@@ -1,6 +1,7 @@
 """Scenes: one analysis set-up -- a topology, the model features and the parameter values.
 
-A scene names the features the model must carry; the derivation emits only their terms:
+A scene names the features the model must carry (``derive/input/features.py``); the
+derivation emits only their terms:
 
 * ``stiffness_harmonics`` -- how many harmonics of each mesh stiffness to keep (0 gives
   constant stiffness and no time-varying stiffness code);
@@ -30,14 +31,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from ..mesh.backlash import (
-    BACKLASH_MODELS,
-    Backlash,
-    DeadZone,
-    LinearContact,
-    SmoothDeadZone,
-    fit_dead_zone,
-)
+from .features import BACKLASH_KEYS, Features, parse_features
 from .reader import InputError, Table, load_toml, nearest, parse_expression
 from .supports import load_topology_data
 from .topology import Topology, load_topology, parse_topology
@@ -58,37 +52,6 @@ def builtin_root() -> Path:
     from gearsym import scenes
 
     return Path(scenes.__file__).parent
-
-
-@dataclass(frozen=True)
-class Features:
-    """Which terms the model carries."""
-
-    stiffness_harmonics: int = 3
-    backlash: Backlash = field(default_factory=lambda: fit_dead_zone())
-    transmission_error: bool = True
-    mesh_phase: bool = True
-    damping_coupling: bool = True
-    # Which degrees of freedom each gear has (derive/equations/structure.py DEGREES_OF_FREEDOM).
-    degrees_of_freedom: str = "torsional"
-
-    def flags(self) -> dict:
-        """The feature switches, with the backlash by kind only (the degrees of freedom
-        only when they go beyond torsion, so that torsional models keep their files)."""
-        flags = {
-            "stiffness_harmonics": self.stiffness_harmonics,
-            "backlash": self.backlash.kind,
-            "transmission_error": self.transmission_error,
-            "mesh_phase": self.mesh_phase,
-            "damping_coupling": self.damping_coupling,
-        }
-        if self.degrees_of_freedom != "torsional":
-            flags["degrees_of_freedom"] = self.degrees_of_freedom
-        return flags
-
-    def describe(self) -> dict:
-        """The feature switches with the backlash model's full description."""
-        return self.flags() | {"backlash": self.backlash.describe()}
 
 
 @dataclass(frozen=True)
@@ -124,69 +87,6 @@ class Scene:
         return self.parameters["damping_ratio"]
 
 
-def _polynomial(t: Table) -> Backlash:
-    order = t.integer("backlash_order", 7)
-    if order % 2 == 0:
-        raise t.error("backlash_order", f"must be odd (the dead zone is odd), got {order}")
-    fit_range = t.number("backlash_range", 3.0)
-    step = t.number("backlash_step", 0.01, low=0.0)
-    try:
-        return fit_dead_zone(order, fit_range, step if step > 0 else None)
-    except ValueError as err:
-        key = {"order": "backlash_order", "range": "backlash_range"}.get(
-            str(err).split(" ", 1)[0], "backlash_step"
-        )
-        raise t.error(key, str(err)) from None
-
-
-# Registry: backlash kind -> (the keys it reads, how it is built from the [features] table).
-_BACKLASH_BUILDERS = {
-    "linear": ((), lambda t: LinearContact()),
-    "dead-zone": ((), lambda t: DeadZone()),
-    "smooth": (
-        ("backlash_width",),
-        lambda t: SmoothDeadZone(t.number("backlash_width", 0.05, low=0, low_open=True, high=1.0)),
-    ),
-    "polynomial": (("backlash_order", "backlash_range", "backlash_step"), _polynomial),
-}
-assert set(_BACKLASH_BUILDERS) == set(BACKLASH_MODELS)
-
-
-def _features(t: Table | None) -> Features:
-    if t is None:
-        return Features()
-    harmonics = t.integer("stiffness_harmonics", 3, low=0, high=64)
-    kind = t.string("backlash", "polynomial", choices=tuple(BACKLASH_MODELS))
-    for other, (keys, _) in _BACKLASH_BUILDERS.items():
-        for key in keys:
-            if other != kind and key in t.data:
-                raise t.error(key, f"applies to backlash = '{other}' only, not '{kind}'")
-    backlash = _BACKLASH_BUILDERS[kind][1](t)
-    features = Features(
-        stiffness_harmonics=harmonics,
-        backlash=backlash,
-        transmission_error=t.boolean("transmission_error", True),
-        mesh_phase=t.boolean("mesh_phase", True),
-        damping_coupling=t.boolean("damping_coupling", True),
-        degrees_of_freedom=_degrees_of_freedom(t),
-    )
-    t.finish()
-    return features
-
-
-def _degrees_of_freedom(t: Table) -> str:
-    from ..equations.structure import DEGREES_OF_FREEDOM
-
-    dofs = t.string("degrees_of_freedom", "torsional", choices=tuple(DEGREES_OF_FREEDOM))
-    if dofs != "torsional" and not t.data.get("damping_coupling", True):
-        raise t.error(
-            "damping_coupling",
-            f"must stay true with degrees_of_freedom = '{dofs}': a mesh's damper acts on a "
-            "deflection its gears' translations share",
-        )
-    return dofs
-
-
 def variant(scene: Scene, name: str, **features) -> Scene:
     """``scene`` with some ``[features]`` keys changed, under another ``name``.
 
@@ -200,7 +100,7 @@ def variant(scene: Scene, name: str, **features) -> Scene:
     table = dict(data.get("features", {}))
     if "backlash" in features:
         kind = features["backlash"]
-        for other, (keys, _) in _BACKLASH_BUILDERS.items():
+        for other, keys in BACKLASH_KEYS.items():
             if other != kind:
                 for key in keys:
                     if key not in features:
@@ -208,7 +108,7 @@ def variant(scene: Scene, name: str, **features) -> Scene:
     table.update(features)
     where = f"{scene.source} (variant {name})"
     checked = Table({"name": name}, where).target_name("name")
-    feats = _features(Table(table, where, "features"))
+    feats = parse_features(Table(table, where, "features"))
     return replace(scene, name=checked, features=feats, variations=scene.variations | features)
 
 
@@ -289,7 +189,7 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
         from .open_values import check_damping
 
         check_damping(damping, f"{source} [open]")
-    features = _features(top.table("features", None))
+    features = parse_features(top.table("features", None))
 
     pt = top.table("parameters")
     parameters: dict[str, float] = {}
@@ -336,8 +236,12 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
         lt.finish()
         import re
 
-        used = {w for e in expressions.values() if isinstance(e, str)
-                for w in re.findall(r"[A-Za-z_]\w*", e)}  # fmt: skip
+        used = {
+            w
+            for e in expressions.values()
+            if isinstance(e, str)
+            for w in re.findall(r"[A-Za-z_]\w*", e)
+        }
         for key in parameters:
             if key not in PARAMETER_LIMITS and key not in used:
                 raise InputError(

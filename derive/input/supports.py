@@ -49,8 +49,9 @@ class Bearing:
     def transverse(self, axis: str) -> tuple[float, float, bool]:
         """(stiffness, damping, own) along ``x`` or ``y``: ``own`` when y has its own."""
         if axis == "y" and self.radial_y is not None:
-            damping = self.radial_damping if self.radial_y_damping is None else (
-                self.radial_y_damping)  # fmt: skip
+            damping = (
+                self.radial_damping if self.radial_y_damping is None else (self.radial_y_damping)
+            )
             return self.radial_y, damping, True
         if axis == "y" and self.radial_y_damping is not None:
             return self.radial, self.radial_y_damping, True
@@ -210,9 +211,11 @@ def _merge(base: dict, top: dict) -> dict:
                 same = [
                     k
                     for k, e in enumerate(merged)
-                    if isinstance(e, dict) and isinstance(entry, dict) and name in entry
+                    if isinstance(e, dict)
+                    and isinstance(entry, dict)
+                    and name in entry
                     and e.get(name) == entry[name]
-                ]  # fmt: skip
+                ]
                 if same:
                     merged[same[0]] = merged[same[0]] | entry
                 else:

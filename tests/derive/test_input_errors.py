@@ -44,7 +44,7 @@ TOPOLOGY_CASES = [
         "normal_module_mm = 4\n",
         "normal_module_mm = 4e3\n",
         "gear[0].normal_module_mm: must be <= 1000",
-    ),  # fmt: skip
+    ),
     (
         "unknown key",
         "teeth = 100",

@@ -72,8 +72,9 @@ def test_very_stiff_bearings_give_the_torsional_poincare_points(tmp_path):
     errors = []
     for k in (1e11, 1e12, 1e13):
         topo = _topology(tmp_path, f"stiff{int(np.log10(k))}", k, k, 0.0)
-        scene = _light_scene(tmp_path, f"stiff-light-{int(np.log10(k))}", topo,
-                             "lateral-torsional-axial")  # fmt: skip
+        scene = _light_scene(
+            tmp_path, f"stiff-light-{int(np.log10(k))}", topo, "lateral-torsional-axial"
+        )
         tr = simulate(System.load(module_for(scene)), **options)
         assert tr.status == "ok"
         error = np.abs(tr.poincare[:2] - ref_points).max()
@@ -87,7 +88,7 @@ def _linear_undamped(tmp_path, dofs: str = "lateral-torsional-axial") -> System:
     text = topo.read_text().replace(
         "axial_damping_N_s_per_m = 0", "axial_damping_N_s_per_m = 0\ntilt_damping_Nm_s_per_rad = 0"
     )
-    topo.write_text(text)  # fmt: skip
+    topo.write_text(text)
     scene = _scene(
         tmp_path,
         "undamped-linear",
@@ -129,8 +130,16 @@ def test_undamped_linear_model_conserves_energy_over_1000_periods(tmp_path, dofs
     x0 = rng.uniform(-0.5, 0.5, system.n)
     drift = {}
     for rtol in (1e-6, 1e-10):
-        tr = simulate(system, x0, method="dop853", rtol=rtol, atol=rtol * 1e-2, transient=0,
-                      periods=1000, samples_per_period=4)  # fmt: skip
+        tr = simulate(
+            system,
+            x0,
+            method="dop853",
+            rtol=rtol,
+            atol=rtol * 1e-2,
+            transient=0,
+            periods=1000,
+            samples_per_period=4,
+        )
         e = _energy(system.module, tr.x)
         drift[rtol] = np.abs(e / e[0] - 1).max()
     assert drift[1e-10] < 100 * 1e-10, drift
@@ -197,7 +206,7 @@ def test_an_anisotropic_bearing_across_the_line_of_action_rings_alone(tmp_path):
     for gear, k in ky.items():
         lines += ["[[bearing]]", f'gear = "{gear}"', f"radial_y_N_per_m = {k:g}"]
     path = tmp_path / "aniso.toml"
-    path.write_text("\n".join(lines) + "\n")  # fmt: skip
+    path.write_text("\n".join(lines) + "\n")
     result = modes(module_for(path))
     freqs = [m.frequency_hz for m in result.modes]
     for gear, k in ky.items():
@@ -222,9 +231,11 @@ def test_a_spur_pair_tilts_free_of_the_mesh(tmp_path):
 
     base = TOPOLOGIES / "helical-pair-bearings.toml"
     spur = tmp_path / "spur.toml"
-    spur.write_text(f'[topology]\nextends = "{base}"\nname = "spur"\n'
-                    '[[gear]]\nid = "p"\nhelix_angle_deg = 0\n'
-                    '[[gear]]\nid = "g"\nhelix_angle_deg = 0\n')  # fmt: skip
+    spur.write_text(
+        f'[topology]\nextends = "{base}"\nname = "spur"\n'
+        '[[gear]]\nid = "p"\nhelix_angle_deg = 0\n'
+        '[[gear]]\nid = "g"\nhelix_angle_deg = 0\n'
+    )
     for topo_path, helical in ((spur, False), (base, True)):
         topo = load_topology(topo_path)
         scene = _scene(
