@@ -147,10 +147,11 @@ C_SOURCE = r"""
 /* diso: right-hand side for the compiled integrators (gearsym derive). */
 #define GS_NX 4
 #define GS_NP 32
-#define GS_NQ 10
+#define GS_NQ 11
 
 static void gs_prep(const double *p, double *q)
 {
+    const double m_omega = p[0];
     const double m_phi_v = p[23];
     const double m_psi_u_1 = p[25];
     const double m_psi_v_1 = p[27];
@@ -164,6 +165,7 @@ static void gs_prep(const double *p, double *q)
     q[7] = sin(m_psi_u_1);
     q[8] = cos(m_phi_v - m_psi_v_1);
     q[9] = -sin(m_phi_v - m_psi_v_1);
+    q[10] = ((m_omega)*(m_omega));
     (void)p; (void)q;
 }
 
@@ -222,6 +224,8 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     (void)tau; (void)p; (void)q;
 }
 
+/* -DGS_SHARED_k=1 declares parameter k equal for all points: the terms of the time
+ * and of shared parameters alone are then computed once, before the loop. */
 static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
 {
     const double th0 = (P[0*n])*tau;
@@ -230,6 +234,18 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
     const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
     const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
+#if GS_SHARED_0 && GS_SHARED_11 && GS_SHARED_12 && GS_SHARED_13 && GS_SHARED_14 && GS_SHARED_15 && GS_SHARED_16
+    const double h_0 = C0_1*P[11*n] + C0_2*P[13*n] + C0_3*P[15*n] + S0_1*P[12*n] + S0_2*P[14*n] + S0_3*P[16*n] + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_17 && GS_SHARED_18 && GS_SHARED_19 && GS_SHARED_20 && GS_SHARED_21 && GS_SHARED_22 && GS_SHARED_23
+    const double h_1 = P[17*n]*(C0_1*Q[0*n] - S0_1*Q[1*n]) + P[19*n]*(C0_2*Q[2*n] - S0_2*Q[3*n]) + P[21*n]*(C0_3*Q[4*n] - S0_3*Q[5*n]) + P[18*n]*(C0_1*Q[1*n] + S0_1*Q[0*n]) + P[20*n]*(C0_2*Q[3*n] + S0_2*Q[2*n]) + P[22*n]*(C0_3*Q[5*n] + S0_3*Q[4*n]) + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_24 && GS_SHARED_25
+    const double h_2 = -P[24*n]*Q[10*n]*(C0_1*Q[6*n] - S0_1*Q[7*n]);
+#endif
+#if GS_SHARED_0 && GS_SHARED_23 && GS_SHARED_26 && GS_SHARED_27
+    const double h_3 = -P[26*n]*Q[10*n]*(C0_1*Q[8*n] - S0_1*Q[9*n]);
+#endif
 #pragma GCC ivdep
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
@@ -238,7 +254,6 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double m_v = X[1*n + j];
         const double m_du = X[2*n + j];
         const double m_dv = X[3*n + j];
-        const double m_omega = P[0*n + j];
         const double m_f_u = P[1*n + j];
         const double m_f_v = P[2*n + j];
         const double m_xi_u_u = P[3*n + j];
@@ -269,15 +284,26 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double m_g7 = P[31*n + j];
         const double t_0 = 2*m_du;
         const double t_1 = 2*m_dv;
-        const double t_2 = ((m_omega)*(m_omega));
         const double t_3 = ((m_u)*(m_u));
-        const double t_4 = m_u*(m_g1 + t_3*(m_g3 + t_3*(m_g5 + m_g7*t_3)))*(C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1);
+#if !(GS_SHARED_0 && GS_SHARED_11 && GS_SHARED_12 && GS_SHARED_13 && GS_SHARED_14 && GS_SHARED_15 && GS_SHARED_16)
+        const double h_0 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
+#endif
+        const double t_4 = m_u*(m_g1 + t_3*(m_g3 + t_3*(m_g5 + m_g7*t_3)))*(h_0);
         const double t_5 = ((m_v)*(m_v));
-        const double t_6 = m_v*(m_g1 + t_5*(m_g3 + t_5*(m_g5 + m_g7*t_5)))*(m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[2] - S0_2*q[3]) + m_kc_v_3*(C0_3*q[4] - S0_3*q[5]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[3] + S0_2*q[2]) + m_ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1);
+#if !(GS_SHARED_0 && GS_SHARED_17 && GS_SHARED_18 && GS_SHARED_19 && GS_SHARED_20 && GS_SHARED_21 && GS_SHARED_22 && GS_SHARED_23)
+        const double h_1 = m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[2] - S0_2*q[3]) + m_kc_v_3*(C0_3*q[4] - S0_3*q[5]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[3] + S0_2*q[2]) + m_ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1;
+#endif
+        const double t_6 = m_v*(m_g1 + t_5*(m_g3 + t_5*(m_g5 + m_g7*t_5)))*(h_1);
         DX[0*n + j] = m_du;
         DX[1*n + j] = m_dv;
-        DX[2*n + j] = -m_E_u_1*t_2*(C0_1*q[6] - S0_1*q[7]) + m_f_u - m_kappa_u_u*t_4 - m_kappa_u_v*t_6 - t_0*m_xi_u_u - t_1*m_xi_u_v;
-        DX[3*n + j] = -m_E_v_1*t_2*(C0_1*q[8] - S0_1*q[9]) + m_f_v - m_kappa_v_u*t_4 - m_kappa_v_v*t_6 - t_0*m_xi_v_u - t_1*m_xi_v_v;
+#if !(GS_SHARED_0 && GS_SHARED_24 && GS_SHARED_25)
+        const double h_2 = -m_E_u_1*q[10]*(C0_1*q[6] - S0_1*q[7]);
+#endif
+        DX[2*n + j] = h_2 + m_f_u - m_kappa_u_u*t_4 - m_kappa_u_v*t_6 - t_0*m_xi_u_u - t_1*m_xi_u_v;
+#if !(GS_SHARED_0 && GS_SHARED_23 && GS_SHARED_26 && GS_SHARED_27)
+        const double h_3 = -m_E_v_1*q[10]*(C0_1*q[8] - S0_1*q[9]);
+#endif
+        DX[3*n + j] = h_3 + m_f_v - m_kappa_v_u*t_4 - m_kappa_v_v*t_6 - t_0*m_xi_v_u - t_1*m_xi_v_v;
     }
     (void)tau; (void)P; (void)Q;
 }
@@ -288,13 +314,15 @@ C_SOURCE_VARIATIONAL = r"""
 /* diso: right-hand side with the variational equations for the compiled integrators (gearsym derive). */
 #define GS_NX 8
 #define GS_NP 32
-#define GS_NQ 10
+#define GS_NQ 12
 
 static void gs_prep(const double *p, double *q)
 {
+    const double m_omega = p[0];
     const double m_phi_v = p[23];
     const double m_psi_u_1 = p[25];
     const double m_psi_v_1 = p[27];
+    const double m_g7 = p[31];
     q[0] = cos(m_phi_v);
     q[1] = -sin(m_phi_v);
     q[2] = cos(2*m_phi_v);
@@ -305,6 +333,8 @@ static void gs_prep(const double *p, double *q)
     q[7] = sin(m_psi_u_1);
     q[8] = cos(m_phi_v - m_psi_v_1);
     q[9] = -sin(m_phi_v - m_psi_v_1);
+    q[10] = ((m_omega)*(m_omega));
+    q[11] = 2*m_g7;
     (void)p; (void)q;
 }
 
@@ -388,6 +418,8 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     (void)tau; (void)p; (void)q;
 }
 
+/* -DGS_SHARED_k=1 declares parameter k equal for all points: the terms of the time
+ * and of shared parameters alone are then computed once, before the loop. */
 static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
 {
     const double th0 = (P[0*n])*tau;
@@ -396,6 +428,18 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
     const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
     const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
+#if GS_SHARED_0 && GS_SHARED_11 && GS_SHARED_12 && GS_SHARED_13 && GS_SHARED_14 && GS_SHARED_15 && GS_SHARED_16
+    const double h_0 = C0_1*P[11*n] + C0_2*P[13*n] + C0_3*P[15*n] + S0_1*P[12*n] + S0_2*P[14*n] + S0_3*P[16*n] + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_17 && GS_SHARED_18 && GS_SHARED_19 && GS_SHARED_20 && GS_SHARED_21 && GS_SHARED_22 && GS_SHARED_23
+    const double h_1 = P[17*n]*(C0_1*Q[0*n] - S0_1*Q[1*n]) + P[19*n]*(C0_2*Q[2*n] - S0_2*Q[3*n]) + P[21*n]*(C0_3*Q[4*n] - S0_3*Q[5*n]) + P[18*n]*(C0_1*Q[1*n] + S0_1*Q[0*n]) + P[20*n]*(C0_2*Q[3*n] + S0_2*Q[2*n]) + P[22*n]*(C0_3*Q[5*n] + S0_3*Q[4*n]) + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_24 && GS_SHARED_25
+    const double h_2 = -P[24*n]*Q[10*n]*(C0_1*Q[6*n] - S0_1*Q[7*n]);
+#endif
+#if GS_SHARED_0 && GS_SHARED_23 && GS_SHARED_26 && GS_SHARED_27
+    const double h_3 = -P[26*n]*Q[10*n]*(C0_1*Q[8*n] - S0_1*Q[9*n]);
+#endif
 #pragma GCC ivdep
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
@@ -408,7 +452,6 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double w1 = X[5*n + j];
         const double w2 = X[6*n + j];
         const double w3 = X[7*n + j];
-        const double m_omega = P[0*n + j];
         const double m_f_u = P[1*n + j];
         const double m_f_v = P[2*n + j];
         const double m_xi_u_u = P[3*n + j];
@@ -439,32 +482,40 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double m_g7 = P[31*n + j];
         const double t_0 = 2*m_du;
         const double t_1 = 2*m_dv;
-        const double t_2 = ((m_omega)*(m_omega));
         const double t_3 = ((m_u)*(m_u));
         const double t_4 = m_g5 + m_g7*t_3;
         const double t_5 = m_g3 + t_3*t_4;
-        const double t_6 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
-        const double t_7 = t_6*(m_g1 + t_3*t_5);
+#if !(GS_SHARED_0 && GS_SHARED_11 && GS_SHARED_12 && GS_SHARED_13 && GS_SHARED_14 && GS_SHARED_15 && GS_SHARED_16)
+        const double h_0 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
+#endif
+        const double t_7 = h_0*(m_g1 + t_3*t_5);
         const double t_8 = m_kappa_u_u*t_7;
         const double t_9 = ((m_v)*(m_v));
         const double t_10 = m_g5 + m_g7*t_9;
         const double t_11 = m_g3 + t_10*t_9;
-        const double t_12 = m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[2] - S0_2*q[3]) + m_kc_v_3*(C0_3*q[4] - S0_3*q[5]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[3] + S0_2*q[2]) + m_ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1;
-        const double t_13 = t_12*(m_g1 + t_11*t_9);
+#if !(GS_SHARED_0 && GS_SHARED_17 && GS_SHARED_18 && GS_SHARED_19 && GS_SHARED_20 && GS_SHARED_21 && GS_SHARED_22 && GS_SHARED_23)
+        const double h_1 = m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[2] - S0_2*q[3]) + m_kc_v_3*(C0_3*q[4] - S0_3*q[5]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[3] + S0_2*q[2]) + m_ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1;
+#endif
+        const double t_13 = h_1*(m_g1 + t_11*t_9);
         const double t_14 = m_kappa_u_v*t_13;
         const double t_15 = m_kappa_v_u*t_7;
         const double t_16 = m_kappa_v_v*t_13;
         const double t_17 = 2*w2;
         const double t_18 = 2*w3;
         const double t_19 = 2*m_u;
-        const double t_20 = 2*m_g7;
-        const double t_21 = t_6*m_u*(t_19*t_5 + t_3*(t_19*t_4 + t_20*((m_u)*(m_u)*(m_u))));
+        const double t_21 = h_0*m_u*(t_19*t_5 + t_3*(t_19*t_4 + q[11]*((m_u)*(m_u)*(m_u))));
         const double t_22 = 2*m_v;
-        const double t_23 = t_12*m_v*(t_11*t_22 + t_9*(t_10*t_22 + t_20*((m_v)*(m_v)*(m_v))));
+        const double t_23 = h_1*m_v*(t_11*t_22 + t_9*(t_10*t_22 + q[11]*((m_v)*(m_v)*(m_v))));
         DX[0*n + j] = m_du;
         DX[1*n + j] = m_dv;
-        DX[2*n + j] = -m_E_u_1*t_2*(C0_1*q[6] - S0_1*q[7]) + m_f_u - t_0*m_xi_u_u - t_1*m_xi_u_v - t_14*m_v - t_8*m_u;
-        DX[3*n + j] = -m_E_v_1*t_2*(C0_1*q[8] - S0_1*q[9]) + m_f_v - t_0*m_xi_v_u - t_1*m_xi_v_v - t_15*m_u - t_16*m_v;
+#if !(GS_SHARED_0 && GS_SHARED_24 && GS_SHARED_25)
+        const double h_2 = -m_E_u_1*q[10]*(C0_1*q[6] - S0_1*q[7]);
+#endif
+        DX[2*n + j] = h_2 + m_f_u - t_0*m_xi_u_u - t_1*m_xi_u_v - t_14*m_v - t_8*m_u;
+#if !(GS_SHARED_0 && GS_SHARED_23 && GS_SHARED_26 && GS_SHARED_27)
+        const double h_3 = -m_E_v_1*q[10]*(C0_1*q[8] - S0_1*q[9]);
+#endif
+        DX[3*n + j] = h_3 + m_f_v - t_0*m_xi_v_u - t_1*m_xi_v_v - t_15*m_u - t_16*m_v;
         DX[4*n + j] = w2;
         DX[5*n + j] = w3;
         DX[6*n + j] = -t_17*m_xi_u_u - t_18*m_xi_u_v + w0*(-m_kappa_u_u*t_21 - t_8) + w1*(-m_kappa_u_v*t_23 - t_14);

@@ -297,10 +297,11 @@ C_SOURCE = r"""
 /* diso_bearings: right-hand side for the compiled integrators (gearsym derive). */
 #define GS_NX 22
 #define GS_NP 98
-#define GS_NQ 10
+#define GS_NQ 11
 
 static void gs_prep(const double *p, double *q)
 {
+    const double m_omega = p[0];
     const double m_phi_v = p[89];
     const double m_psi_u_1 = p[91];
     const double m_psi_v_1 = p[93];
@@ -314,6 +315,7 @@ static void gs_prep(const double *p, double *q)
     q[7] = sin(m_psi_u_1);
     q[8] = cos(m_phi_v - m_psi_v_1);
     q[9] = -sin(m_phi_v - m_psi_v_1);
+    q[10] = ((m_omega)*(m_omega));
     (void)p; (void)q;
 }
 
@@ -483,6 +485,8 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     (void)tau; (void)p; (void)q;
 }
 
+/* -DGS_SHARED_k=1 declares parameter k equal for all points: the terms of the time
+ * and of shared parameters alone are then computed once, before the loop. */
 static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
 {
     const double th0 = (P[0*n])*tau;
@@ -491,6 +495,18 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
     const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
     const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
+#if GS_SHARED_0 && GS_SHARED_77 && GS_SHARED_78 && GS_SHARED_79 && GS_SHARED_80 && GS_SHARED_81 && GS_SHARED_82
+    const double h_0 = C0_1*P[77*n] + C0_2*P[79*n] + C0_3*P[81*n] + S0_1*P[78*n] + S0_2*P[80*n] + S0_3*P[82*n] + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_83 && GS_SHARED_84 && GS_SHARED_85 && GS_SHARED_86 && GS_SHARED_87 && GS_SHARED_88 && GS_SHARED_89
+    const double h_1 = P[83*n]*(C0_1*Q[0*n] - S0_1*Q[1*n]) + P[85*n]*(C0_2*Q[2*n] - S0_2*Q[3*n]) + P[87*n]*(C0_3*Q[4*n] - S0_3*Q[5*n]) + P[84*n]*(C0_1*Q[1*n] + S0_1*Q[0*n]) + P[86*n]*(C0_2*Q[3*n] + S0_2*Q[2*n]) + P[88*n]*(C0_3*Q[5*n] + S0_3*Q[4*n]) + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_90 && GS_SHARED_91
+    const double h_2 = -P[90*n]*Q[10*n]*(C0_1*Q[6*n] - S0_1*Q[7*n]);
+#endif
+#if GS_SHARED_0 && GS_SHARED_89 && GS_SHARED_92 && GS_SHARED_93
+    const double h_3 = -P[92*n]*Q[10*n]*(C0_1*Q[8*n] - S0_1*Q[9*n]);
+#endif
 #pragma GCC ivdep
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
@@ -517,7 +533,6 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double m_dxg = X[19*n + j];
         const double m_dyg = X[20*n + j];
         const double m_dzg = X[21*n + j];
-        const double m_omega = P[0*n + j];
         const double m_f_u = P[1*n + j];
         const double m_f_v = P[2*n + j];
         const double m_xi_u_u = P[3*n + j];
@@ -620,11 +635,16 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double t_5 = 2*m_dyp;
         const double t_6 = 2*m_dzg;
         const double t_7 = 2*m_dzp;
-        const double t_8 = ((m_omega)*(m_omega));
         const double t_9 = ((m_u)*(m_u));
-        const double t_10 = m_u*(m_g1 + t_9*(m_g3 + t_9*(m_g5 + m_g7*t_9)))*(C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1);
+#if !(GS_SHARED_0 && GS_SHARED_77 && GS_SHARED_78 && GS_SHARED_79 && GS_SHARED_80 && GS_SHARED_81 && GS_SHARED_82)
+        const double h_0 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
+#endif
+        const double t_10 = m_u*(m_g1 + t_9*(m_g3 + t_9*(m_g5 + m_g7*t_9)))*(h_0);
         const double t_11 = ((m_v)*(m_v));
-        const double t_12 = m_v*(m_g1 + t_11*(m_g3 + t_11*(m_g5 + m_g7*t_11)))*(m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[2] - S0_2*q[3]) + m_kc_v_3*(C0_3*q[4] - S0_3*q[5]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[3] + S0_2*q[2]) + m_ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1);
+#if !(GS_SHARED_0 && GS_SHARED_83 && GS_SHARED_84 && GS_SHARED_85 && GS_SHARED_86 && GS_SHARED_87 && GS_SHARED_88 && GS_SHARED_89)
+        const double h_1 = m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[2] - S0_2*q[3]) + m_kc_v_3*(C0_3*q[4] - S0_3*q[5]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[3] + S0_2*q[2]) + m_ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1;
+#endif
+        const double t_12 = m_v*(m_g1 + t_11*(m_g3 + t_11*(m_g5 + m_g7*t_11)))*(h_1);
         const double t_13 = 2*m_dxq;
         const double t_14 = 2*m_dyq;
         const double t_15 = 2*m_dzq;
@@ -639,8 +659,14 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         DX[8*n + j] = m_dxg;
         DX[9*n + j] = m_dyg;
         DX[10*n + j] = m_dzg;
-        DX[11*n + j] = -m_E_u_1*t_8*(C0_1*q[6] - S0_1*q[7]) + m_f_u - m_kappa_u_u*t_10 - m_kappa_u_v*t_12 - m_kappa_u_xg*m_xg - m_kappa_u_xp*m_xp - m_kappa_u_yg*m_yg - m_kappa_u_yp*m_yp - m_kappa_u_zg*m_zg - m_kappa_u_zp*m_zp - t_0*m_xi_u_u - t_1*m_xi_u_v - t_2*m_xi_u_xg - t_3*m_xi_u_xp - t_4*m_xi_u_yg - t_5*m_xi_u_yp - t_6*m_xi_u_zg - t_7*m_xi_u_zp;
-        DX[12*n + j] = -m_E_v_1*t_8*(C0_1*q[8] - S0_1*q[9]) + m_f_v - m_kappa_v_u*t_10 - m_kappa_v_v*t_12 - m_kappa_v_xg*m_xg - m_kappa_v_xq*m_xq - m_kappa_v_yg*m_yg - m_kappa_v_yq*m_yq - m_kappa_v_zg*m_zg - m_kappa_v_zq*m_zq - t_0*m_xi_v_u - t_1*m_xi_v_v - t_13*m_xi_v_xq - t_14*m_xi_v_yq - t_15*m_xi_v_zq - t_2*m_xi_v_xg - t_4*m_xi_v_yg - t_6*m_xi_v_zg;
+#if !(GS_SHARED_0 && GS_SHARED_90 && GS_SHARED_91)
+        const double h_2 = -m_E_u_1*q[10]*(C0_1*q[6] - S0_1*q[7]);
+#endif
+        DX[11*n + j] = h_2 + m_f_u - m_kappa_u_u*t_10 - m_kappa_u_v*t_12 - m_kappa_u_xg*m_xg - m_kappa_u_xp*m_xp - m_kappa_u_yg*m_yg - m_kappa_u_yp*m_yp - m_kappa_u_zg*m_zg - m_kappa_u_zp*m_zp - t_0*m_xi_u_u - t_1*m_xi_u_v - t_2*m_xi_u_xg - t_3*m_xi_u_xp - t_4*m_xi_u_yg - t_5*m_xi_u_yp - t_6*m_xi_u_zg - t_7*m_xi_u_zp;
+#if !(GS_SHARED_0 && GS_SHARED_89 && GS_SHARED_92 && GS_SHARED_93)
+        const double h_3 = -m_E_v_1*q[10]*(C0_1*q[8] - S0_1*q[9]);
+#endif
+        DX[12*n + j] = h_3 + m_f_v - m_kappa_v_u*t_10 - m_kappa_v_v*t_12 - m_kappa_v_xg*m_xg - m_kappa_v_xq*m_xq - m_kappa_v_yg*m_yg - m_kappa_v_yq*m_yq - m_kappa_v_zg*m_zg - m_kappa_v_zq*m_zq - t_0*m_xi_v_u - t_1*m_xi_v_v - t_13*m_xi_v_xq - t_14*m_xi_v_yq - t_15*m_xi_v_zq - t_2*m_xi_v_xg - t_4*m_xi_v_yg - t_6*m_xi_v_zg;
         DX[13*n + j] = -m_kappa_xp_u*t_10 - m_kappa_xp_xp*m_xp - t_0*m_xi_xp_u - t_3*m_xi_xp_xp;
         DX[14*n + j] = -m_kappa_yp_u*t_10 - m_kappa_yp_yp*m_yp - t_0*m_xi_yp_u - t_5*m_xi_yp_yp;
         DX[15*n + j] = -m_kappa_zp_u*t_10 - m_kappa_zp_zp*m_zp - t_0*m_xi_zp_u - t_7*m_xi_zp_zp;
@@ -660,13 +686,15 @@ C_SOURCE_VARIATIONAL = r"""
 /* diso_bearings: right-hand side with the variational equations for the compiled integrators (gearsym derive). */
 #define GS_NX 44
 #define GS_NP 98
-#define GS_NQ 10
+#define GS_NQ 12
 
 static void gs_prep(const double *p, double *q)
 {
+    const double m_omega = p[0];
     const double m_phi_v = p[89];
     const double m_psi_u_1 = p[91];
     const double m_psi_v_1 = p[93];
+    const double m_g7 = p[97];
     q[0] = cos(m_phi_v);
     q[1] = -sin(m_phi_v);
     q[2] = cos(2*m_phi_v);
@@ -677,6 +705,8 @@ static void gs_prep(const double *p, double *q)
     q[7] = sin(m_psi_u_1);
     q[8] = cos(m_phi_v - m_psi_v_1);
     q[9] = -sin(m_phi_v - m_psi_v_1);
+    q[10] = ((m_omega)*(m_omega));
+    q[11] = 2*m_g7;
     (void)p; (void)q;
 }
 
@@ -928,6 +958,8 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     (void)tau; (void)p; (void)q;
 }
 
+/* -DGS_SHARED_k=1 declares parameter k equal for all points: the terms of the time
+ * and of shared parameters alone are then computed once, before the loop. */
 static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
 {
     const double th0 = (P[0*n])*tau;
@@ -936,6 +968,18 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
     const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
     const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
+#if GS_SHARED_0 && GS_SHARED_77 && GS_SHARED_78 && GS_SHARED_79 && GS_SHARED_80 && GS_SHARED_81 && GS_SHARED_82
+    const double h_0 = C0_1*P[77*n] + C0_2*P[79*n] + C0_3*P[81*n] + S0_1*P[78*n] + S0_2*P[80*n] + S0_3*P[82*n] + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_83 && GS_SHARED_84 && GS_SHARED_85 && GS_SHARED_86 && GS_SHARED_87 && GS_SHARED_88 && GS_SHARED_89
+    const double h_1 = P[83*n]*(C0_1*Q[0*n] - S0_1*Q[1*n]) + P[85*n]*(C0_2*Q[2*n] - S0_2*Q[3*n]) + P[87*n]*(C0_3*Q[4*n] - S0_3*Q[5*n]) + P[84*n]*(C0_1*Q[1*n] + S0_1*Q[0*n]) + P[86*n]*(C0_2*Q[3*n] + S0_2*Q[2*n]) + P[88*n]*(C0_3*Q[5*n] + S0_3*Q[4*n]) + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_90 && GS_SHARED_91
+    const double h_2 = -P[90*n]*Q[10*n]*(C0_1*Q[6*n] - S0_1*Q[7*n]);
+#endif
+#if GS_SHARED_0 && GS_SHARED_89 && GS_SHARED_92 && GS_SHARED_93
+    const double h_3 = -P[92*n]*Q[10*n]*(C0_1*Q[8*n] - S0_1*Q[9*n]);
+#endif
 #pragma GCC ivdep
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
@@ -984,7 +1028,6 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double w19 = X[41*n + j];
         const double w20 = X[42*n + j];
         const double w21 = X[43*n + j];
-        const double m_omega = P[0*n + j];
         const double m_f_u = P[1*n + j];
         const double m_f_v = P[2*n + j];
         const double m_xi_u_u = P[3*n + j];
@@ -1087,18 +1130,21 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double t_5 = 2*m_dyp;
         const double t_6 = 2*m_dzg;
         const double t_7 = 2*m_dzp;
-        const double t_8 = ((m_omega)*(m_omega));
         const double t_9 = ((m_u)*(m_u));
         const double t_10 = m_g5 + m_g7*t_9;
         const double t_11 = m_g3 + t_10*t_9;
-        const double t_12 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
-        const double t_13 = t_12*(m_g1 + t_11*t_9);
+#if !(GS_SHARED_0 && GS_SHARED_77 && GS_SHARED_78 && GS_SHARED_79 && GS_SHARED_80 && GS_SHARED_81 && GS_SHARED_82)
+        const double h_0 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
+#endif
+        const double t_13 = h_0*(m_g1 + t_11*t_9);
         const double t_14 = m_kappa_u_u*t_13;
         const double t_15 = ((m_v)*(m_v));
         const double t_16 = m_g5 + m_g7*t_15;
         const double t_17 = m_g3 + t_15*t_16;
-        const double t_18 = m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[2] - S0_2*q[3]) + m_kc_v_3*(C0_3*q[4] - S0_3*q[5]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[3] + S0_2*q[2]) + m_ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1;
-        const double t_19 = t_18*(m_g1 + t_15*t_17);
+#if !(GS_SHARED_0 && GS_SHARED_83 && GS_SHARED_84 && GS_SHARED_85 && GS_SHARED_86 && GS_SHARED_87 && GS_SHARED_88 && GS_SHARED_89)
+        const double h_1 = m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[2] - S0_2*q[3]) + m_kc_v_3*(C0_3*q[4] - S0_3*q[5]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[3] + S0_2*q[2]) + m_ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1;
+#endif
+        const double t_19 = h_1*(m_g1 + t_15*t_17);
         const double t_20 = m_kappa_u_v*t_19;
         const double t_21 = 2*m_dxq;
         const double t_22 = 2*m_dyq;
@@ -1126,10 +1172,9 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double t_44 = 2*w20;
         const double t_45 = 2*w21;
         const double t_46 = 2*m_u;
-        const double t_47 = 2*m_g7;
-        const double t_48 = t_12*m_u*(t_11*t_46 + t_9*(t_10*t_46 + t_47*((m_u)*(m_u)*(m_u))));
+        const double t_48 = h_0*m_u*(t_11*t_46 + t_9*(t_10*t_46 + q[11]*((m_u)*(m_u)*(m_u))));
         const double t_49 = 2*m_v;
-        const double t_50 = t_18*m_v*(t_15*(t_16*t_49 + t_47*((m_v)*(m_v)*(m_v))) + t_17*t_49);
+        const double t_50 = h_1*m_v*(t_15*(t_16*t_49 + q[11]*((m_v)*(m_v)*(m_v))) + t_17*t_49);
         const double t_51 = 2*w16;
         const double t_52 = 2*w17;
         const double t_53 = 2*w18;
@@ -1144,8 +1189,14 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         DX[8*n + j] = m_dxg;
         DX[9*n + j] = m_dyg;
         DX[10*n + j] = m_dzg;
-        DX[11*n + j] = -m_E_u_1*t_8*(C0_1*q[6] - S0_1*q[7]) + m_f_u - m_kappa_u_xg*m_xg - m_kappa_u_xp*m_xp - m_kappa_u_yg*m_yg - m_kappa_u_yp*m_yp - m_kappa_u_zg*m_zg - m_kappa_u_zp*m_zp - t_0*m_xi_u_u - t_1*m_xi_u_v - t_14*m_u - t_2*m_xi_u_xg - t_20*m_v - t_3*m_xi_u_xp - t_4*m_xi_u_yg - t_5*m_xi_u_yp - t_6*m_xi_u_zg - t_7*m_xi_u_zp;
-        DX[12*n + j] = -m_E_v_1*t_8*(C0_1*q[8] - S0_1*q[9]) + m_f_v - m_kappa_v_xg*m_xg - m_kappa_v_xq*m_xq - m_kappa_v_yg*m_yg - m_kappa_v_yq*m_yq - m_kappa_v_zg*m_zg - m_kappa_v_zq*m_zq - t_0*m_xi_v_u - t_1*m_xi_v_v - t_2*m_xi_v_xg - t_21*m_xi_v_xq - t_22*m_xi_v_yq - t_23*m_xi_v_zq - t_24*m_u - t_25*m_v - t_4*m_xi_v_yg - t_6*m_xi_v_zg;
+#if !(GS_SHARED_0 && GS_SHARED_90 && GS_SHARED_91)
+        const double h_2 = -m_E_u_1*q[10]*(C0_1*q[6] - S0_1*q[7]);
+#endif
+        DX[11*n + j] = h_2 + m_f_u - m_kappa_u_xg*m_xg - m_kappa_u_xp*m_xp - m_kappa_u_yg*m_yg - m_kappa_u_yp*m_yp - m_kappa_u_zg*m_zg - m_kappa_u_zp*m_zp - t_0*m_xi_u_u - t_1*m_xi_u_v - t_14*m_u - t_2*m_xi_u_xg - t_20*m_v - t_3*m_xi_u_xp - t_4*m_xi_u_yg - t_5*m_xi_u_yp - t_6*m_xi_u_zg - t_7*m_xi_u_zp;
+#if !(GS_SHARED_0 && GS_SHARED_89 && GS_SHARED_92 && GS_SHARED_93)
+        const double h_3 = -m_E_v_1*q[10]*(C0_1*q[8] - S0_1*q[9]);
+#endif
+        DX[12*n + j] = h_3 + m_f_v - m_kappa_v_xg*m_xg - m_kappa_v_xq*m_xq - m_kappa_v_yg*m_yg - m_kappa_v_yq*m_yq - m_kappa_v_zg*m_zg - m_kappa_v_zq*m_zq - t_0*m_xi_v_u - t_1*m_xi_v_v - t_2*m_xi_v_xg - t_21*m_xi_v_xq - t_22*m_xi_v_yq - t_23*m_xi_v_zq - t_24*m_u - t_25*m_v - t_4*m_xi_v_yg - t_6*m_xi_v_zg;
         DX[13*n + j] = -m_kappa_xp_xp*m_xp - t_0*m_xi_xp_u - t_26*m_u - t_3*m_xi_xp_xp;
         DX[14*n + j] = -m_kappa_yp_yp*m_yp - t_0*m_xi_yp_u - t_27*m_u - t_5*m_xi_yp_yp;
         DX[15*n + j] = -m_kappa_zp_zp*m_zp - t_0*m_xi_zp_u - t_28*m_u - t_7*m_xi_zp_zp;

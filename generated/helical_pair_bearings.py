@@ -197,13 +197,15 @@ C_SOURCE = r"""
 /* helical_pair_bearings: right-hand side for the compiled integrators (gearsym derive). */
 #define GS_NX 14
 #define GS_NP 52
-#define GS_NQ 2
+#define GS_NQ 3
 
 static void gs_prep(const double *p, double *q)
 {
+    const double m_omega = p[0];
     const double m_psi_u_1 = p[47];
     q[0] = cos(m_psi_u_1);
     q[1] = sin(m_psi_u_1);
+    q[2] = ((m_omega)*(m_omega));
     (void)p; (void)q;
 }
 
@@ -306,6 +308,8 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     (void)tau; (void)p; (void)q;
 }
 
+/* -DGS_SHARED_k=1 declares parameter k equal for all points: the terms of the time
+ * and of shared parameters alone are then computed once, before the loop. */
 static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
 {
     const double th0 = (P[0*n])*tau;
@@ -314,6 +318,12 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
     const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
     const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
+#if GS_SHARED_0 && GS_SHARED_40 && GS_SHARED_41 && GS_SHARED_42 && GS_SHARED_43 && GS_SHARED_44 && GS_SHARED_45
+    const double h_0 = C0_1*P[40*n] + C0_2*P[42*n] + C0_3*P[44*n] + S0_1*P[41*n] + S0_2*P[43*n] + S0_3*P[45*n] + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_46 && GS_SHARED_47
+    const double h_1 = -P[46*n]*Q[2*n]*(C0_1*Q[0*n] - S0_1*Q[1*n]);
+#endif
 #pragma GCC ivdep
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
@@ -332,7 +342,6 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double m_dxg = X[11*n + j];
         const double m_dyg = X[12*n + j];
         const double m_dzg = X[13*n + j];
-        const double m_omega = P[0*n + j];
         const double m_f_u = P[1*n + j];
         const double m_xi_u_u = P[2*n + j];
         const double m_xi_u_xp = P[3*n + j];
@@ -391,7 +400,10 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double t_5 = 2*m_dzg;
         const double t_6 = 2*m_dzp;
         const double t_7 = ((m_u)*(m_u));
-        const double t_8 = m_u*(m_g1 + t_7*(m_g3 + t_7*(m_g5 + m_g7*t_7)))*(C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1);
+#if !(GS_SHARED_0 && GS_SHARED_40 && GS_SHARED_41 && GS_SHARED_42 && GS_SHARED_43 && GS_SHARED_44 && GS_SHARED_45)
+        const double h_0 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
+#endif
+        const double t_8 = m_u*(m_g1 + t_7*(m_g3 + t_7*(m_g5 + m_g7*t_7)))*(h_0);
         DX[0*n + j] = m_du;
         DX[1*n + j] = m_dxp;
         DX[2*n + j] = m_dyp;
@@ -399,7 +411,10 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         DX[4*n + j] = m_dxg;
         DX[5*n + j] = m_dyg;
         DX[6*n + j] = m_dzg;
-        DX[7*n + j] = -m_E_u_1*((m_omega)*(m_omega))*(C0_1*q[0] - S0_1*q[1]) + m_f_u - m_kappa_u_u*t_8 - m_kappa_u_xg*m_xg - m_kappa_u_xp*m_xp - m_kappa_u_yg*m_yg - m_kappa_u_yp*m_yp - m_kappa_u_zg*m_zg - m_kappa_u_zp*m_zp - t_0*m_xi_u_u - t_1*m_xi_u_xg - t_2*m_xi_u_xp - t_3*m_xi_u_yg - t_4*m_xi_u_yp - t_5*m_xi_u_zg - t_6*m_xi_u_zp;
+#if !(GS_SHARED_0 && GS_SHARED_46 && GS_SHARED_47)
+        const double h_1 = -m_E_u_1*q[2]*(C0_1*q[0] - S0_1*q[1]);
+#endif
+        DX[7*n + j] = h_1 + m_f_u - m_kappa_u_u*t_8 - m_kappa_u_xg*m_xg - m_kappa_u_xp*m_xp - m_kappa_u_yg*m_yg - m_kappa_u_yp*m_yp - m_kappa_u_zg*m_zg - m_kappa_u_zp*m_zp - t_0*m_xi_u_u - t_1*m_xi_u_xg - t_2*m_xi_u_xp - t_3*m_xi_u_yg - t_4*m_xi_u_yp - t_5*m_xi_u_zg - t_6*m_xi_u_zp;
         DX[8*n + j] = -m_kappa_xp_u*t_8 - m_kappa_xp_xp*m_xp - t_0*m_xi_xp_u - t_2*m_xi_xp_xp;
         DX[9*n + j] = -m_kappa_yp_u*t_8 - m_kappa_yp_yp*m_yp - t_0*m_xi_yp_u - t_4*m_xi_yp_yp;
         DX[10*n + j] = -m_kappa_zp_u*t_8 - m_kappa_zp_zp*m_zp - t_0*m_xi_zp_u - t_6*m_xi_zp_zp;
@@ -416,13 +431,15 @@ C_SOURCE_VARIATIONAL = r"""
 /* helical_pair_bearings: right-hand side with the variational equations for the compiled integrators (gearsym derive). */
 #define GS_NX 28
 #define GS_NP 52
-#define GS_NQ 2
+#define GS_NQ 3
 
 static void gs_prep(const double *p, double *q)
 {
+    const double m_omega = p[0];
     const double m_psi_u_1 = p[47];
     q[0] = cos(m_psi_u_1);
     q[1] = sin(m_psi_u_1);
+    q[2] = ((m_omega)*(m_omega));
     (void)p; (void)q;
 }
 
@@ -572,6 +589,8 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     (void)tau; (void)p; (void)q;
 }
 
+/* -DGS_SHARED_k=1 declares parameter k equal for all points: the terms of the time
+ * and of shared parameters alone are then computed once, before the loop. */
 static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
 {
     const double th0 = (P[0*n])*tau;
@@ -580,6 +599,12 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
     const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
     const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
+#if GS_SHARED_0 && GS_SHARED_40 && GS_SHARED_41 && GS_SHARED_42 && GS_SHARED_43 && GS_SHARED_44 && GS_SHARED_45
+    const double h_0 = C0_1*P[40*n] + C0_2*P[42*n] + C0_3*P[44*n] + S0_1*P[41*n] + S0_2*P[43*n] + S0_3*P[45*n] + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_46 && GS_SHARED_47
+    const double h_1 = -P[46*n]*Q[2*n]*(C0_1*Q[0*n] - S0_1*Q[1*n]);
+#endif
 #pragma GCC ivdep
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
@@ -612,7 +637,6 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double w11 = X[25*n + j];
         const double w12 = X[26*n + j];
         const double w13 = X[27*n + j];
-        const double m_omega = P[0*n + j];
         const double m_f_u = P[1*n + j];
         const double m_xi_u_u = P[2*n + j];
         const double m_xi_u_xp = P[3*n + j];
@@ -673,8 +697,10 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double t_7 = ((m_u)*(m_u));
         const double t_8 = m_g5 + m_g7*t_7;
         const double t_9 = m_g3 + t_7*t_8;
-        const double t_10 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
-        const double t_11 = t_10*(m_g1 + t_7*t_9);
+#if !(GS_SHARED_0 && GS_SHARED_40 && GS_SHARED_41 && GS_SHARED_42 && GS_SHARED_43 && GS_SHARED_44 && GS_SHARED_45)
+        const double h_0 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
+#endif
+        const double t_11 = h_0*(m_g1 + t_7*t_9);
         const double t_12 = m_kappa_u_u*t_11;
         const double t_13 = m_kappa_xp_u*t_11;
         const double t_14 = m_kappa_yp_u*t_11;
@@ -690,7 +716,7 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double t_24 = 2*w8;
         const double t_25 = 2*w9;
         const double t_26 = 2*m_u;
-        const double t_27 = t_10*m_u*(t_26*t_9 + t_7*(2*m_g7*((m_u)*(m_u)*(m_u)) + t_26*t_8));
+        const double t_27 = h_0*m_u*(t_26*t_9 + t_7*(2*m_g7*((m_u)*(m_u)*(m_u)) + t_26*t_8));
         DX[0*n + j] = m_du;
         DX[1*n + j] = m_dxp;
         DX[2*n + j] = m_dyp;
@@ -698,7 +724,10 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         DX[4*n + j] = m_dxg;
         DX[5*n + j] = m_dyg;
         DX[6*n + j] = m_dzg;
-        DX[7*n + j] = -m_E_u_1*((m_omega)*(m_omega))*(C0_1*q[0] - S0_1*q[1]) + m_f_u - m_kappa_u_xg*m_xg - m_kappa_u_xp*m_xp - m_kappa_u_yg*m_yg - m_kappa_u_yp*m_yp - m_kappa_u_zg*m_zg - m_kappa_u_zp*m_zp - t_0*m_xi_u_u - t_1*m_xi_u_xg - t_12*m_u - t_2*m_xi_u_xp - t_3*m_xi_u_yg - t_4*m_xi_u_yp - t_5*m_xi_u_zg - t_6*m_xi_u_zp;
+#if !(GS_SHARED_0 && GS_SHARED_46 && GS_SHARED_47)
+        const double h_1 = -m_E_u_1*q[2]*(C0_1*q[0] - S0_1*q[1]);
+#endif
+        DX[7*n + j] = h_1 + m_f_u - m_kappa_u_xg*m_xg - m_kappa_u_xp*m_xp - m_kappa_u_yg*m_yg - m_kappa_u_yp*m_yp - m_kappa_u_zg*m_zg - m_kappa_u_zp*m_zp - t_0*m_xi_u_u - t_1*m_xi_u_xg - t_12*m_u - t_2*m_xi_u_xp - t_3*m_xi_u_yg - t_4*m_xi_u_yp - t_5*m_xi_u_zg - t_6*m_xi_u_zp;
         DX[8*n + j] = -m_kappa_xp_xp*m_xp - t_0*m_xi_xp_u - t_13*m_u - t_2*m_xi_xp_xp;
         DX[9*n + j] = -m_kappa_yp_yp*m_yp - t_0*m_xi_yp_u - t_14*m_u - t_4*m_xi_yp_yp;
         DX[10*n + j] = -m_kappa_zp_zp*m_zp - t_0*m_xi_zp_u - t_15*m_u - t_6*m_xi_zp_zp;

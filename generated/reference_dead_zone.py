@@ -139,10 +139,11 @@ C_SOURCE = r"""
 /* reference_dead_zone: right-hand side for the compiled integrators (gearsym derive). */
 #define GS_NX 4
 #define GS_NP 28
-#define GS_NQ 10
+#define GS_NQ 11
 
 static void gs_prep(const double *p, double *q)
 {
+    const double m_omega = p[0];
     const double m_phi_v = p[23];
     const double m_psi_u_1 = p[25];
     const double m_psi_v_1 = p[27];
@@ -156,6 +157,7 @@ static void gs_prep(const double *p, double *q)
     q[7] = sin(m_psi_u_1);
     q[8] = cos(m_phi_v - m_psi_v_1);
     q[9] = -sin(m_phi_v - m_psi_v_1);
+    q[10] = ((m_omega)*(m_omega));
     (void)p; (void)q;
 }
 
@@ -208,6 +210,8 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     (void)tau; (void)p; (void)q;
 }
 
+/* -DGS_SHARED_k=1 declares parameter k equal for all points: the terms of the time
+ * and of shared parameters alone are then computed once, before the loop. */
 static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
 {
     const double th0 = (P[0*n])*tau;
@@ -216,6 +220,18 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
     const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
     const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
+#if GS_SHARED_0 && GS_SHARED_11 && GS_SHARED_12 && GS_SHARED_13 && GS_SHARED_14 && GS_SHARED_15 && GS_SHARED_16
+    const double h_0 = C0_1*P[11*n] + C0_2*P[13*n] + C0_3*P[15*n] + S0_1*P[12*n] + S0_2*P[14*n] + S0_3*P[16*n] + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_17 && GS_SHARED_18 && GS_SHARED_19 && GS_SHARED_20 && GS_SHARED_21 && GS_SHARED_22 && GS_SHARED_23
+    const double h_1 = P[17*n]*(C0_1*Q[0*n] - S0_1*Q[1*n]) + P[19*n]*(C0_2*Q[2*n] - S0_2*Q[3*n]) + P[21*n]*(C0_3*Q[4*n] - S0_3*Q[5*n]) + P[18*n]*(C0_1*Q[1*n] + S0_1*Q[0*n]) + P[20*n]*(C0_2*Q[3*n] + S0_2*Q[2*n]) + P[22*n]*(C0_3*Q[5*n] + S0_3*Q[4*n]) + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_24 && GS_SHARED_25
+    const double h_2 = -P[24*n]*Q[10*n]*(C0_1*Q[6*n] - S0_1*Q[7*n]);
+#endif
+#if GS_SHARED_0 && GS_SHARED_23 && GS_SHARED_26 && GS_SHARED_27
+    const double h_3 = -P[26*n]*Q[10*n]*(C0_1*Q[8*n] - S0_1*Q[9*n]);
+#endif
 #pragma GCC ivdep
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
@@ -224,7 +240,6 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double m_v = X[1*n + j];
         const double m_du = X[2*n + j];
         const double m_dv = X[3*n + j];
-        const double m_omega = P[0*n + j];
         const double m_f_u = P[1*n + j];
         const double m_f_v = P[2*n + j];
         const double m_xi_u_u = P[3*n + j];
@@ -251,13 +266,24 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double m_E_v_1 = P[26*n + j];
         const double t_0 = 2*m_du;
         const double t_1 = 2*m_dv;
-        const double t_2 = ((m_omega)*(m_omega));
-        const double t_3 = (C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1)*((m_u > 1) ? (m_u - 1) : ((m_u < -1) ? (m_u + 1) : (0)));
-        const double t_4 = (m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[2] - S0_2*q[3]) + m_kc_v_3*(C0_3*q[4] - S0_3*q[5]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[3] + S0_2*q[2]) + m_ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1)*((m_v > 1) ? (m_v - 1) : ((m_v < -1) ? (m_v + 1) : (0)));
+#if !(GS_SHARED_0 && GS_SHARED_11 && GS_SHARED_12 && GS_SHARED_13 && GS_SHARED_14 && GS_SHARED_15 && GS_SHARED_16)
+        const double h_0 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
+#endif
+        const double t_3 = (h_0)*((m_u > 1) ? (m_u - 1) : ((m_u < -1) ? (m_u + 1) : (0)));
+#if !(GS_SHARED_0 && GS_SHARED_17 && GS_SHARED_18 && GS_SHARED_19 && GS_SHARED_20 && GS_SHARED_21 && GS_SHARED_22 && GS_SHARED_23)
+        const double h_1 = m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[2] - S0_2*q[3]) + m_kc_v_3*(C0_3*q[4] - S0_3*q[5]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[3] + S0_2*q[2]) + m_ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1;
+#endif
+        const double t_4 = (h_1)*((m_v > 1) ? (m_v - 1) : ((m_v < -1) ? (m_v + 1) : (0)));
         DX[0*n + j] = m_du;
         DX[1*n + j] = m_dv;
-        DX[2*n + j] = -m_E_u_1*t_2*(C0_1*q[6] - S0_1*q[7]) + m_f_u - m_kappa_u_u*t_3 - m_kappa_u_v*t_4 - t_0*m_xi_u_u - t_1*m_xi_u_v;
-        DX[3*n + j] = -m_E_v_1*t_2*(C0_1*q[8] - S0_1*q[9]) + m_f_v - m_kappa_v_u*t_3 - m_kappa_v_v*t_4 - t_0*m_xi_v_u - t_1*m_xi_v_v;
+#if !(GS_SHARED_0 && GS_SHARED_24 && GS_SHARED_25)
+        const double h_2 = -m_E_u_1*q[10]*(C0_1*q[6] - S0_1*q[7]);
+#endif
+        DX[2*n + j] = h_2 + m_f_u - m_kappa_u_u*t_3 - m_kappa_u_v*t_4 - t_0*m_xi_u_u - t_1*m_xi_u_v;
+#if !(GS_SHARED_0 && GS_SHARED_23 && GS_SHARED_26 && GS_SHARED_27)
+        const double h_3 = -m_E_v_1*q[10]*(C0_1*q[8] - S0_1*q[9]);
+#endif
+        DX[3*n + j] = h_3 + m_f_v - m_kappa_v_u*t_3 - m_kappa_v_v*t_4 - t_0*m_xi_v_u - t_1*m_xi_v_v;
     }
     (void)tau; (void)P; (void)Q;
 }
@@ -268,10 +294,11 @@ C_SOURCE_VARIATIONAL = r"""
 /* reference_dead_zone: right-hand side with the variational equations for the compiled integrators (gearsym derive). */
 #define GS_NX 8
 #define GS_NP 28
-#define GS_NQ 10
+#define GS_NQ 11
 
 static void gs_prep(const double *p, double *q)
 {
+    const double m_omega = p[0];
     const double m_phi_v = p[23];
     const double m_psi_u_1 = p[25];
     const double m_psi_v_1 = p[27];
@@ -285,6 +312,7 @@ static void gs_prep(const double *p, double *q)
     q[7] = sin(m_psi_u_1);
     q[8] = cos(m_phi_v - m_psi_v_1);
     q[9] = -sin(m_phi_v - m_psi_v_1);
+    q[10] = ((m_omega)*(m_omega));
     (void)p; (void)q;
 }
 
@@ -355,6 +383,8 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     (void)tau; (void)p; (void)q;
 }
 
+/* -DGS_SHARED_k=1 declares parameter k equal for all points: the terms of the time
+ * and of shared parameters alone are then computed once, before the loop. */
 static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
 {
     const double th0 = (P[0*n])*tau;
@@ -363,6 +393,18 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
     const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
     const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
+#if GS_SHARED_0 && GS_SHARED_11 && GS_SHARED_12 && GS_SHARED_13 && GS_SHARED_14 && GS_SHARED_15 && GS_SHARED_16
+    const double h_0 = C0_1*P[11*n] + C0_2*P[13*n] + C0_3*P[15*n] + S0_1*P[12*n] + S0_2*P[14*n] + S0_3*P[16*n] + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_17 && GS_SHARED_18 && GS_SHARED_19 && GS_SHARED_20 && GS_SHARED_21 && GS_SHARED_22 && GS_SHARED_23
+    const double h_1 = P[17*n]*(C0_1*Q[0*n] - S0_1*Q[1*n]) + P[19*n]*(C0_2*Q[2*n] - S0_2*Q[3*n]) + P[21*n]*(C0_3*Q[4*n] - S0_3*Q[5*n]) + P[18*n]*(C0_1*Q[1*n] + S0_1*Q[0*n]) + P[20*n]*(C0_2*Q[3*n] + S0_2*Q[2*n]) + P[22*n]*(C0_3*Q[5*n] + S0_3*Q[4*n]) + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_24 && GS_SHARED_25
+    const double h_2 = -P[24*n]*Q[10*n]*(C0_1*Q[6*n] - S0_1*Q[7*n]);
+#endif
+#if GS_SHARED_0 && GS_SHARED_23 && GS_SHARED_26 && GS_SHARED_27
+    const double h_3 = -P[26*n]*Q[10*n]*(C0_1*Q[8*n] - S0_1*Q[9*n]);
+#endif
 #pragma GCC ivdep
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
@@ -375,7 +417,6 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double w1 = X[5*n + j];
         const double w2 = X[6*n + j];
         const double w3 = X[7*n + j];
-        const double m_omega = P[0*n + j];
         const double m_f_u = P[1*n + j];
         const double m_f_v = P[2*n + j];
         const double m_xi_u_u = P[3*n + j];
@@ -402,23 +443,32 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double m_E_v_1 = P[26*n + j];
         const double t_0 = 2*m_du;
         const double t_1 = 2*m_dv;
-        const double t_2 = ((m_omega)*(m_omega));
-        const double t_3 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
+#if !(GS_SHARED_0 && GS_SHARED_11 && GS_SHARED_12 && GS_SHARED_13 && GS_SHARED_14 && GS_SHARED_15 && GS_SHARED_16)
+        const double h_0 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
+#endif
         const double t_4 = m_u > 1;
         const double t_5 = m_u < -1;
-        const double t_6 = t_3*((t_4) ? (m_u - 1) : ((t_5) ? (m_u + 1) : (0)));
-        const double t_7 = m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[2] - S0_2*q[3]) + m_kc_v_3*(C0_3*q[4] - S0_3*q[5]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[3] + S0_2*q[2]) + m_ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1;
+        const double t_6 = h_0*((t_4) ? (m_u - 1) : ((t_5) ? (m_u + 1) : (0)));
+#if !(GS_SHARED_0 && GS_SHARED_17 && GS_SHARED_18 && GS_SHARED_19 && GS_SHARED_20 && GS_SHARED_21 && GS_SHARED_22 && GS_SHARED_23)
+        const double h_1 = m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[2] - S0_2*q[3]) + m_kc_v_3*(C0_3*q[4] - S0_3*q[5]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[3] + S0_2*q[2]) + m_ks_v_3*(C0_3*q[5] + S0_3*q[4]) + 1;
+#endif
         const double t_8 = m_v > 1;
         const double t_9 = m_v < -1;
-        const double t_10 = t_7*((t_8) ? (m_v - 1) : ((t_9) ? (m_v + 1) : (0)));
+        const double t_10 = h_1*((t_8) ? (m_v - 1) : ((t_9) ? (m_v + 1) : (0)));
         const double t_11 = 2*w2;
         const double t_12 = 2*w3;
-        const double t_13 = t_3*w0*((t_4 || t_5) ? (1) : (0));
-        const double t_14 = t_7*w1*((t_8 || t_9) ? (1) : (0));
+        const double t_13 = h_0*w0*((t_4 || t_5) ? (1) : (0));
+        const double t_14 = h_1*w1*((t_8 || t_9) ? (1) : (0));
         DX[0*n + j] = m_du;
         DX[1*n + j] = m_dv;
-        DX[2*n + j] = -m_E_u_1*t_2*(C0_1*q[6] - S0_1*q[7]) + m_f_u - m_kappa_u_u*t_6 - m_kappa_u_v*t_10 - t_0*m_xi_u_u - t_1*m_xi_u_v;
-        DX[3*n + j] = -m_E_v_1*t_2*(C0_1*q[8] - S0_1*q[9]) + m_f_v - m_kappa_v_u*t_6 - m_kappa_v_v*t_10 - t_0*m_xi_v_u - t_1*m_xi_v_v;
+#if !(GS_SHARED_0 && GS_SHARED_24 && GS_SHARED_25)
+        const double h_2 = -m_E_u_1*q[10]*(C0_1*q[6] - S0_1*q[7]);
+#endif
+        DX[2*n + j] = h_2 + m_f_u - m_kappa_u_u*t_6 - m_kappa_u_v*t_10 - t_0*m_xi_u_u - t_1*m_xi_u_v;
+#if !(GS_SHARED_0 && GS_SHARED_23 && GS_SHARED_26 && GS_SHARED_27)
+        const double h_3 = -m_E_v_1*q[10]*(C0_1*q[8] - S0_1*q[9]);
+#endif
+        DX[3*n + j] = h_3 + m_f_v - m_kappa_v_u*t_6 - m_kappa_v_v*t_10 - t_0*m_xi_v_u - t_1*m_xi_v_v;
         DX[4*n + j] = w2;
         DX[5*n + j] = w3;
         DX[6*n + j] = -m_kappa_u_u*t_13 - m_kappa_u_v*t_14 - t_11*m_xi_u_u - t_12*m_xi_u_v;

@@ -129,6 +129,8 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     (void)tau; (void)p; (void)q;
 }
 
+/* -DGS_SHARED_k=1 declares parameter k equal for all points: the terms of the time
+ * and of shared parameters alone are then computed once, before the loop. */
 static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
 {
 #pragma GCC ivdep
@@ -159,10 +161,14 @@ C_SOURCE_VARIATIONAL = r"""
 /* reference_linear: right-hand side with the variational equations for the compiled integrators (gearsym derive). */
 #define GS_NX 8
 #define GS_NP 9
-#define GS_NQ 1
+#define GS_NQ 2
 
 static void gs_prep(const double *p, double *q)
 {
+    const double m_xi_u_u = p[3];
+    const double m_xi_v_v = p[4];
+    q[0] = 2*m_xi_u_u;
+    q[1] = 2*m_xi_v_v;
     (void)p; (void)q;
 }
 
@@ -197,10 +203,14 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     (void)tau; (void)p; (void)q;
 }
 
+/* -DGS_SHARED_k=1 declares parameter k equal for all points: the terms of the time
+ * and of shared parameters alone are then computed once, before the loop. */
 static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
 {
 #pragma GCC ivdep
     for (int j = 0; j < n; ++j) {
+        double q[GS_NQ];
+        for (int k = 0; k < GS_NQ; ++k) q[k] = Q[k*n + j];
         const double m_u = X[0*n + j];
         const double m_v = X[1*n + j];
         const double m_du = X[2*n + j];
@@ -211,22 +221,18 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double w3 = X[7*n + j];
         const double m_f_u = P[1*n + j];
         const double m_f_v = P[2*n + j];
-        const double m_xi_u_u = P[3*n + j];
-        const double m_xi_v_v = P[4*n + j];
         const double m_kappa_u_u = P[5*n + j];
         const double m_kappa_u_v = P[6*n + j];
         const double m_kappa_v_u = P[7*n + j];
         const double m_kappa_v_v = P[8*n + j];
-        const double t_0 = 2*m_xi_u_u;
-        const double t_1 = 2*m_xi_v_v;
         DX[0*n + j] = m_du;
         DX[1*n + j] = m_dv;
-        DX[2*n + j] = -m_du*t_0 + m_f_u - m_kappa_u_u*m_u - m_kappa_u_v*m_v;
-        DX[3*n + j] = -m_dv*t_1 + m_f_v - m_kappa_v_u*m_u - m_kappa_v_v*m_v;
+        DX[2*n + j] = -m_du*q[0] + m_f_u - m_kappa_u_u*m_u - m_kappa_u_v*m_v;
+        DX[3*n + j] = -m_dv*q[1] + m_f_v - m_kappa_v_u*m_u - m_kappa_v_v*m_v;
         DX[4*n + j] = w2;
         DX[5*n + j] = w3;
-        DX[6*n + j] = -m_kappa_u_u*w0 - m_kappa_u_v*w1 - t_0*w2;
-        DX[7*n + j] = -m_kappa_v_u*w0 - m_kappa_v_v*w1 - t_1*w3;
+        DX[6*n + j] = -m_kappa_u_u*w0 - m_kappa_u_v*w1 - q[0]*w2;
+        DX[7*n + j] = -m_kappa_v_u*w0 - m_kappa_v_v*w1 - q[1]*w3;
     }
     (void)tau; (void)P; (void)Q;
 }

@@ -113,13 +113,15 @@ C_SOURCE = r"""
 /* siso: right-hand side for the compiled integrators (gearsym derive). */
 #define GS_NX 2
 #define GS_NP 16
-#define GS_NQ 2
+#define GS_NQ 3
 
 static void gs_prep(const double *p, double *q)
 {
+    const double m_omega = p[0];
     const double m_psi_u_1 = p[11];
     q[0] = cos(m_psi_u_1);
     q[1] = sin(m_psi_u_1);
+    q[2] = ((m_omega)*(m_omega));
     (void)p; (void)q;
 }
 
@@ -154,6 +156,8 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     (void)tau; (void)p; (void)q;
 }
 
+/* -DGS_SHARED_k=1 declares parameter k equal for all points: the terms of the time
+ * and of shared parameters alone are then computed once, before the loop. */
 static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
 {
     const double th0 = (P[0*n])*tau;
@@ -162,13 +166,18 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
     const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
     const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
+#if GS_SHARED_0 && GS_SHARED_10 && GS_SHARED_11
+    const double h_0 = -P[10*n]*Q[2*n]*(C0_1*Q[0*n] - S0_1*Q[1*n]);
+#endif
+#if GS_SHARED_0 && GS_SHARED_4 && GS_SHARED_5 && GS_SHARED_6 && GS_SHARED_7 && GS_SHARED_8 && GS_SHARED_9
+    const double h_1 = C0_1*P[4*n] + C0_2*P[6*n] + C0_3*P[8*n] + S0_1*P[5*n] + S0_2*P[7*n] + S0_3*P[9*n] + 1;
+#endif
 #pragma GCC ivdep
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
         for (int k = 0; k < GS_NQ; ++k) q[k] = Q[k*n + j];
         const double m_u = X[0*n + j];
         const double m_du = X[1*n + j];
-        const double m_omega = P[0*n + j];
         const double m_f_u = P[1*n + j];
         const double m_xi_u_u = P[2*n + j];
         const double m_kappa_u_u = P[3*n + j];
@@ -185,7 +194,13 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double m_g7 = P[15*n + j];
         const double t_0 = ((m_u)*(m_u));
         DX[0*n + j] = m_du;
-        DX[1*n + j] = -m_E_u_1*((m_omega)*(m_omega))*(C0_1*q[0] - S0_1*q[1]) - 2*m_du*m_xi_u_u + m_f_u - m_kappa_u_u*m_u*(m_g1 + t_0*(m_g3 + t_0*(m_g5 + m_g7*t_0)))*(C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1);
+#if !(GS_SHARED_0 && GS_SHARED_10 && GS_SHARED_11)
+        const double h_0 = -m_E_u_1*q[2]*(C0_1*q[0] - S0_1*q[1]);
+#endif
+#if !(GS_SHARED_0 && GS_SHARED_4 && GS_SHARED_5 && GS_SHARED_6 && GS_SHARED_7 && GS_SHARED_8 && GS_SHARED_9)
+        const double h_1 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
+#endif
+        DX[1*n + j] = h_0 - 2*m_du*m_xi_u_u + m_f_u - m_kappa_u_u*m_u*(m_g1 + t_0*(m_g3 + t_0*(m_g5 + m_g7*t_0)))*(h_1);
     }
     (void)tau; (void)P; (void)Q;
 }
@@ -196,13 +211,17 @@ C_SOURCE_VARIATIONAL = r"""
 /* siso: right-hand side with the variational equations for the compiled integrators (gearsym derive). */
 #define GS_NX 4
 #define GS_NP 16
-#define GS_NQ 2
+#define GS_NQ 4
 
 static void gs_prep(const double *p, double *q)
 {
+    const double m_omega = p[0];
+    const double m_xi_u_u = p[2];
     const double m_psi_u_1 = p[11];
     q[0] = cos(m_psi_u_1);
     q[1] = sin(m_psi_u_1);
+    q[2] = 2*m_xi_u_u;
+    q[3] = ((m_omega)*(m_omega));
     (void)p; (void)q;
 }
 
@@ -247,6 +266,8 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     (void)tau; (void)p; (void)q;
 }
 
+/* -DGS_SHARED_k=1 declares parameter k equal for all points: the terms of the time
+ * and of shared parameters alone are then computed once, before the loop. */
 static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
 {
     const double th0 = (P[0*n])*tau;
@@ -255,6 +276,12 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
     const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
     const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
+#if GS_SHARED_0 && GS_SHARED_3 && GS_SHARED_4 && GS_SHARED_5 && GS_SHARED_6 && GS_SHARED_7 && GS_SHARED_8 && GS_SHARED_9
+    const double h_0 = P[3*n]*(C0_1*P[4*n] + C0_2*P[6*n] + C0_3*P[8*n] + S0_1*P[5*n] + S0_2*P[7*n] + S0_3*P[9*n] + 1);
+#endif
+#if GS_SHARED_0 && GS_SHARED_10 && GS_SHARED_11
+    const double h_1 = -P[10*n]*Q[3*n]*(C0_1*Q[0*n] - S0_1*Q[1*n]);
+#endif
 #pragma GCC ivdep
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
@@ -263,9 +290,7 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double m_du = X[1*n + j];
         const double w0 = X[2*n + j];
         const double w1 = X[3*n + j];
-        const double m_omega = P[0*n + j];
         const double m_f_u = P[1*n + j];
-        const double m_xi_u_u = P[2*n + j];
         const double m_kappa_u_u = P[3*n + j];
         const double m_kc_u_1 = P[4*n + j];
         const double m_ks_u_1 = P[5*n + j];
@@ -278,17 +303,21 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double m_g3 = P[13*n + j];
         const double m_g5 = P[14*n + j];
         const double m_g7 = P[15*n + j];
-        const double t_0 = 2*m_xi_u_u;
         const double t_1 = ((m_u)*(m_u));
         const double t_2 = m_g5 + m_g7*t_1;
         const double t_3 = m_g3 + t_1*t_2;
-        const double t_4 = m_kappa_u_u*(C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1);
-        const double t_5 = t_4*(m_g1 + t_1*t_3);
+#if !(GS_SHARED_0 && GS_SHARED_3 && GS_SHARED_4 && GS_SHARED_5 && GS_SHARED_6 && GS_SHARED_7 && GS_SHARED_8 && GS_SHARED_9)
+        const double h_0 = m_kappa_u_u*(C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1);
+#endif
+        const double t_5 = h_0*(m_g1 + t_1*t_3);
         const double t_6 = 2*m_u;
         DX[0*n + j] = m_du;
-        DX[1*n + j] = -m_E_u_1*((m_omega)*(m_omega))*(C0_1*q[0] - S0_1*q[1]) - m_du*t_0 + m_f_u - t_5*m_u;
+#if !(GS_SHARED_0 && GS_SHARED_10 && GS_SHARED_11)
+        const double h_1 = -m_E_u_1*q[3]*(C0_1*q[0] - S0_1*q[1]);
+#endif
+        DX[1*n + j] = h_1 - m_du*q[2] + m_f_u - t_5*m_u;
         DX[2*n + j] = w1;
-        DX[3*n + j] = -t_0*w1 + w0*(-t_4*m_u*(t_1*(2*m_g7*((m_u)*(m_u)*(m_u)) + t_2*t_6) + t_3*t_6) - t_5);
+        DX[3*n + j] = -q[2]*w1 + w0*(-h_0*m_u*(t_1*(2*m_g7*((m_u)*(m_u)*(m_u)) + t_2*t_6) + t_3*t_6) - t_5);
     }
     (void)tau; (void)P; (void)Q;
 }

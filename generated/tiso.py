@@ -189,10 +189,11 @@ C_SOURCE = r"""
 /* tiso: right-hand side for the compiled integrators (gearsym derive). */
 #define GS_NX 6
 #define GS_NP 52
-#define GS_NQ 18
+#define GS_NQ 19
 
 static void gs_prep(const double *p, double *q)
 {
+    const double m_omega = p[0];
     const double m_phi_v = p[40];
     const double m_phi_w = p[41];
     const double m_psi_u_1 = p[43];
@@ -216,6 +217,7 @@ static void gs_prep(const double *p, double *q)
     q[15] = -sin(m_phi_v - m_psi_v_1);
     q[16] = cos(m_phi_w - m_psi_w_1);
     q[17] = -sin(m_phi_w - m_psi_w_1);
+    q[18] = ((m_omega)*(m_omega));
     (void)p; (void)q;
 }
 
@@ -299,6 +301,8 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     (void)tau; (void)p; (void)q;
 }
 
+/* -DGS_SHARED_k=1 declares parameter k equal for all points: the terms of the time
+ * and of shared parameters alone are then computed once, before the loop. */
 static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
 {
     const double th0 = (P[0*n])*tau;
@@ -307,6 +311,24 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
     const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
     const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
+#if GS_SHARED_0 && GS_SHARED_22 && GS_SHARED_23 && GS_SHARED_24 && GS_SHARED_25 && GS_SHARED_26 && GS_SHARED_27
+    const double h_0 = C0_1*P[22*n] + C0_2*P[24*n] + C0_3*P[26*n] + S0_1*P[23*n] + S0_2*P[25*n] + S0_3*P[27*n] + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_28 && GS_SHARED_29 && GS_SHARED_30 && GS_SHARED_31 && GS_SHARED_32 && GS_SHARED_33 && GS_SHARED_40
+    const double h_1 = P[28*n]*(C0_1*Q[0*n] - S0_1*Q[1*n]) + P[30*n]*(C0_2*Q[4*n] - S0_2*Q[5*n]) + P[32*n]*(C0_3*Q[8*n] - S0_3*Q[9*n]) + P[29*n]*(C0_1*Q[1*n] + S0_1*Q[0*n]) + P[31*n]*(C0_2*Q[5*n] + S0_2*Q[4*n]) + P[33*n]*(C0_3*Q[9*n] + S0_3*Q[8*n]) + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_34 && GS_SHARED_35 && GS_SHARED_36 && GS_SHARED_37 && GS_SHARED_38 && GS_SHARED_39 && GS_SHARED_41
+    const double h_2 = P[34*n]*(C0_1*Q[2*n] - S0_1*Q[3*n]) + P[36*n]*(C0_2*Q[6*n] - S0_2*Q[7*n]) + P[38*n]*(C0_3*Q[10*n] - S0_3*Q[11*n]) + P[35*n]*(C0_1*Q[3*n] + S0_1*Q[2*n]) + P[37*n]*(C0_2*Q[7*n] + S0_2*Q[6*n]) + P[39*n]*(C0_3*Q[11*n] + S0_3*Q[10*n]) + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_42 && GS_SHARED_43
+    const double h_3 = -P[42*n]*Q[18*n]*(C0_1*Q[12*n] - S0_1*Q[13*n]);
+#endif
+#if GS_SHARED_0 && GS_SHARED_40 && GS_SHARED_44 && GS_SHARED_45
+    const double h_4 = -P[44*n]*Q[18*n]*(C0_1*Q[14*n] - S0_1*Q[15*n]);
+#endif
+#if GS_SHARED_0 && GS_SHARED_41 && GS_SHARED_46 && GS_SHARED_47
+    const double h_5 = -P[46*n]*Q[18*n]*(C0_1*Q[16*n] - S0_1*Q[17*n]);
+#endif
 #pragma GCC ivdep
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
@@ -317,7 +339,6 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double m_du = X[3*n + j];
         const double m_dv = X[4*n + j];
         const double m_dw = X[5*n + j];
-        const double m_omega = P[0*n + j];
         const double m_f_u = P[1*n + j];
         const double m_f_v = P[2*n + j];
         const double m_f_w = P[3*n + j];
@@ -367,19 +388,36 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double t_0 = 2*m_du;
         const double t_1 = 2*m_dv;
         const double t_2 = 2*m_dw;
-        const double t_3 = ((m_omega)*(m_omega));
         const double t_4 = ((m_u)*(m_u));
-        const double t_5 = m_u*(m_g1 + t_4*(m_g3 + t_4*(m_g5 + m_g7*t_4)))*(C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1);
+#if !(GS_SHARED_0 && GS_SHARED_22 && GS_SHARED_23 && GS_SHARED_24 && GS_SHARED_25 && GS_SHARED_26 && GS_SHARED_27)
+        const double h_0 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
+#endif
+        const double t_5 = m_u*(m_g1 + t_4*(m_g3 + t_4*(m_g5 + m_g7*t_4)))*(h_0);
         const double t_6 = ((m_v)*(m_v));
-        const double t_7 = m_v*(m_g1 + t_6*(m_g3 + t_6*(m_g5 + m_g7*t_6)))*(m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[4] - S0_2*q[5]) + m_kc_v_3*(C0_3*q[8] - S0_3*q[9]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[5] + S0_2*q[4]) + m_ks_v_3*(C0_3*q[9] + S0_3*q[8]) + 1);
+#if !(GS_SHARED_0 && GS_SHARED_28 && GS_SHARED_29 && GS_SHARED_30 && GS_SHARED_31 && GS_SHARED_32 && GS_SHARED_33 && GS_SHARED_40)
+        const double h_1 = m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[4] - S0_2*q[5]) + m_kc_v_3*(C0_3*q[8] - S0_3*q[9]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[5] + S0_2*q[4]) + m_ks_v_3*(C0_3*q[9] + S0_3*q[8]) + 1;
+#endif
+        const double t_7 = m_v*(m_g1 + t_6*(m_g3 + t_6*(m_g5 + m_g7*t_6)))*(h_1);
         const double t_8 = ((m_w)*(m_w));
-        const double t_9 = m_w*(m_g1 + t_8*(m_g3 + t_8*(m_g5 + m_g7*t_8)))*(m_kc_w_1*(C0_1*q[2] - S0_1*q[3]) + m_kc_w_2*(C0_2*q[6] - S0_2*q[7]) + m_kc_w_3*(C0_3*q[10] - S0_3*q[11]) + m_ks_w_1*(C0_1*q[3] + S0_1*q[2]) + m_ks_w_2*(C0_2*q[7] + S0_2*q[6]) + m_ks_w_3*(C0_3*q[11] + S0_3*q[10]) + 1);
+#if !(GS_SHARED_0 && GS_SHARED_34 && GS_SHARED_35 && GS_SHARED_36 && GS_SHARED_37 && GS_SHARED_38 && GS_SHARED_39 && GS_SHARED_41)
+        const double h_2 = m_kc_w_1*(C0_1*q[2] - S0_1*q[3]) + m_kc_w_2*(C0_2*q[6] - S0_2*q[7]) + m_kc_w_3*(C0_3*q[10] - S0_3*q[11]) + m_ks_w_1*(C0_1*q[3] + S0_1*q[2]) + m_ks_w_2*(C0_2*q[7] + S0_2*q[6]) + m_ks_w_3*(C0_3*q[11] + S0_3*q[10]) + 1;
+#endif
+        const double t_9 = m_w*(m_g1 + t_8*(m_g3 + t_8*(m_g5 + m_g7*t_8)))*(h_2);
         DX[0*n + j] = m_du;
         DX[1*n + j] = m_dv;
         DX[2*n + j] = m_dw;
-        DX[3*n + j] = -m_E_u_1*t_3*(C0_1*q[12] - S0_1*q[13]) + m_f_u - m_kappa_u_u*t_5 - m_kappa_u_v*t_7 - m_kappa_u_w*t_9 - t_0*m_xi_u_u - t_1*m_xi_u_v - t_2*m_xi_u_w;
-        DX[4*n + j] = -m_E_v_1*t_3*(C0_1*q[14] - S0_1*q[15]) + m_f_v - m_kappa_v_u*t_5 - m_kappa_v_v*t_7 - m_kappa_v_w*t_9 - t_0*m_xi_v_u - t_1*m_xi_v_v - t_2*m_xi_v_w;
-        DX[5*n + j] = -m_E_w_1*t_3*(C0_1*q[16] - S0_1*q[17]) + m_f_w - m_kappa_w_u*t_5 - m_kappa_w_v*t_7 - m_kappa_w_w*t_9 - t_0*m_xi_w_u - t_1*m_xi_w_v - t_2*m_xi_w_w;
+#if !(GS_SHARED_0 && GS_SHARED_42 && GS_SHARED_43)
+        const double h_3 = -m_E_u_1*q[18]*(C0_1*q[12] - S0_1*q[13]);
+#endif
+        DX[3*n + j] = h_3 + m_f_u - m_kappa_u_u*t_5 - m_kappa_u_v*t_7 - m_kappa_u_w*t_9 - t_0*m_xi_u_u - t_1*m_xi_u_v - t_2*m_xi_u_w;
+#if !(GS_SHARED_0 && GS_SHARED_40 && GS_SHARED_44 && GS_SHARED_45)
+        const double h_4 = -m_E_v_1*q[18]*(C0_1*q[14] - S0_1*q[15]);
+#endif
+        DX[4*n + j] = h_4 + m_f_v - m_kappa_v_u*t_5 - m_kappa_v_v*t_7 - m_kappa_v_w*t_9 - t_0*m_xi_v_u - t_1*m_xi_v_v - t_2*m_xi_v_w;
+#if !(GS_SHARED_0 && GS_SHARED_41 && GS_SHARED_46 && GS_SHARED_47)
+        const double h_5 = -m_E_w_1*q[18]*(C0_1*q[16] - S0_1*q[17]);
+#endif
+        DX[5*n + j] = h_5 + m_f_w - m_kappa_w_u*t_5 - m_kappa_w_v*t_7 - m_kappa_w_w*t_9 - t_0*m_xi_w_u - t_1*m_xi_w_v - t_2*m_xi_w_w;
     }
     (void)tau; (void)P; (void)Q;
 }
@@ -390,15 +428,17 @@ C_SOURCE_VARIATIONAL = r"""
 /* tiso: right-hand side with the variational equations for the compiled integrators (gearsym derive). */
 #define GS_NX 12
 #define GS_NP 52
-#define GS_NQ 18
+#define GS_NQ 20
 
 static void gs_prep(const double *p, double *q)
 {
+    const double m_omega = p[0];
     const double m_phi_v = p[40];
     const double m_phi_w = p[41];
     const double m_psi_u_1 = p[43];
     const double m_psi_v_1 = p[45];
     const double m_psi_w_1 = p[47];
+    const double m_g7 = p[51];
     q[0] = cos(m_phi_v);
     q[1] = -sin(m_phi_v);
     q[2] = cos(m_phi_w);
@@ -417,6 +457,8 @@ static void gs_prep(const double *p, double *q)
     q[15] = -sin(m_phi_v - m_psi_v_1);
     q[16] = cos(m_phi_w - m_psi_w_1);
     q[17] = -sin(m_phi_w - m_psi_w_1);
+    q[18] = ((m_omega)*(m_omega));
+    q[19] = 2*m_g7;
     (void)p; (void)q;
 }
 
@@ -540,6 +582,8 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     (void)tau; (void)p; (void)q;
 }
 
+/* -DGS_SHARED_k=1 declares parameter k equal for all points: the terms of the time
+ * and of shared parameters alone are then computed once, before the loop. */
 static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
 {
     const double th0 = (P[0*n])*tau;
@@ -548,6 +592,24 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     const double S0_2 = S0_1*C0_1 + C0_1*S0_1;
     const double C0_3 = C0_2*C0_1 - S0_2*S0_1;
     const double S0_3 = S0_2*C0_1 + C0_2*S0_1;
+#if GS_SHARED_0 && GS_SHARED_22 && GS_SHARED_23 && GS_SHARED_24 && GS_SHARED_25 && GS_SHARED_26 && GS_SHARED_27
+    const double h_0 = C0_1*P[22*n] + C0_2*P[24*n] + C0_3*P[26*n] + S0_1*P[23*n] + S0_2*P[25*n] + S0_3*P[27*n] + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_28 && GS_SHARED_29 && GS_SHARED_30 && GS_SHARED_31 && GS_SHARED_32 && GS_SHARED_33 && GS_SHARED_40
+    const double h_1 = P[28*n]*(C0_1*Q[0*n] - S0_1*Q[1*n]) + P[30*n]*(C0_2*Q[4*n] - S0_2*Q[5*n]) + P[32*n]*(C0_3*Q[8*n] - S0_3*Q[9*n]) + P[29*n]*(C0_1*Q[1*n] + S0_1*Q[0*n]) + P[31*n]*(C0_2*Q[5*n] + S0_2*Q[4*n]) + P[33*n]*(C0_3*Q[9*n] + S0_3*Q[8*n]) + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_34 && GS_SHARED_35 && GS_SHARED_36 && GS_SHARED_37 && GS_SHARED_38 && GS_SHARED_39 && GS_SHARED_41
+    const double h_2 = P[34*n]*(C0_1*Q[2*n] - S0_1*Q[3*n]) + P[36*n]*(C0_2*Q[6*n] - S0_2*Q[7*n]) + P[38*n]*(C0_3*Q[10*n] - S0_3*Q[11*n]) + P[35*n]*(C0_1*Q[3*n] + S0_1*Q[2*n]) + P[37*n]*(C0_2*Q[7*n] + S0_2*Q[6*n]) + P[39*n]*(C0_3*Q[11*n] + S0_3*Q[10*n]) + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_42 && GS_SHARED_43
+    const double h_3 = -P[42*n]*Q[18*n]*(C0_1*Q[12*n] - S0_1*Q[13*n]);
+#endif
+#if GS_SHARED_0 && GS_SHARED_40 && GS_SHARED_44 && GS_SHARED_45
+    const double h_4 = -P[44*n]*Q[18*n]*(C0_1*Q[14*n] - S0_1*Q[15*n]);
+#endif
+#if GS_SHARED_0 && GS_SHARED_41 && GS_SHARED_46 && GS_SHARED_47
+    const double h_5 = -P[46*n]*Q[18*n]*(C0_1*Q[16*n] - S0_1*Q[17*n]);
+#endif
 #pragma GCC ivdep
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
@@ -564,7 +626,6 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double w3 = X[9*n + j];
         const double w4 = X[10*n + j];
         const double w5 = X[11*n + j];
-        const double m_omega = P[0*n + j];
         const double m_f_u = P[1*n + j];
         const double m_f_v = P[2*n + j];
         const double m_f_w = P[3*n + j];
@@ -614,24 +675,29 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double t_0 = 2*m_du;
         const double t_1 = 2*m_dv;
         const double t_2 = 2*m_dw;
-        const double t_3 = ((m_omega)*(m_omega));
         const double t_4 = ((m_u)*(m_u));
         const double t_5 = m_g5 + m_g7*t_4;
         const double t_6 = m_g3 + t_4*t_5;
-        const double t_7 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
-        const double t_8 = t_7*(m_g1 + t_4*t_6);
+#if !(GS_SHARED_0 && GS_SHARED_22 && GS_SHARED_23 && GS_SHARED_24 && GS_SHARED_25 && GS_SHARED_26 && GS_SHARED_27)
+        const double h_0 = C0_1*m_kc_u_1 + C0_2*m_kc_u_2 + C0_3*m_kc_u_3 + S0_1*m_ks_u_1 + S0_2*m_ks_u_2 + S0_3*m_ks_u_3 + 1;
+#endif
+        const double t_8 = h_0*(m_g1 + t_4*t_6);
         const double t_9 = m_kappa_u_u*t_8;
         const double t_10 = ((m_v)*(m_v));
         const double t_11 = m_g5 + m_g7*t_10;
         const double t_12 = m_g3 + t_10*t_11;
-        const double t_13 = m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[4] - S0_2*q[5]) + m_kc_v_3*(C0_3*q[8] - S0_3*q[9]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[5] + S0_2*q[4]) + m_ks_v_3*(C0_3*q[9] + S0_3*q[8]) + 1;
-        const double t_14 = t_13*(m_g1 + t_10*t_12);
+#if !(GS_SHARED_0 && GS_SHARED_28 && GS_SHARED_29 && GS_SHARED_30 && GS_SHARED_31 && GS_SHARED_32 && GS_SHARED_33 && GS_SHARED_40)
+        const double h_1 = m_kc_v_1*(C0_1*q[0] - S0_1*q[1]) + m_kc_v_2*(C0_2*q[4] - S0_2*q[5]) + m_kc_v_3*(C0_3*q[8] - S0_3*q[9]) + m_ks_v_1*(C0_1*q[1] + S0_1*q[0]) + m_ks_v_2*(C0_2*q[5] + S0_2*q[4]) + m_ks_v_3*(C0_3*q[9] + S0_3*q[8]) + 1;
+#endif
+        const double t_14 = h_1*(m_g1 + t_10*t_12);
         const double t_15 = m_kappa_u_v*t_14;
         const double t_16 = ((m_w)*(m_w));
         const double t_17 = m_g5 + m_g7*t_16;
         const double t_18 = m_g3 + t_16*t_17;
-        const double t_19 = m_kc_w_1*(C0_1*q[2] - S0_1*q[3]) + m_kc_w_2*(C0_2*q[6] - S0_2*q[7]) + m_kc_w_3*(C0_3*q[10] - S0_3*q[11]) + m_ks_w_1*(C0_1*q[3] + S0_1*q[2]) + m_ks_w_2*(C0_2*q[7] + S0_2*q[6]) + m_ks_w_3*(C0_3*q[11] + S0_3*q[10]) + 1;
-        const double t_20 = t_19*(m_g1 + t_16*t_18);
+#if !(GS_SHARED_0 && GS_SHARED_34 && GS_SHARED_35 && GS_SHARED_36 && GS_SHARED_37 && GS_SHARED_38 && GS_SHARED_39 && GS_SHARED_41)
+        const double h_2 = m_kc_w_1*(C0_1*q[2] - S0_1*q[3]) + m_kc_w_2*(C0_2*q[6] - S0_2*q[7]) + m_kc_w_3*(C0_3*q[10] - S0_3*q[11]) + m_ks_w_1*(C0_1*q[3] + S0_1*q[2]) + m_ks_w_2*(C0_2*q[7] + S0_2*q[6]) + m_ks_w_3*(C0_3*q[11] + S0_3*q[10]) + 1;
+#endif
+        const double t_20 = h_2*(m_g1 + t_16*t_18);
         const double t_21 = m_kappa_u_w*t_20;
         const double t_22 = m_kappa_v_u*t_8;
         const double t_23 = m_kappa_v_v*t_14;
@@ -643,18 +709,26 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double t_29 = 2*w4;
         const double t_30 = 2*w5;
         const double t_31 = 2*m_u;
-        const double t_32 = 2*m_g7;
-        const double t_33 = t_7*m_u*(t_31*t_6 + t_4*(t_31*t_5 + t_32*((m_u)*(m_u)*(m_u))));
+        const double t_33 = h_0*m_u*(t_31*t_6 + t_4*(t_31*t_5 + q[19]*((m_u)*(m_u)*(m_u))));
         const double t_34 = 2*m_v;
-        const double t_35 = t_13*m_v*(t_10*(t_11*t_34 + t_32*((m_v)*(m_v)*(m_v))) + t_12*t_34);
+        const double t_35 = h_1*m_v*(t_10*(t_11*t_34 + q[19]*((m_v)*(m_v)*(m_v))) + t_12*t_34);
         const double t_36 = 2*m_w;
-        const double t_37 = t_19*m_w*(t_16*(t_17*t_36 + t_32*((m_w)*(m_w)*(m_w))) + t_18*t_36);
+        const double t_37 = h_2*m_w*(t_16*(t_17*t_36 + q[19]*((m_w)*(m_w)*(m_w))) + t_18*t_36);
         DX[0*n + j] = m_du;
         DX[1*n + j] = m_dv;
         DX[2*n + j] = m_dw;
-        DX[3*n + j] = -m_E_u_1*t_3*(C0_1*q[12] - S0_1*q[13]) + m_f_u - t_0*m_xi_u_u - t_1*m_xi_u_v - t_15*m_v - t_2*m_xi_u_w - t_21*m_w - t_9*m_u;
-        DX[4*n + j] = -m_E_v_1*t_3*(C0_1*q[14] - S0_1*q[15]) + m_f_v - t_0*m_xi_v_u - t_1*m_xi_v_v - t_2*m_xi_v_w - t_22*m_u - t_23*m_v - t_24*m_w;
-        DX[5*n + j] = -m_E_w_1*t_3*(C0_1*q[16] - S0_1*q[17]) + m_f_w - t_0*m_xi_w_u - t_1*m_xi_w_v - t_2*m_xi_w_w - t_25*m_u - t_26*m_v - t_27*m_w;
+#if !(GS_SHARED_0 && GS_SHARED_42 && GS_SHARED_43)
+        const double h_3 = -m_E_u_1*q[18]*(C0_1*q[12] - S0_1*q[13]);
+#endif
+        DX[3*n + j] = h_3 + m_f_u - t_0*m_xi_u_u - t_1*m_xi_u_v - t_15*m_v - t_2*m_xi_u_w - t_21*m_w - t_9*m_u;
+#if !(GS_SHARED_0 && GS_SHARED_40 && GS_SHARED_44 && GS_SHARED_45)
+        const double h_4 = -m_E_v_1*q[18]*(C0_1*q[14] - S0_1*q[15]);
+#endif
+        DX[4*n + j] = h_4 + m_f_v - t_0*m_xi_v_u - t_1*m_xi_v_v - t_2*m_xi_v_w - t_22*m_u - t_23*m_v - t_24*m_w;
+#if !(GS_SHARED_0 && GS_SHARED_41 && GS_SHARED_46 && GS_SHARED_47)
+        const double h_5 = -m_E_w_1*q[18]*(C0_1*q[16] - S0_1*q[17]);
+#endif
+        DX[5*n + j] = h_5 + m_f_w - t_0*m_xi_w_u - t_1*m_xi_w_v - t_2*m_xi_w_w - t_25*m_u - t_26*m_v - t_27*m_w;
         DX[6*n + j] = w3;
         DX[7*n + j] = w4;
         DX[8*n + j] = w5;

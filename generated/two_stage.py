@@ -325,10 +325,11 @@ C_SOURCE = r"""
 /* two_stage: right-hand side for the compiled integrators (gearsym derive). */
 #define GS_NX 30
 #define GS_NP 108
-#define GS_NQ 8
+#define GS_NQ 9
 
 static void gs_prep(const double *p, double *q)
 {
+    const double m_omega = p[0];
     const double m_phi_u = p[101];
     const double m_psi_u_1 = p[103];
     q[0] = cos(m_phi_u);
@@ -339,6 +340,7 @@ static void gs_prep(const double *p, double *q)
     q[5] = -sin(3*m_phi_u);
     q[6] = cos(m_phi_u - m_psi_u_1);
     q[7] = -sin(m_phi_u - m_psi_u_1);
+    q[8] = ((m_omega)*(m_omega));
     (void)p; (void)q;
 }
 
@@ -544,6 +546,8 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     (void)tau; (void)p; (void)q;
 }
 
+/* -DGS_SHARED_k=1 declares parameter k equal for all points: the terms of the time
+ * and of shared parameters alone are then computed once, before the loop. */
 static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
 {
     const double th0 = (P[0*n])*tau;
@@ -558,6 +562,15 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     const double S0_5 = S0_4*C0_1 + C0_4*S0_1;
     const double C0_6 = C0_5*C0_1 - S0_5*S0_1;
     const double S0_6 = S0_5*C0_1 + C0_5*S0_1;
+#if GS_SHARED_0 && GS_SHARED_89 && GS_SHARED_90 && GS_SHARED_91 && GS_SHARED_92 && GS_SHARED_93 && GS_SHARED_94
+    const double h_0 = C0_1*P[89*n] + C0_2*P[91*n] + C0_3*P[93*n] + S0_1*P[90*n] + S0_2*P[92*n] + S0_3*P[94*n] + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_95 && GS_SHARED_96 && GS_SHARED_97 && GS_SHARED_98 && GS_SHARED_99 && GS_SHARED_100 && GS_SHARED_101
+    const double h_1 = P[95*n]*(C0_2*Q[0*n] - S0_2*Q[1*n]) + P[97*n]*(C0_4*Q[2*n] - S0_4*Q[3*n]) + P[99*n]*(C0_6*Q[4*n] - S0_6*Q[5*n]) + P[96*n]*(C0_2*Q[1*n] + S0_2*Q[0*n]) + P[98*n]*(C0_4*Q[3*n] + S0_4*Q[2*n]) + P[100*n]*(C0_6*Q[5*n] + S0_6*Q[4*n]) + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_101 && GS_SHARED_102 && GS_SHARED_103
+    const double h_2 = -4*P[102*n]*Q[8*n]*(C0_2*Q[6*n] - S0_2*Q[7*n]);
+#endif
 #pragma GCC ivdep
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
@@ -592,7 +605,6 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double m_dxd = X[27*n + j];
         const double m_dyd = X[28*n + j];
         const double m_dzd = X[29*n + j];
-        const double m_omega = P[0*n + j];
         const double m_f_v = P[1*n + j];
         const double m_f_u = P[2*n + j];
         const double m_xi_v_v = P[3*n + j];
@@ -707,7 +719,10 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double t_6 = 2*m_dzc;
         const double t_7 = 2*m_dzd;
         const double t_8 = ((m_v)*(m_v));
-        const double t_9 = m_v*(m_g1 + t_8*(m_g3 + t_8*(m_g5 + m_g7*t_8)))*(C0_1*m_kc_v_1 + C0_2*m_kc_v_2 + C0_3*m_kc_v_3 + S0_1*m_ks_v_1 + S0_2*m_ks_v_2 + S0_3*m_ks_v_3 + 1);
+#if !(GS_SHARED_0 && GS_SHARED_89 && GS_SHARED_90 && GS_SHARED_91 && GS_SHARED_92 && GS_SHARED_93 && GS_SHARED_94)
+        const double h_0 = C0_1*m_kc_v_1 + C0_2*m_kc_v_2 + C0_3*m_kc_v_3 + S0_1*m_ks_v_1 + S0_2*m_ks_v_2 + S0_3*m_ks_v_3 + 1;
+#endif
+        const double t_9 = m_v*(m_g1 + t_8*(m_g3 + t_8*(m_g5 + m_g7*t_8)))*(h_0);
         const double t_10 = 2*m_du;
         const double t_11 = 2*m_dxa;
         const double t_12 = 2*m_dxb;
@@ -716,7 +731,10 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double t_15 = 2*m_dza;
         const double t_16 = 2*m_dzb;
         const double t_17 = ((m_u)*(m_u));
-        const double t_18 = m_u*(m_g1 + t_17*(m_g3 + t_17*(m_g5 + m_g7*t_17)))*(m_kc_u_1*(C0_2*q[0] - S0_2*q[1]) + m_kc_u_2*(C0_4*q[2] - S0_4*q[3]) + m_kc_u_3*(C0_6*q[4] - S0_6*q[5]) + m_ks_u_1*(C0_2*q[1] + S0_2*q[0]) + m_ks_u_2*(C0_4*q[3] + S0_4*q[2]) + m_ks_u_3*(C0_6*q[5] + S0_6*q[4]) + 1);
+#if !(GS_SHARED_0 && GS_SHARED_95 && GS_SHARED_96 && GS_SHARED_97 && GS_SHARED_98 && GS_SHARED_99 && GS_SHARED_100 && GS_SHARED_101)
+        const double h_1 = m_kc_u_1*(C0_2*q[0] - S0_2*q[1]) + m_kc_u_2*(C0_4*q[2] - S0_4*q[3]) + m_kc_u_3*(C0_6*q[4] - S0_6*q[5]) + m_ks_u_1*(C0_2*q[1] + S0_2*q[0]) + m_ks_u_2*(C0_4*q[3] + S0_4*q[2]) + m_ks_u_3*(C0_6*q[5] + S0_6*q[4]) + 1;
+#endif
+        const double t_18 = m_u*(m_g1 + t_17*(m_g3 + t_17*(m_g5 + m_g7*t_17)))*(h_1);
         DX[0*n + j] = m_dv;
         DX[1*n + j] = m_du;
         DX[2*n + j] = m_dw;
@@ -733,7 +751,10 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         DX[13*n + j] = m_dyd;
         DX[14*n + j] = m_dzd;
         DX[15*n + j] = m_f_v - m_kappa_v_v*t_9 - m_kappa_v_w*m_w - m_kappa_v_xc*m_xc - m_kappa_v_xd*m_xd - m_kappa_v_yc*m_yc - m_kappa_v_yd*m_yd - m_kappa_v_zc*m_zc - m_kappa_v_zd*m_zd - t_0*m_xi_v_v - t_1*m_xi_v_w - t_2*m_xi_v_xc - t_3*m_xi_v_xd - t_4*m_xi_v_yc - t_5*m_xi_v_yd - t_6*m_xi_v_zc - t_7*m_xi_v_zd;
-        DX[16*n + j] = -4*m_E_u_1*((m_omega)*(m_omega))*(C0_2*q[6] - S0_2*q[7]) + m_f_u - m_kappa_u_u*t_18 - m_kappa_u_w*m_w - m_kappa_u_xa*m_xa - m_kappa_u_xb*m_xb - m_kappa_u_ya*m_ya - m_kappa_u_yb*m_yb - m_kappa_u_za*m_za - m_kappa_u_zb*m_zb - t_1*m_xi_u_w - t_10*m_xi_u_u - t_11*m_xi_u_xa - t_12*m_xi_u_xb - t_13*m_xi_u_ya - t_14*m_xi_u_yb - t_15*m_xi_u_za - t_16*m_xi_u_zb;
+#if !(GS_SHARED_0 && GS_SHARED_101 && GS_SHARED_102 && GS_SHARED_103)
+        const double h_2 = -4*m_E_u_1*q[8]*(C0_2*q[6] - S0_2*q[7]);
+#endif
+        DX[16*n + j] = h_2 + m_f_u - m_kappa_u_u*t_18 - m_kappa_u_w*m_w - m_kappa_u_xa*m_xa - m_kappa_u_xb*m_xb - m_kappa_u_ya*m_ya - m_kappa_u_yb*m_yb - m_kappa_u_za*m_za - m_kappa_u_zb*m_zb - t_1*m_xi_u_w - t_10*m_xi_u_u - t_11*m_xi_u_xa - t_12*m_xi_u_xb - t_13*m_xi_u_ya - t_14*m_xi_u_yb - t_15*m_xi_u_za - t_16*m_xi_u_zb;
         DX[17*n + j] = -m_kappa_w_u*t_18 - m_kappa_w_v*t_9 - m_kappa_w_w*m_w - t_0*m_xi_w_v - t_1*m_xi_w_w - t_10*m_xi_w_u;
         DX[18*n + j] = -m_kappa_xa_u*t_18 - m_kappa_xa_xa*m_xa - t_10*m_xi_xa_u - t_11*m_xi_xa_xa;
         DX[19*n + j] = -m_kappa_ya_u*t_18 - m_kappa_ya_ya*m_ya - t_10*m_xi_ya_u - t_13*m_xi_ya_ya;
@@ -757,12 +778,14 @@ C_SOURCE_VARIATIONAL = r"""
 /* two_stage: right-hand side with the variational equations for the compiled integrators (gearsym derive). */
 #define GS_NX 60
 #define GS_NP 108
-#define GS_NQ 8
+#define GS_NQ 10
 
 static void gs_prep(const double *p, double *q)
 {
+    const double m_omega = p[0];
     const double m_phi_u = p[101];
     const double m_psi_u_1 = p[103];
+    const double m_g7 = p[107];
     q[0] = cos(m_phi_u);
     q[1] = -sin(m_phi_u);
     q[2] = cos(2*m_phi_u);
@@ -771,6 +794,8 @@ static void gs_prep(const double *p, double *q)
     q[5] = -sin(3*m_phi_u);
     q[6] = cos(m_phi_u - m_psi_u_1);
     q[7] = -sin(m_phi_u - m_psi_u_1);
+    q[8] = 2*m_g7;
+    q[9] = ((m_omega)*(m_omega));
     (void)p; (void)q;
 }
 
@@ -1078,6 +1103,8 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
     (void)tau; (void)p; (void)q;
 }
 
+/* -DGS_SHARED_k=1 declares parameter k equal for all points: the terms of the time
+ * and of shared parameters alone are then computed once, before the loop. */
 static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P, const double *restrict Q, double *restrict DX)
 {
     const double th0 = (P[0*n])*tau;
@@ -1092,6 +1119,15 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
     const double S0_5 = S0_4*C0_1 + C0_4*S0_1;
     const double C0_6 = C0_5*C0_1 - S0_5*S0_1;
     const double S0_6 = S0_5*C0_1 + C0_5*S0_1;
+#if GS_SHARED_0 && GS_SHARED_89 && GS_SHARED_90 && GS_SHARED_91 && GS_SHARED_92 && GS_SHARED_93 && GS_SHARED_94
+    const double h_0 = C0_1*P[89*n] + C0_2*P[91*n] + C0_3*P[93*n] + S0_1*P[90*n] + S0_2*P[92*n] + S0_3*P[94*n] + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_95 && GS_SHARED_96 && GS_SHARED_97 && GS_SHARED_98 && GS_SHARED_99 && GS_SHARED_100 && GS_SHARED_101
+    const double h_1 = P[95*n]*(C0_2*Q[0*n] - S0_2*Q[1*n]) + P[97*n]*(C0_4*Q[2*n] - S0_4*Q[3*n]) + P[99*n]*(C0_6*Q[4*n] - S0_6*Q[5*n]) + P[96*n]*(C0_2*Q[1*n] + S0_2*Q[0*n]) + P[98*n]*(C0_4*Q[3*n] + S0_4*Q[2*n]) + P[100*n]*(C0_6*Q[5*n] + S0_6*Q[4*n]) + 1;
+#endif
+#if GS_SHARED_0 && GS_SHARED_101 && GS_SHARED_102 && GS_SHARED_103
+    const double h_2 = -4*P[102*n]*Q[9*n]*(C0_2*Q[6*n] - S0_2*Q[7*n]);
+#endif
 #pragma GCC ivdep
     for (int j = 0; j < n; ++j) {
         double q[GS_NQ];
@@ -1156,7 +1192,6 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double w27 = X[57*n + j];
         const double w28 = X[58*n + j];
         const double w29 = X[59*n + j];
-        const double m_omega = P[0*n + j];
         const double m_f_v = P[1*n + j];
         const double m_f_u = P[2*n + j];
         const double m_xi_v_v = P[3*n + j];
@@ -1273,8 +1308,10 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double t_8 = ((m_v)*(m_v));
         const double t_9 = m_g5 + m_g7*t_8;
         const double t_10 = m_g3 + t_8*t_9;
-        const double t_11 = C0_1*m_kc_v_1 + C0_2*m_kc_v_2 + C0_3*m_kc_v_3 + S0_1*m_ks_v_1 + S0_2*m_ks_v_2 + S0_3*m_ks_v_3 + 1;
-        const double t_12 = t_11*(m_g1 + t_10*t_8);
+#if !(GS_SHARED_0 && GS_SHARED_89 && GS_SHARED_90 && GS_SHARED_91 && GS_SHARED_92 && GS_SHARED_93 && GS_SHARED_94)
+        const double h_0 = C0_1*m_kc_v_1 + C0_2*m_kc_v_2 + C0_3*m_kc_v_3 + S0_1*m_ks_v_1 + S0_2*m_ks_v_2 + S0_3*m_ks_v_3 + 1;
+#endif
+        const double t_12 = h_0*(m_g1 + t_10*t_8);
         const double t_13 = m_kappa_v_v*t_12;
         const double t_14 = 2*m_du;
         const double t_15 = 2*m_dxa;
@@ -1286,8 +1323,10 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double t_21 = ((m_u)*(m_u));
         const double t_22 = m_g5 + m_g7*t_21;
         const double t_23 = m_g3 + t_21*t_22;
-        const double t_24 = m_kc_u_1*(C0_2*q[0] - S0_2*q[1]) + m_kc_u_2*(C0_4*q[2] - S0_4*q[3]) + m_kc_u_3*(C0_6*q[4] - S0_6*q[5]) + m_ks_u_1*(C0_2*q[1] + S0_2*q[0]) + m_ks_u_2*(C0_4*q[3] + S0_4*q[2]) + m_ks_u_3*(C0_6*q[5] + S0_6*q[4]) + 1;
-        const double t_25 = t_24*(m_g1 + t_21*t_23);
+#if !(GS_SHARED_0 && GS_SHARED_95 && GS_SHARED_96 && GS_SHARED_97 && GS_SHARED_98 && GS_SHARED_99 && GS_SHARED_100 && GS_SHARED_101)
+        const double h_1 = m_kc_u_1*(C0_2*q[0] - S0_2*q[1]) + m_kc_u_2*(C0_4*q[2] - S0_4*q[3]) + m_kc_u_3*(C0_6*q[4] - S0_6*q[5]) + m_ks_u_1*(C0_2*q[1] + S0_2*q[0]) + m_ks_u_2*(C0_4*q[3] + S0_4*q[2]) + m_ks_u_3*(C0_6*q[5] + S0_6*q[4]) + 1;
+#endif
+        const double t_25 = h_1*(m_g1 + t_21*t_23);
         const double t_26 = m_kappa_u_u*t_25;
         const double t_27 = m_kappa_w_v*t_12;
         const double t_28 = m_kappa_w_u*t_25;
@@ -1312,8 +1351,7 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double t_47 = 2*w28;
         const double t_48 = 2*w29;
         const double t_49 = 2*m_v;
-        const double t_50 = 2*m_g7;
-        const double t_51 = t_11*m_v*(t_10*t_49 + t_8*(t_49*t_9 + t_50*((m_v)*(m_v)*(m_v))));
+        const double t_51 = h_0*m_v*(t_10*t_49 + t_8*(t_49*t_9 + q[8]*((m_v)*(m_v)*(m_v))));
         const double t_52 = 2*w16;
         const double t_53 = 2*w18;
         const double t_54 = 2*w19;
@@ -1322,7 +1360,7 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         const double t_57 = 2*w22;
         const double t_58 = 2*w23;
         const double t_59 = 2*m_u;
-        const double t_60 = t_24*m_u*(t_21*(t_22*t_59 + t_50*((m_u)*(m_u)*(m_u))) + t_23*t_59);
+        const double t_60 = h_1*m_u*(t_21*(t_22*t_59 + q[8]*((m_u)*(m_u)*(m_u))) + t_23*t_59);
         DX[0*n + j] = m_dv;
         DX[1*n + j] = m_du;
         DX[2*n + j] = m_dw;
@@ -1339,7 +1377,10 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
         DX[13*n + j] = m_dyd;
         DX[14*n + j] = m_dzd;
         DX[15*n + j] = m_f_v - m_kappa_v_w*m_w - m_kappa_v_xc*m_xc - m_kappa_v_xd*m_xd - m_kappa_v_yc*m_yc - m_kappa_v_yd*m_yd - m_kappa_v_zc*m_zc - m_kappa_v_zd*m_zd - t_0*m_xi_v_v - t_1*m_xi_v_w - t_13*m_v - t_2*m_xi_v_xc - t_3*m_xi_v_xd - t_4*m_xi_v_yc - t_5*m_xi_v_yd - t_6*m_xi_v_zc - t_7*m_xi_v_zd;
-        DX[16*n + j] = -4*m_E_u_1*((m_omega)*(m_omega))*(C0_2*q[6] - S0_2*q[7]) + m_f_u - m_kappa_u_w*m_w - m_kappa_u_xa*m_xa - m_kappa_u_xb*m_xb - m_kappa_u_ya*m_ya - m_kappa_u_yb*m_yb - m_kappa_u_za*m_za - m_kappa_u_zb*m_zb - t_1*m_xi_u_w - t_14*m_xi_u_u - t_15*m_xi_u_xa - t_16*m_xi_u_xb - t_17*m_xi_u_ya - t_18*m_xi_u_yb - t_19*m_xi_u_za - t_20*m_xi_u_zb - t_26*m_u;
+#if !(GS_SHARED_0 && GS_SHARED_101 && GS_SHARED_102 && GS_SHARED_103)
+        const double h_2 = -4*m_E_u_1*q[9]*(C0_2*q[6] - S0_2*q[7]);
+#endif
+        DX[16*n + j] = h_2 + m_f_u - m_kappa_u_w*m_w - m_kappa_u_xa*m_xa - m_kappa_u_xb*m_xb - m_kappa_u_ya*m_ya - m_kappa_u_yb*m_yb - m_kappa_u_za*m_za - m_kappa_u_zb*m_zb - t_1*m_xi_u_w - t_14*m_xi_u_u - t_15*m_xi_u_xa - t_16*m_xi_u_xb - t_17*m_xi_u_ya - t_18*m_xi_u_yb - t_19*m_xi_u_za - t_20*m_xi_u_zb - t_26*m_u;
         DX[17*n + j] = -m_kappa_w_w*m_w - t_0*m_xi_w_v - t_1*m_xi_w_w - t_14*m_xi_w_u - t_27*m_v - t_28*m_u;
         DX[18*n + j] = -m_kappa_xa_xa*m_xa - t_14*m_xi_xa_u - t_15*m_xi_xa_xa - t_29*m_u;
         DX[19*n + j] = -m_kappa_ya_ya*m_ya - t_14*m_xi_ya_u - t_17*m_xi_ya_ya - t_30*m_u;

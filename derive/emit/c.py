@@ -6,10 +6,14 @@ The same SymPy expressions as the NumPy and CasADi code, rewritten for speed:
   becomes a polynomial in ``cos(w tau)``, ``sin(w tau)`` (one pair per distinct ``w``, the
   harmonics by the angle-addition recurrence) and ``cos B``, ``sin B``, which depend on the
   parameters only and are computed once per parameter set by ``gs_prep``;
-* common subexpressions are eliminated and small integer powers are multiplications.
+* common subexpressions are eliminated and small integer powers are multiplications;
+* in the batched form, the terms free of the states are computed off the per-point path
+  (:class:`_Hoist`): those of the parameters alone once per point by ``gs_prep``, those of
+  the time once per call for the whole batch when the parameters they read are shared.
 
-The C text defines ``GS_NX``, ``GS_NP``, ``GS_NQ``, ``gs_prep(p, q)`` and
-``gs_rhs(tau, x, p, q, dx)``; it is stored in the generated module as ``C_SOURCE``.
+The C text defines ``GS_NX``, ``GS_NP``, ``GS_NQ``, ``gs_prep(p, q)``,
+``gs_rhs(tau, x, p, q, dx)`` and ``gs_rhs_batch(tau, n, X, P, Q, DX)``; it is stored in the
+generated module as ``C_SOURCE``.
 """
 
 from __future__ import annotations
@@ -31,9 +35,37 @@ class _Printer(C99CodePrinter):
     def __init__(self, names: dict | None = None):
         super().__init__()
         self.names = names or {}
+        self.hoist: _Hoist | None = None  # set while printing gs_rhs_batch and gs_prep
+        self.where = "loop"  # "loop" (per point), "pre" (before the loop) or "prep"
+        self.mode = "off"  # which terms become hoisted symbols: "off", "q" or "all"
+        self.seen: set = set()  # model symbols printed in the loop
+        self._top = False  # the next node is a definition's own: printed, not replaced
+
+    def text(self, expr, where: str, mode: str, top: bool = False) -> str:
+        """``expr`` printed for ``where`` with the terms ``mode`` names replaced by their
+        hoisted symbols (``top``: not ``expr`` itself, whose definition this is)."""
+        self.where, self.mode, self._top = where, mode, top
+        try:
+            return self.doprint(expr)
+        finally:
+            self.mode, self._top = "off", False
+
+    def _print(self, expr, **kwargs):
+        if self.mode != "off" and not self._top:
+            sym = self.hoist.unit(expr, tau=self.mode == "all")
+            if sym is not None:
+                return self._print_Symbol(sym)
+        self._top = False
+        return super()._print(expr, **kwargs)
 
     def _print_Symbol(self, expr):
+        if self.hoist is not None:
+            expr = self.hoist.alias.get(expr, expr)
+            if self.where == "pre" and expr in self.hoist.pre_names:
+                return self.hoist.pre_names[expr]
         if expr in self.names:
+            if self.where == "loop":
+                self.seen.add(expr)
             return self.names[expr]
         return super()._print_Symbol(expr)
 
@@ -134,15 +166,141 @@ def _harmonic_lines(bases, printer, substitute=None) -> list[str]:
     return lines
 
 
-def c_source(model: Model, variational: bool = False) -> str:
-    """C text of ``gs_prep`` and ``gs_rhs`` for ``model``; with ``variational`` for the
-    state extended by a tangent vector ``w``: ``(x, w)' = (F(tau, x), J(tau, x) w)``."""
-    printer = _Printer(code_names((*model.state_symbols, *model.parameter_symbols)))
-    tau = (
-        next(s for e in model.rhs for s in e.free_symbols if s.name == "tau")
-        if any(s.name == "tau" for e in model.rhs for s in e.free_symbols)
-        else sp.Symbol("tau")
+def _trivial(expr) -> bool:
+    """A symbol, a number or its negation: nothing to compute, nothing to hoist."""
+    return expr.is_Atom or (
+        expr.is_Mul and len(expr.args) == 2 and expr.args[0] == -1 and expr.args[1].is_Atom
     )
+
+
+class _Hoist:
+    """The terms of ``gs_rhs_batch`` that its loop over points need not compute.
+
+    Each symbol is classified by what it depends on (``deps``: a state, the time, the set
+    of parameter indices ``k``, as in ``P[k*n + j]``); a term free of the states is a
+    *Q unit* ``q[i]`` when it reads parameters only (run once per point by ``gs_prep``
+    into ``Q``), a *tau unit* ``h_i`` when it reads the time too (the stiffness and
+    transmission-error harmonics at the step's time with their coefficients): computed
+    once per call before the loop when every ``k`` it reads is declared shared
+    (``-DGS_SHARED_k=1``), in the loop otherwise.  Units are found top-down while printing,
+    each a whole operand where it stands: the arithmetic and its order stay the loop's.
+    """
+
+    def __init__(self, states, params: dict, tau, bases: dict, q_defs: dict):
+        # symbol -> (state: bool, tau: bool, parameter indices); the harmonics C{i}_{k},
+        # S{i}_{k} read the time and the parameters of their frequency
+        self.deps = {s: (True, False, ()) for s in states}
+        self.deps.update({s: (False, False, (k,)) for s, k in params.items()})
+        self.deps[tau] = (False, True, ())
+        for w, (i, top) in bases.items():
+            on = (False, True, tuple(params[s] for s in w.free_symbols if s in params))
+            self.deps.update(
+                {sp.Symbol(f"{cs}{i}_{k}"): on for k in range(1, top + 1) for cs in "CS"}
+            )
+        self.n_q = len(q_defs)
+        self.q_units: dict = {}  # parameter-only term -> q[i] (i after the trig q's)
+        self.tau_units: dict = {}  # time-dependent term -> h_i
+        self.fresh: list = []  # tau units not yet given their definitions
+        self.alias: dict = {}  # CSE symbol whose whole value is a unit -> the unit
+        self.pre_names = {s: f"P[{k}*n]" for s, k in params.items()}
+        for e, sym in q_defs.items():
+            self.deps[sym] = (False, False, self.of(e)[2])
+            self.pre_names[sym] = f"Q[{sym.name[2:-1]}*n]"
+
+    def of(self, expr) -> tuple[bool, bool, frozenset]:
+        """What ``expr`` depends on; an unknown symbol counts as a state (never hoisted)."""
+        state, tau, params = False, False, set()
+        for s in expr.free_symbols:
+            d_state, d_tau, d_params = self.deps.get(s, (True, False, ()))
+            state, tau = state or d_state, tau or d_tau
+            params.update(d_params)
+        return state, tau, frozenset(params)
+
+    def unit(self, expr, tau: bool):
+        """The symbol standing for ``expr`` if it is a unit (``tau``: time-dependent ones
+        too), else None."""
+        if not isinstance(expr, sp.Expr) or _trivial(expr):
+            return None
+        state, on_tau, params = self.of(expr)
+        if state or (on_tau and not tau):
+            return None
+        units = self.tau_units if on_tau else self.q_units
+        if expr not in units:
+            if on_tau:
+                sym = sp.Symbol(f"h_{len(units)}")
+                self.fresh.append(expr)
+            else:
+                sym = sp.Symbol(f"q[{self.n_q}]")
+                self.pre_names[sym] = f"Q[{self.n_q}*n]"
+                self.n_q += 1
+            units[expr] = sym
+            self.deps[sym] = (False, on_tau, params)
+        return units[expr]
+
+
+def _guarded(rows, indent: str, negate: bool) -> list[str]:
+    """``(parameter indices, line)`` rows in ``#if`` blocks, one per run of equal indices:
+    kept when every parameter read is shared (``negate``: when one is not); a row that
+    reads none is kept unguarded (before the loop) or dropped (in it)."""
+    lines, open_ = [], None
+    for params, line in rows:
+        if params != open_ and open_ is not None:
+            lines.append("#endif")
+            open_ = None
+        if not params:
+            if not negate:
+                lines.append(indent + line)
+            continue
+        if open_ is None:
+            cond = " && ".join(f"GS_SHARED_{k}" for k in sorted(params))
+            lines.append(f"#if !({cond})" if negate else f"#if {cond}")
+            open_ = params
+        lines.append(indent + line)
+    if open_ is not None:
+        lines.append("#endif")
+    return lines
+
+
+def _batch(printer, hoist, replacements, reduced) -> tuple[list[str], list[str]]:
+    """Lines of ``gs_rhs_batch`` before its loop over points and inside it.
+
+    Each CSE replacement and output is printed with its units named (:class:`_Hoist`);
+    a replacement that is a unit as a whole becomes an alias of it.  The definitions of
+    the tau units met in a statement go before the loop, guarded by ``#if`` on the
+    parameters they read, and again just before that statement in the loop, guarded by
+    the negation: with no ``GS_SHARED_k`` defined the loop computes what it did before."""
+    pre, body = [], []
+
+    def settle(line: str | None = None):  # the fresh tau units' definitions, then line
+        rows = []
+        for expr in hoist.fresh:
+            sym = hoist.tau_units[expr]
+            for where, out in (("pre", pre), ("loop", rows)):
+                code = printer.text(expr, where, "q", top=True)
+                out.append((hoist.deps[sym][2], f"const double {sym.name} = {code};"))
+        hoist.fresh.clear()
+        body.extend([*_guarded(rows, "        ", negate=True), *([line] if line else [])])
+
+    for sym, expr in replacements:
+        hoist.deps[sym] = hoist.of(expr)
+        unit = hoist.unit(expr, tau=True)
+        if unit is not None:
+            hoist.alias[sym] = unit
+            settle()
+        else:
+            settle(f"        const double {sym.name} = {printer.text(expr, 'loop', 'all')};")
+    for k, expr in enumerate(reduced):
+        settle(f"        DX[{k}*n + j] = {printer.text(expr, 'loop', 'all')};")
+    return _guarded(pre, "    ", negate=False), body
+
+
+def c_source(model: Model, variational: bool = False) -> str:
+    """C text of ``gs_prep``, ``gs_rhs`` and ``gs_rhs_batch`` for ``model``; with
+    ``variational`` for the state extended by a tangent vector ``w``:
+    ``(x, w)' = (F(tau, x), J(tau, x) w)``."""
+    printer = _Printer(code_names((*model.state_symbols, *model.parameter_symbols)))
+    found = (s for e in model.rhs for s in e.free_symbols if s.name == "tau")
+    tau = next(found, sp.Symbol("tau"))
     states = list(model.state_symbols)
     exprs = list(model.rhs)
     if variational:
@@ -156,29 +314,14 @@ def c_source(model: Model, variational: bool = False) -> str:
     n, m = len(states), len(model.parameters)
     params = {s: k for k, s in enumerate(model.parameter_symbols)}
 
-    def unpack(symbols, used, indent="    "):
+    def unpack(used):  # the parameters in ``used``, in their order
         return [
-            f"{indent}const double {printer.doprint(s)} = p[{params[s]}];"
-            for s in symbols
+            f"    const double {printer.doprint(s)} = p[{k}];"
+            for s, k in params.items()
             if s in used
         ]
 
-    prep_used = set().union(*(e.free_symbols for e in q_defs)) if q_defs else set()
-    what = " with the variational equations" if variational else ""
-    lines = [
-        f"/* {text(model.name)}: right-hand side{what} for the compiled integrators "
-        "(gearsym derive). */",
-        f"#define GS_NX {n}",
-        f"#define GS_NP {m}",
-        f"#define GS_NQ {max(len(q_defs), 1)}",
-        "",
-        "static void gs_prep(const double *p, double *q)",
-        "{",
-        *unpack(model.parameter_symbols, prep_used),
-        *(f"    {sym.name} = {printer.doprint(e)};" for e, sym in q_defs.items()),
-        "    (void)p; (void)q;",
-        "}",
-        "",
+    rhs = [
         "static inline void gs_rhs(double tau, const double *x, const double *p, "
         "const double *q, double *dx)",
         "{",
@@ -189,40 +332,68 @@ def c_source(model: Model, variational: bool = False) -> str:
     )
     for k, s in enumerate(states):
         if s in used:
-            lines.append(f"    const double {printer.doprint(s)} = x[{k}];")
-    base_used = set()
-    for w in bases:
-        base_used |= w.free_symbols
-    lines += unpack(model.parameter_symbols, used | base_used)
-    lines += _harmonic_lines(bases, printer)
+            rhs.append(f"    const double {printer.doprint(s)} = x[{k}];")
+    base_used = set().union(*(w.free_symbols for w in bases))
+    rhs += unpack(used | base_used)
+    rhs += _harmonic_lines(bases, printer)
     for sym, e in replacements:
-        lines.append(f"    const double {sym.name} = {printer.doprint(e)};")
+        rhs.append(f"    const double {sym.name} = {printer.doprint(e)};")
     for k, e in enumerate(reduced):
-        lines.append(f"    dx[{k}] = {printer.doprint(e)};")
-    lines += ["    (void)tau; (void)p; (void)q;", "}", ""]
+        rhs.append(f"    dx[{k}] = {printer.doprint(e)};")
+    rhs += ["    (void)tau; (void)p; (void)q;", "}", ""]
+
     # Batched form for lockstep integration: n points in structure-of-arrays layout
-    # (X[i*n + j] is state i of point j); the excitation terms are computed once for all
-    # points (they share the time and, by contract, the frequencies), the rest vectorises.
-    lines += [
+    # (X[i*n + j] is state i of point j); the excitation's harmonics are computed once for
+    # all points (they share the time and, by contract, the frequencies), and so is every
+    # term of time and shared parameters alone (_Hoist); the rest vectorises.
+    hoist = printer.hoist = _Hoist(states, params, tau, bases, q_defs)
+    printer.seen = set()
+    pre, body = _batch(printer, hoist, replacements, reduced)
+    batch = [
+        "/* -DGS_SHARED_k=1 declares parameter k equal for all points: the terms of the time",
+        " * and of shared parameters alone are then computed once, before the loop. */",
         "static void gs_rhs_batch(double tau, int n, const double *restrict X, "
         "const double *restrict P, const double *restrict Q, double *restrict DX)",
         "{",
+        *_harmonic_lines(bases, printer, {s: sp.Symbol(f"P[{k}*n]") for s, k in params.items()}),
+        *pre,
+        "#pragma GCC ivdep",
+        "    for (int j = 0; j < n; ++j) {",
     ]
-    first = {s: sp.Symbol(f"P[{params[s]}*n]") for s in model.parameter_symbols}
-    lines += _harmonic_lines(bases, printer, first)
-    lines += ["#pragma GCC ivdep", "    for (int j = 0; j < n; ++j) {"]
-    if q_defs:
-        lines.append("        double q[GS_NQ];")
-        lines.append("        for (int k = 0; k < GS_NQ; ++k) q[k] = Q[k*n + j];")
+    if hoist.n_q:
+        batch += [
+            "        double q[GS_NQ];",
+            "        for (int k = 0; k < GS_NQ; ++k) q[k] = Q[k*n + j];",
+        ]
     for k, s in enumerate(states):
         if s in used:
-            lines.append(f"        const double {printer.doprint(s)} = X[{k}*n + j];")
+            batch.append(f"        const double {printer.doprint(s)} = X[{k}*n + j];")
     for s in model.parameter_symbols:
-        if s in used:
-            lines.append(f"        const double {printer.doprint(s)} = P[{params[s]}*n + j];")
-    for sym, e in replacements:
-        lines.append(f"        const double {sym.name} = {printer.doprint(e)};")
-    for k, e in enumerate(reduced):
-        lines.append(f"        DX[{k}*n + j] = {printer.doprint(e)};")
-    lines += ["    }", "    (void)tau; (void)P; (void)Q;", "}", ""]
-    return "\n".join(lines)
+        if s in printer.seen:
+            batch.append(f"        const double {printer.doprint(s)} = P[{params[s]}*n + j];")
+    batch += [*body, "    }", "    (void)tau; (void)P; (void)Q;", "}", ""]
+
+    prep_used = set().union(*(e.free_symbols for e in (*q_defs, *hoist.q_units)))
+    prep = [
+        "static void gs_prep(const double *p, double *q)",
+        "{",
+        *unpack(prep_used),
+        *(
+            f"    {sym.name} = {printer.text(e, 'prep', 'off')};"
+            for e, sym in (*q_defs.items(), *hoist.q_units.items())
+        ),
+        "    (void)p; (void)q;",
+        "}",
+        "",
+    ]
+    printer.hoist = None
+    what = " with the variational equations" if variational else ""
+    head = [
+        f"/* {text(model.name)}: right-hand side{what} for the compiled integrators "
+        "(gearsym derive). */",
+        f"#define GS_NX {n}",
+        f"#define GS_NP {m}",
+        f"#define GS_NQ {max(hoist.n_q, 1)}",
+        "",
+    ]
+    return "\n".join([*head, *prep, *rhs, *batch])

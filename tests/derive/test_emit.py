@@ -211,3 +211,80 @@ def test_a_periodic_orbit_carries_the_static_force_on_average():
     tau = np.linspace(0.0, system.period, 1024, endpoint=False)
     F = system.module.mesh_force(tau, sol.at(tau), system.p)
     np.testing.assert_allclose(F.mean(axis=1), system.module.static_mesh_force(system.p), rtol=1e-9)
+
+
+_EVAL_BATCH = r"""
+#include <stdlib.h>
+void ev_batch(double tau, int n, const double *X, const double *P, double *DX)
+{
+    double *Q = malloc(sizeof(double) * GS_NQ * n), p[GS_NP], q[GS_NQ];
+    for (int j = 0; j < n; ++j) {
+        for (int k = 0; k < GS_NP; ++k) p[k] = P[k * n + j];
+        gs_prep(p, q);
+        for (int k = 0; k < GS_NQ; ++k) Q[k * n + j] = q[k];
+    }
+    gs_rhs_batch(tau, n, X, P, Q, DX);
+    free(Q);
+}
+"""
+
+
+def _batch_library(c_text, defines, folder):
+    """``c_text`` compiled as the engine compiles it (build._FLAGS) with ``defines``, and
+    its loop over points as the preprocessor leaves it."""
+    import ctypes
+    import subprocess
+
+    from gearsym.solver.integrate.native import build
+
+    cc = build.compiler()
+    if cc is None:
+        pytest.skip("no C compiler")
+    stem = folder / f"m{len(list(folder.glob('*.so')))}"  # a new name: dlopen caches by path
+    src, so = stem.with_suffix(".c"), stem.with_suffix(".so")
+    src.write_text("#include <math.h>\n" + c_text + _EVAL_BATCH)
+    subprocess.run([cc, *build._FLAGS, *defines, "-o", str(so), str(src), "-lm"], check=True)
+    pre = subprocess.run(
+        [cc, "-E", "-P", *defines, "-x", "c", "-"], input=c_text, text=True, capture_output=True
+    ).stdout
+    batch = pre[pre.index("gs_rhs_batch(") :]
+    lib = ctypes.CDLL(str(so))
+    ptr = np.ctypeslib.ndpointer(np.float64, flags="C")
+    lib.ev_batch.argtypes = [ctypes.c_double, ctypes.c_int, ptr, ptr, ptr]
+    return lib, batch[batch.index("for (int j") :]
+
+
+@pytest.mark.parametrize(
+    "scene, variational", [("reference-light", False), ("reference-dead-zone", True)]
+)
+def test_batch_with_shared_parameters_gives_the_same_dx(tmp_path, scene, variational):
+    # gs_rhs_batch computes the terms of the time and of parameters declared shared
+    # (-DGS_SHARED_k=1) once per call, before its loop over points; undeclared, in the
+    # loop. Same expressions in the same order: the same dx but for a multiply-add the
+    # compiler may fuse on one side only (-ffp-contract), an ulp or two.
+    from gearsym.derive.emit.c import c_source
+
+    model = derive_model(load_target(project_root() / "scenes" / f"{scene}.toml"))
+    c_text = c_source(model, variational=variational)
+    names = model.parameter_names
+    loads = [k for k, name in enumerate(names) if name.startswith("f_")]
+    first = next(k for k, name in enumerate(names) if name.startswith("kc_"))
+    last = max(k for k, name in enumerate(names) if name.startswith("ks_"))
+    nx, n = int(c_text.split("#define GS_NX ")[1].split()[0]), 33  # odd: a loop remainder
+    rng = np.random.default_rng(7)
+    every, in_loop = _batch_library(c_text, [], tmp_path)
+    assert "const double h_" in in_loop  # undeclared: the loop computes them
+    for varying in (loads, [*loads, first], [*loads, last]):
+        shared = [f"-DGS_SHARED_{k}=1" for k in range(len(names)) if k not in varying]
+        lib, loop = _batch_library(c_text, shared, tmp_path)
+        # a term of the time stays in the loop only where it reads a varying coefficient
+        assert ("const double h_" in loop) == (len(varying) > len(loads))
+        P = np.repeat(np.array([p.value for p in model.parameters])[:, None], n, axis=1)
+        P[varying] *= rng.uniform(0.5, 1.5, (len(varying), n))
+        for _ in range(20):
+            X, tau = rng.uniform(-2.0, 2.0, (nx, n)), rng.uniform(0.0, 200.0)
+            a, b = np.empty_like(X), np.empty_like(X)
+            every.ev_batch(tau, n, X, P, a)
+            lib.ev_batch(tau, n, X, P, b)
+            scale = np.max(np.abs(a), axis=1, keepdims=True)
+            assert np.all(np.abs(a - b) <= 1e-15 * scale), np.max(np.abs(a - b) / scale)
