@@ -35,13 +35,26 @@ _EXPORTS = {
     **{
         name: "gearsym.solver"
         for name in (
-            "METHODS", "Branch", "Contract", "FlowMap", "Orbit", "PointResult",
-            "ShootingError", "SimulationError", "StroboscopicMap", "SweepPoint",
-            "SweepResult", "System", "Trajectory", "continue_orbit", "shoot", "simulate",
+            "METHODS",
+            "Branch",
+            "Contract",
+            "FlowMap",
+            "Orbit",
+            "PointResult",
+            "ShootingError",
+            "SimulationError",
+            "StroboscopicMap",
+            "SweepPoint",
+            "SweepResult",
+            "System",
+            "Trajectory",
+            "continue_orbit",
+            "shoot",
+            "simulate",
             "switch_period_doubling",
         )
     },
-}  # fmt: skip
+}
 
 
 def __getattr__(name: str):

@@ -3,7 +3,15 @@
 * ``performance`` -- speed against accuracy of every integration back end (``gearsym bench``
   or ``python -m gearsym.benchmarks.performance``); writes ``performance.md`` and
   ``performance-pareto.png`` to an output folder, or to the checkout's ``docs/`` with
-  ``--docs``;
+  ``--docs``; its sections live in ``baseline`` (the reference model, the plain baseline
+  and the hand-written C), ``backends`` (sections 1-5) and ``sections`` (the appended
+  sections and the floors table);
+* ``peers`` -- the 400-point sweep by the engine, the hand-written lockstep reference and
+  JAX + diffrax (optional: skipped with the reason when absent), at equal accuracy, in one
+  run; ``rhs_cost`` -- floating-point operations per point and evaluation of the generated
+  batched right-hand side, with and without shared parameters;
+* ``floors`` -- this checkout against another one (``--before DIR``), alternating fresh
+  processes: the speed floors of the engine and whether the results are the same;
 * ``robustness`` -- the extremes matrix, every case with every back end
   (``python -m gearsym.benchmarks.robustness``; writes ``docs/robustness.md``, needs the
   checkout, whose tests list the bad-input cases);

@@ -25,8 +25,10 @@ def _models(tmp: Path) -> list[tuple[str, object, str]]:
 
     scene = load_target(builtin_root() / "diso-bearings-light.toml")
     paths = {}
-    for tag, dofs in (("lateral", "lateral-torsional"),
-                      ("tilting", "lateral-torsional-axial-tilting")):  # fmt: skip
+    for tag, dofs in (
+        ("lateral", "lateral-torsional"),
+        ("tilting", "lateral-torsional-axial-tilting"),
+    ):
         model = derive_model(variant(scene, f"dofs-{tag}", degrees_of_freedom=dofs))
         paths[tag] = tmp / f"{model.name}.py"
         write_atomic(paths[tag], emit_module(model, "gearsym bench"))

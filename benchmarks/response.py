@@ -69,9 +69,13 @@ def response_speed(quick: bool = False, repeats: int = 3) -> dict:
             errs.append(float(np.max(np.abs(orbit.x0 - x0))))
         except Exception:  # noqa: BLE001 (a point at a fold: shooting is singular there)
             continue
-    out["hb"] = {"median_s": t_hb, "curve_points": int(sum(len(c.values) for c in hb.curves)),
-                 "folds": [e["omega"] for e in c0.events if e["kind"] == "fold"],
-                 "error": max(errs) if errs else None, "checked": len(errs)}  # fmt: skip
+    out["hb"] = {
+        "median_s": t_hb,
+        "curve_points": int(sum(len(c.values) for c in hb.curves)),
+        "folds": [e.value for e in c0.events if e.kind == "fold"],
+        "error": max(errs) if errs else None,
+        "checked": len(errs),
+    }
     # shooting against harmonic balance from its states
     errs = []
     c1 = sh.curves[0]
@@ -83,9 +87,13 @@ def response_speed(quick: bool = False, repeats: int = 3) -> dict:
             errs.append(float(np.max(np.abs(sol.state(0.0) - x0))))
         except Exception:  # noqa: BLE001
             continue
-    out["shooting"] = {"median_s": t_sh, "curve_points": len(c1.values),
-                       "folds": [e["omega"] for e in c1.events if e["kind"] == "fold"],
-                       "error": max(errs) if errs else None, "checked": len(errs)}  # fmt: skip
+    out["shooting"] = {
+        "median_s": t_sh,
+        "curve_points": len(c1.values),
+        "folds": [e.value for e in c1.events if e.kind == "fold"],
+        "error": max(errs) if errs else None,
+        "checked": len(errs),
+    }
     # integration: mean and RMS against harmonic balance from the Poincare state
     errs = []
     up = integ.curves[0]
@@ -98,14 +106,23 @@ def response_speed(quick: bool = False, repeats: int = 3) -> dict:
             sol = harmonic_balance(s, state, harmonics=32, stability=False)
         except Exception:  # noqa: BLE001
             continue
-        errs.append(max(
-            max(abs(sol.mean(c) - up.stats[c]["mean"][k]), abs(sol.rms(c) - up.stats[c]["rms"][k]))
-            for c in system.coordinates
-        ))  # fmt: skip
-    out["integration"] = {"median_s": t_int, "curve_points": 2 * len(up.values),
-                          "settle": up.details["settle_periods"],
-                          "sampled": up.details["sampled_periods"],
-                          "error": max(errs) if errs else None, "checked": len(errs)}  # fmt: skip
+        errs.append(
+            max(
+                max(
+                    abs(sol.mean(c) - up.stats[c]["mean"][k]),
+                    abs(sol.rms(c) - up.stats[c]["rms"][k]),
+                )
+                for c in system.coordinates
+            )
+        )
+    out["integration"] = {
+        "median_s": t_int,
+        "curve_points": 2 * len(up.values),
+        "settle": up.details["settle_periods"],
+        "sampled": up.details["sampled_periods"],
+        "error": max(errs) if errs else None,
+        "checked": len(errs),
+    }
     return out
 
 

@@ -76,8 +76,18 @@ def _memory_rows() -> list[tuple[str, int, float]]:
     for scene in ("reference-light", "reference-dead-zone"):
         for periods in (20_000, 100_000):
             with tempfile.TemporaryDirectory() as tmp:
-                args = ["simulate", scene, "--set", "lambda=0.05", "--periods", str(periods),
-                        "--lyapunov-periods", "0", "--out", f"{tmp}/out"]  # fmt: skip
+                args = [
+                    "simulate",
+                    scene,
+                    "--set",
+                    "lambda=0.05",
+                    "--periods",
+                    str(periods),
+                    "--lyapunov-periods",
+                    "0",
+                    "--out",
+                    f"{tmp}/out",
+                ]
                 code, mb = peak_mb(args, tmp)
             rows.append((f"`gearsym {' '.join(args[:-2])} --out DIR`", code, mb))
     return rows
@@ -208,8 +218,9 @@ def main() -> None:
         "",
     ]
     table = _command_table()
-    clean = sum(code == 2 and " ⏎ " not in text and "Traceback" not in text
-                for _, code, text in table)  # fmt: skip
+    clean = sum(
+        code == 2 and " ⏎ " not in text and "Traceback" not in text for _, code, text in table
+    )
     lines += [
         "## Bad input on every command",
         "",

@@ -139,9 +139,9 @@ def _bind_to_parent(parent: int | None) -> None:
     """
     import warnings
 
-    from ..integrate.native.build import NativeFallback
+    from ._warnings import NativeFallback
 
-    # The parent said it once already (sweep._decide_native, maps.map_backend).
+    # The parent said it once already (sweep._decide_native, run.decide_backend).
     warnings.simplefilter("ignore", NativeFallback)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # discards a pending Ctrl-C too
     if hasattr(signal, "pthread_sigmask"):

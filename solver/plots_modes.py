@@ -42,8 +42,14 @@ def campbell_figure(
         ax.plot(n, [mode.frequency_hz] * 2, color=colour, ls=style, lw=1.2, label=label)
     for h in range(1, harmonics + 1):
         ax.plot(n, h * z * n / 60.0, color="black", lw=0.8 + 0.4 * (h == 1))
-        ax.annotate(f"{h}× mesh", (n[1], h * z * n[1] / 60.0), fontsize=8,
-                    xytext=(3, 0), textcoords="offset points", va="center")  # fmt: skip
+        ax.annotate(
+            f"{h}× mesh",
+            (n[1], h * z * n[1] / 60.0),
+            fontsize=8,
+            xytext=(3, 0),
+            textcoords="offset points",
+            va="center",
+        )
     for r in result.resonances(speeds_rpm, harmonics):
         f = r["harmonic"] * z * r["speed_rpm"] / 60.0
         ax.plot(r["speed_rpm"], f, "o", ms=4, color="black")
@@ -51,8 +57,9 @@ def campbell_figure(
         ax.axvline(scene_rpm, color="grey", lw=0.8, ls="--", label="the scene's speed")
     ax.set_xlim(speeds_rpm)
     ax.set_ylim(0, 1.05 * top)
-    ax.set_xlabel(f"speed of gear {result.reference_driver}, the first mesh's driver "
-                  f"(rpm, {z} teeth)")  # fmt: skip
+    ax.set_xlabel(
+        f"speed of gear {result.reference_driver}, the first mesh's driver (rpm, {z} teeth)"
+    )
     ax.set_ylabel("frequency (Hz)")
     ax.set_title(f"{result.model}: natural frequencies and mesh-frequency harmonics")
     ax.legend(title="mode (kinetic energy)", loc="upper left", fontsize=8)

@@ -18,8 +18,11 @@ __all__ = ["frequency_response_figure"]
 
 _COLOURS = {"hb": "tab:blue", "shooting": "tab:orange"}
 _NAMES = {"hb": "harmonic balance", "shooting": "shooting", "integration": "integration"}
-_MARKS = {"fold": ("s", "tab:red"), "period-doubling": ("D", "tab:purple"),
-          "neimark-sacker": ("o", "tab:green")}  # fmt: skip
+_MARKS = {
+    "fold": ("s", "tab:red"),
+    "period-doubling": ("D", "tab:purple"),
+    "neimark-sacker": ("o", "tab:green"),
+}
 
 
 def _segments(x, y, stable):
@@ -40,8 +43,9 @@ def frequency_response_figure(resp, path, physical: bool = False, title: str = "
     scales = system.scales()
     physical = physical and resp.parameter == system.contract.forcing_frequency
     fx = scales["omega_n_rad_per_s"] / (2 * math.pi) if physical else 1.0
-    fig, axes = plt.subplots(len(coords), 1, figsize=(8, 3.2 * len(coords)), sharex=True,
-                             squeeze=False)  # fmt: skip
+    fig, axes = plt.subplots(
+        len(coords), 1, figsize=(8, 3.2 * len(coords)), sharex=True, squeeze=False
+    )
     for ax, c in zip(axes[:, 0], coords, strict=True):
         fy = scales["half_backlash_m"].get(c, 1.0) * 1e6 if physical else 1.0
         for curve in resp.curves:
@@ -50,28 +54,47 @@ def frequency_response_figure(resp, path, physical: bool = False, title: str = "
             colour = _COLOURS.get(curve.method, "k")
             if curve.method == "integration":
                 up = curve.details.get("direction") == "up"
-                ax.plot(x, y, "^" if up else "v", color="tab:green" if up else "tab:olive",
-                        ms=3, mfc="none", lw=0,
-                        label=f"integration, {'up' if up else 'down'} sweep")  # fmt: skip
+                ax.plot(
+                    x,
+                    y,
+                    "^" if up else "v",
+                    color="tab:green" if up else "tab:olive",
+                    ms=3,
+                    mfc="none",
+                    lw=0,
+                    label=f"integration, {'up' if up else 'down'} sweep",
+                )
                 continue
             shown = set()
             for xs, ys, st in _segments(x, y, curve.stable):
                 label = f"{_NAMES[curve.method]}, {'stable' if st else 'unstable'}"
-                ax.plot(xs, ys, "-" if st else "--", color=colour, lw=1.3 if st else 1.0,
-                        label=None if label in shown else label)  # fmt: skip
+                ax.plot(
+                    xs,
+                    ys,
+                    "-" if st else "--",
+                    color=colour,
+                    lw=1.3 if st else 1.0,
+                    label=None if label in shown else label,
+                )
                 shown.add(label)
             for e in curve.events:
-                marker, mc = _MARKS.get(e["kind"], ("x", "k"))
-                v = e[resp.parameter]
+                marker, mc = _MARKS.get(e.kind, ("x", "k"))
+                v = e.value
                 # the point before the event on the curve (a fold has two sides at
                 # nearly one parameter value: the nearest value would not do)
-                if "index" in e:
-                    k = min(max(int(e["index"]) - 1, 0), len(x) - 1)
+                if e.index >= 0:
+                    k = min(max(e.index - 1, 0), len(x) - 1)
                 else:
                     k = int(np.argmin(np.abs(curve.values - v)))
-                ax.plot(v * fx, y[k], marker, color=mc, ms=6, mfc="none",
-                        label=f"{e['kind']}" + (" (a sweep jumps here)"
-                                                if e["kind"] == "fold" else ""))  # fmt: skip
+                ax.plot(
+                    v * fx,
+                    y[k],
+                    marker,
+                    color=mc,
+                    ms=6,
+                    mfc="none",
+                    label=f"{e.kind}" + (" (a sweep jumps here)" if e.kind == "fold" else ""),
+                )
         ax.set_ylabel(f"half peak-to-peak of {c}" + (" (µm)" if physical else " (half backlashes)"))
         ax.grid(alpha=0.3)
         handles, labels = ax.get_legend_handles_labels()

@@ -33,12 +33,12 @@ SCENE_EDITS = {
     "flywheel": (
         'damping_normalisation = "mesh"',
         'damping_normalisation = "mesh"\nflywheel_inertia_kg_m2 = -1',
-    ),  # fmt: skip
+    ),
     "dofs": ("mesh_phase = true", 'mesh_phase = true\ndegrees_of_freedom = "lateral"'),
     "tilting": (
         "mesh_phase = true",
         'mesh_phase = true\ndegrees_of_freedom = "lateral-torsional-axial-tilting"',
-    ),  # fmt: skip
+    ),
 }
 
 OUT_COMMANDS = [

@@ -1,14 +1,25 @@
 """The rooms of DESIGN.md hold: data moves down, nothing below reaches back up.
 
-Read from the source with ``ast`` (nothing is imported): ``solver/`` never imports the
-derivation or the application layer, ``derive/`` never imports the solver, no package
-has an import circle (lazy imports inside functions count), and no module of ``solver/``
-is longer than a reader takes in at one sitting (400 lines, issue 11).
+Read from the source with ``ast`` (nothing is imported):
+
+* ``solver/`` never imports the derivation or the application layer, ``derive/`` never
+  imports the solver, no package has an import circle (lazy imports inside functions
+  count);
+* inside ``solver/`` the rooms import down one order (:data:`SOLVER_ORDER`): the ground
+  (contract, cache, executor, export), ``system``, ``integrate``, ``periodic``,
+  ``analysis``, ``sweep``, the plots;
+* each engine exists once (issue 24): :data:`ENGINES` names the one module that defines
+  it, and no other module of ``solver/`` defines a function or class of that name;
+* the C interface is declared once: one ``ctypes.Structure`` and every ``argtypes`` in
+  ``solver/integrate/native/abi.py``, and the C exports one integrator entry;
+* no module of ``derive/``, ``solver/`` or ``app/`` is longer than a reader takes in at
+  one sitting (400 lines), and the formatter is switched off at most 20 times in the tree.
 """
 
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 import pytest
@@ -73,10 +84,130 @@ def test_no_import_circles(folder):
     assert cycle is None, f"import circle in {folder}/: " + " -> ".join(cycle)
 
 
-def test_solver_modules_are_short_enough_to_read_in_one_sitting():
+@pytest.mark.parametrize("folder", ["derive", "solver", "app"])
+def test_modules_are_short_enough_to_read_in_one_sitting(folder):
     long = {
         str(p.relative_to(ROOT)): n
-        for p in (ROOT / "solver").rglob("*.py")
+        for p in (ROOT / folder).rglob("*.py")
         if (n := len(p.read_text(encoding="utf-8").splitlines())) > 400
     }
     assert not long, long
+
+
+def test_the_formatter_is_switched_off_at_most_twenty_times():
+    where = {}
+    for folder in ("derive", "solver", "app", "tests", "benchmarks", "scenes"):
+        for p in (ROOT / folder).rglob("*.py"):
+            n = p.read_text(encoding="utf-8").count("# fmt: " + "skip")
+            n += p.read_text(encoding="utf-8").count("# fmt: " + "off")
+            if n:
+                where[str(p.relative_to(ROOT))] = n
+    assert sum(where.values()) <= 20, where
+
+
+# Inside solver/: a room may import its own modules and the rooms of its order or lower.
+SOLVER_ORDER = {
+    "__init__": 9,
+    "_json": 0,
+    "_memory": 0,
+    "_warnings": 0,
+    "cache": 0,
+    "contract": 0,
+    "executor": 0,
+    "export": 0,
+    "system": 1,
+    "integrate": 2,
+    "periodic": 3,
+    "analysis": 4,
+    "sweep": 5,
+    "plots": 6,
+    "plots_maps": 6,
+    "plots_modes": 6,
+    "plots_response": 6,
+}
+
+
+def test_solver_rooms_import_down_one_order():
+    graph = import_graph(ROOT / "solver", "gearsym.solver")
+    room = {m: (m.split(".") + ["__init__"])[2] for m in graph}
+    unknown = sorted({r for r in room.values()} - set(SOLVER_ORDER))
+    assert not unknown, f"rooms of solver/ without a place in SOLVER_ORDER: {unknown}"
+    up = sorted(
+        f"{a} -> {b}"
+        for a, targets in graph.items()
+        for b in targets
+        if room[a] != room[b] and SOLVER_ORDER[room[b]] > SOLVER_ORDER[room[a]]
+    )
+    assert not up, "imports that run up the order of solver/: " + "; ".join(up)
+
+
+# Engine -> (the one module that defines it, the names only that module may define).
+ENGINES = {
+    "the run's options and result": ("integrate/spec.py", {"RunSpec", "RunResult"}),
+    "the front door to the integrators": ("integrate/run.py", {"integrate", "Batch"}),
+    "the compiled engine's call": ("integrate/native/engine.py", {"run_compiled"}),
+    "the fallback without a compiler": (
+        "integrate/native/fallback.py",
+        {"run_fallback", "numpy_map", "_numpy_batch", "_scipy"},
+    ),
+    "Newton's method": ("periodic/newton.py", {"newton", "_at"}),
+    "pseudo-arclength continuation": (
+        "periodic/engine.py",
+        {"tangent", "_tangent", "correct", "_correct", "_locate", "continue_branch"},
+    ),
+    "bifurcation records": ("periodic/records.py", {"Bifurcation", "Branch", "HBBranch"}),
+    "bifurcation test functions": ("periodic/floquet.py", {"bifurcation_tests"}),
+    "the record of a classified run": (
+        "analysis/record.py",
+        {"RunRecord", "RunOutcome", "SweepPointRecord"},
+    ),
+    "the store of sweeps and maps": ("sweep/store.py", {"RunStore", "MapStore", "SweepStore"}),
+    "the process pool": ("executor.py", {"map_tasks"}),
+    "the event loop at switching surfaces": (
+        "integrate/events.py",
+        {"integrate_located", "LocatedRun"},
+    ),
+    "the explicit Runge-Kutta step": ("integrate/tableau.py", {"rk_step", "ButcherTableau"}),
+}
+
+
+def _definitions() -> dict[str, set[str]]:
+    out: dict[str, set[str]] = {}
+    for path in (ROOT / "solver").rglob("*.py"):
+        tree = ast.parse(path.read_text(encoding="utf-8"), str(path))
+        rel = str(path.relative_to(ROOT / "solver"))
+        out[rel] = {
+            node.name
+            for node in ast.walk(tree)
+            if isinstance(node, ast.FunctionDef | ast.ClassDef | ast.AsyncFunctionDef)
+        }
+    return out
+
+
+@pytest.mark.parametrize("engine", sorted(ENGINES))
+def test_each_engine_exists_once(engine):
+    home, names = ENGINES[engine]
+    defs = _definitions()
+    assert defs.get(home, set()) & names, f"{engine}: {home} defines none of {sorted(names)}"
+    elsewhere = {m: sorted(d & names) for m, d in defs.items() if m != home and d & names}
+    assert not elsewhere, f"{engine} lives in {home}, but is also defined in {elsewhere}"
+
+
+def test_the_c_interface_is_declared_once():
+    native = ROOT / "solver" / "integrate" / "native"
+    structures, bindings = set(), set()
+    for path in (ROOT / "solver").rglob("*.py"):
+        text = path.read_text(encoding="utf-8")
+        rel = str(path.relative_to(ROOT))
+        if "ctypes.Structure" in text:
+            structures.add(rel)
+        if ".argtypes" in text:
+            bindings.add(rel)
+    assert structures == bindings == {"solver/integrate/native/abi.py"}, (structures, bindings)
+    c = (native / "_native.c").read_text(encoding="utf-8")
+    exported = set(re.findall(r"^(?!static)[A-Za-z][\w \*]*?\b(gs_\w+)\s*\(", c, re.M))
+    entries = {e for e in exported if e not in {"gs_job_fields", "gs_job_layout"}}
+    integrators = entries - {"gs_eval", "gs_eval_batch", "gs_rhs_loop"}
+    assert integrators == {"gs_integrate"}, f"the C exports more than one integrator: {entries}"
+    benettin = re.findall(r"^static[^;{]*\bgs_benettin\w*\s*\(", c, re.M)
+    assert len(benettin) == 1, f"Benettin's renormalisation is defined {len(benettin)} times"

@@ -34,8 +34,19 @@ def files(tmp_path_factory, root):
 def test_the_table_holds_at_least_150_cases_on_every_command():
     assert len(CASES) >= 150
     commands = {argv.split()[0] for argv, _ in CASES}
-    assert commands >= {"derive", "backlash", "stiffness", "simulate", "sweep", "shoot",
-                        "continue", "map", "frequency-response", "reproduce", "bench"}  # fmt: skip
+    assert commands >= {
+        "derive",
+        "backlash",
+        "stiffness",
+        "simulate",
+        "sweep",
+        "shoot",
+        "continue",
+        "map",
+        "frequency-response",
+        "reproduce",
+        "bench",
+    }
 
 
 @pytest.mark.parametrize("argv,fragment", CASES, ids=[c[0] for c in CASES])

@@ -57,10 +57,20 @@ def test_a_section_appended_to_the_list_is_measured_and_written(monkeypatch, tmp
 def test_the_response_section_and_its_floor_row():
     from gearsym.benchmarks.response import response_section
 
-    method = {"median_s": 1.5, "curve_points": 634, "folds": [0.45838, 0.37922],
-              "error": 6.8e-10, "checked": 8}  # fmt: skip
-    r = {"points": 400, "range": [0.3, 0.9], "hb": method, "shooting": dict(method),
-         "integration": {**method, "settle": 50, "sampled": 16}}  # fmt: skip
+    method = {
+        "median_s": 1.5,
+        "curve_points": 634,
+        "folds": [0.45838, 0.37922],
+        "error": 6.8e-10,
+        "checked": 8,
+    }
+    r = {
+        "points": 400,
+        "range": [0.3, 0.9],
+        "hb": method,
+        "shooting": dict(method),
+        "integration": {**method, "settle": 50, "sampled": 16},
+    }
     text = "\n".join(response_section(r))
     assert (
         "(floor of issue 13: 2 s), median | 1.50 | 634 | 0.45838, 0.37922 | 6.8e-10 (8) |" in text

@@ -71,14 +71,20 @@ def test_shooting_and_harmonic_balance_find_the_same_folds(capsys, tmp_path):
     ],
 )
 def test_errors_are_one_line(capsys, tmp_path, args, message):
-    code, out, err = run(capsys, "frequency-response", "reference-light", *args,
-                         f"--out={tmp_path}")  # fmt: skip
+    code, out, err = run(
+        capsys, "frequency-response", "reference-light", *args, f"--out={tmp_path}"
+    )
     assert code == 2 and message in err and len(err.strip().splitlines()) == 1
 
 
 def test_an_unwritable_folder_is_refused_before_computing(capsys, tmp_path):
     blocker = tmp_path / "file"
     blocker.write_text("x")
-    code, out, err = run(capsys, "frequency-response", "reference-light",
-                         "--param=omega=0.3:0.9:10", f"--out={blocker / 'sub'}")  # fmt: skip
+    code, out, err = run(
+        capsys,
+        "frequency-response",
+        "reference-light",
+        "--param=omega=0.3:0.9:10",
+        f"--out={blocker / 'sub'}",
+    )
     assert code == 2 and "--out" in err and "cannot write there" in err

@@ -19,10 +19,22 @@ def test_an_unwritable_cache_falls_back_to_a_temporary_folder_with_one_warning(t
     blocker.write_text("x", encoding="utf-8")
     env = os.environ | {"GEARSYM_CACHE": str(blocker / "cache")}
     run = subprocess.run(
-        [*GEARSYM, "simulate", "reference-light", "--periods", "5", "--transient", "5",
-         "--lyapunov-periods", "0"],
-        capture_output=True, text=True, env=env, cwd=tmp_path,
-    )  # fmt: skip
+        [
+            *GEARSYM,
+            "simulate",
+            "reference-light",
+            "--periods",
+            "5",
+            "--transient",
+            "5",
+            "--lyapunov-periods",
+            "0",
+        ],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=tmp_path,
+    )
     assert run.returncode == 0, run.stderr
     lines = [ln for ln in run.stderr.splitlines() if ln.strip()]
     assert len(lines) == 1 and lines[0].startswith("gearsym: warning: the cache"), lines
@@ -38,9 +50,25 @@ def _small_files():
 
 def test_a_full_disk_during_a_sweep_is_one_line_and_keeps_the_finished_points(tmp_path):
     out = tmp_path / "sweep"
-    args = [*GEARSYM, "sweep", "reference-light", "--param", "lambda", "--range", "0:1:40",
-            "--transient", "20", "--periods", "1200", "--lyapunov-periods", "0", "--out",
-            str(out), "--quiet", "--no-figure"]  # fmt: skip
+    args = [
+        *GEARSYM,
+        "sweep",
+        "reference-light",
+        "--param",
+        "lambda",
+        "--range",
+        "0:1:40",
+        "--transient",
+        "20",
+        "--periods",
+        "1200",
+        "--lyapunov-periods",
+        "0",
+        "--out",
+        str(out),
+        "--quiet",
+        "--no-figure",
+    ]
     full = subprocess.run(args, capture_output=True, text=True, preexec_fn=_small_files)
     lines = [ln for ln in full.stderr.splitlines() if ln.strip()]
     assert full.returncode == 2, full.stderr

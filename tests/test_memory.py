@@ -26,8 +26,9 @@ print(code, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)
 
 def peak_mb(args: list[str], cwd) -> tuple[int, float]:
     """(exit code, peak resident MB) of ``gearsym args`` in its own process."""
-    out = subprocess.run([sys.executable, "-c", _WRAP, *args], cwd=cwd, capture_output=True,
-                         text=True, check=True).stdout.split()  # fmt: skip
+    out = subprocess.run(
+        [sys.executable, "-c", _WRAP, *args], cwd=cwd, capture_output=True, text=True, check=True
+    ).stdout.split()
     return int(out[0]), int(out[1]) / 1024.0  # kB on Linux
 
 
@@ -42,10 +43,20 @@ def peak_mb(args: list[str], cwd) -> tuple[int, float]:
 )
 def test_long_runs_stay_under_the_memory_floor(tmp_path, scene, periods, limit_mb):
     code, mb = peak_mb(
-        ["simulate", scene, "--set", "lambda=0.05", "--periods", str(periods),
-         "--lyapunov-periods", "0", "--out", str(tmp_path / "out")],
+        [
+            "simulate",
+            scene,
+            "--set",
+            "lambda=0.05",
+            "--periods",
+            str(periods),
+            "--lyapunov-periods",
+            "0",
+            "--out",
+            str(tmp_path / "out"),
+        ],
         tmp_path,
-    )  # fmt: skip
+    )
     assert code == 0
     assert (tmp_path / "out" / "point.png").exists()
     assert mb < limit_mb, f"{mb:.0f} MB"

@@ -4,6 +4,7 @@ import math
 
 import numpy as np
 import pytest
+from gearsym.solver.periodic.records import Bifurcation
 from gearsym.studies.report_sensitivity import sensitivity_section
 from gearsym.studies.sensitivity import OPEN_SPREAD, Sensitivity, _critical, _matches, _named
 
@@ -117,16 +118,23 @@ def test_response_section_counts_the_solutions_at_the_operating_frequency():
         values=values,
         stable=np.array([True, False, False, True]),
         stats={"u": {"amplitude": amp, "mean": amp * 0}},
-        events=({"kind": "fold", "omega": 0.6}, {"kind": "fold", "omega": 0.45}),
+        events=(
+            Bifurcation("fold", 0.6, np.zeros(2), parameter="omega", index=2),
+            Bifurcation("fold", 0.45, np.zeros(2), parameter="omega", index=4),
+        ),
     )
     sols = _at(curve, 0.5, ("u",))
     assert len(sols) == 3
     assert [s["stable"] for s in sols] == [False, False, False]  # each spans a change
     assert sols[0]["amplitude"]["u"] == pytest.approx(0.15)
     row = SimpleNamespace(
-        case="light", f1=0.1, lam=0.8, at_omega=sols, attractor=None,
+        case="light",
+        f1=0.1,
+        lam=0.8,
+        at_omega=sols,
+        attractor=None,
         resp=SimpleNamespace(system=SimpleNamespace(coordinates=("u",)), curves=[curve]),
-    )  # fmt: skip
+    )
     text = response_section([row])
     assert "| light (f1 = 0.1) | 0.8 | 0.6000, 0.4500 | 3: " in text
     assert "not simulated" in text

@@ -98,8 +98,10 @@ def figure_file(path, option: str) -> Path:
     if out.is_dir() or not suffix:
         raise Fail(f"{option} {out}: give a file name with a format, for example k.png")
     if suffix not in formats:
-        raise Fail(f"{option} {out}: '.{suffix}' is not a figure format; use one of "
-                   + ", ".join(sorted(formats)))  # fmt: skip
+        raise Fail(
+            f"{option} {out}: '.{suffix}' is not a figure format; use one of "
+            + ", ".join(sorted(formats))
+        )
     out_folder(out.parent if str(out.parent) else ".", option)
     return out
 
@@ -131,25 +133,31 @@ def parse_set(items: list[str]) -> dict[str, float | str]:
     return out
 
 
-def parse_range(text: str):
+def parse_range(text: str, given: str | None = None, negative: str | None = None):
+    """``START:STOP:NUM`` as ``numpy.linspace(START, STOP, NUM)``.
 
+    A refusal starts with ``given`` (what the user typed, default ``--range TEXT``); a
+    map's axis passes ``negative``, the way to write a negative START, which then ends
+    every refusal (``--range`` says it only where the form itself is wrong)."""
+    given = f"--range {text}" if given is None else given
+    tail = f" {negative}" if negative else ""
     parts = text.split(":")
     try:
         if len(parts) != 3:
             raise ValueError
         start, stop, num = float(parts[0]), float(parts[1]), int(parts[2])
     except ValueError:
-        raise Fail(
-            f"--range {text}: expected START:STOP:NUM, for example 0:1:51 "
-            "(write --range=-0.5:1:11 when START is negative)"
-        ) from None
+        how = negative or "(write --range=-0.5:1:11 when START is negative)"
+        raise Fail(f"{given}: expected START:STOP:NUM, for example 0:1:51 {how}") from None
     if not (math.isfinite(start) and math.isfinite(stop)):
-        raise Fail(f"--range {text}: START and STOP must be finite numbers")
+        raise Fail(f"{given}: START and STOP must be finite numbers{tail}")
     if num < 1 or (num == 1 and start != stop):
-        raise Fail(f"--range {text}: NUM must be >= 2, or 1 with START equal to STOP")
+        raise Fail(f"{given}: NUM must be >= 2, or 1 with START equal to STOP{tail}")
     if num > 1 and start == stop:
-        raise Fail(f"--range {text}: START equals STOP, so all {num} values are the same; "
-                   f"give different ends, or {start:g}:{stop:g}:1")  # fmt: skip
+        raise Fail(
+            f"{given}: START equals STOP, so all {num} values are the same; "
+            f"give different ends, or {start:g}:{stop:g}:1{tail}"
+        )
     return np.linspace(start, stop, num)
 
 
@@ -203,8 +211,10 @@ def refuse_conflicts(args, varied: list[str], option: str) -> None:
         if key in varied:
             raise Fail(f"--set {item} contradicts {option}, which varies {key}; drop one")
     if getattr(args, "scheduler", None) and getattr(args, "executor", "dask") != "dask":
-        raise Fail(f"--scheduler {args.scheduler} needs --executor dask (not "
-                   f"'{args.executor}'); drop --scheduler or add --executor dask")  # fmt: skip
+        raise Fail(
+            f"--scheduler {args.scheduler} needs --executor dask (not "
+            f"'{args.executor}'); drop --scheduler or add --executor dask"
+        )
 
 
 # Bounded work: the most periods a run may ask for (stated in each option's help).  The
@@ -226,8 +236,10 @@ def analysis_settings(args) -> dict:
             option = "--" + name.replace("_", "-")
             raise Fail(f"{option} must be a whole number >= {low}, got {getattr(args, name)}")
     if args.rtol > 0.1:
-        raise Fail(f"--rtol {args.rtol:g}: a relative tolerance above 0.1 controls nothing; "
-                   "give 1e-3 or less")  # fmt: skip
+        raise Fail(
+            f"--rtol {args.rtol:g}: a relative tolerance above 0.1 controls nothing; "
+            "give 1e-3 or less"
+        )
     from gearsym.solver.integrate.simulate import check_samples, samples_for
 
     spp = samples_for(args.periods)
@@ -243,9 +255,11 @@ def analysis_settings(args) -> dict:
                 "run takes hours)"
             )
     if spp < 64 and not getattr(args, "quiet", False):
-        print(f"gearsym: note: {args.periods} periods are sampled {spp} times each (not 64) "
-              f"to bound memory; spectra reach {spp // 2} times the excitation frequency",
-              file=sys.stderr)  # fmt: skip
+        print(
+            f"gearsym: note: {args.periods} periods are sampled {spp} times each (not 64) "
+            f"to bound memory; spectra reach {spp // 2} times the excitation frequency",
+            file=sys.stderr,
+        )
     return dict(
         method=args.method,
         rtol=args.rtol,

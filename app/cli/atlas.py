@@ -107,14 +107,8 @@ def _axis(text: str, flag: str):
     name, sep, spec = text.partition("=")
     if not sep or not name.strip():
         raise Fail(f"{flag} {text}: expected NAME=START:STOP:NUM, for example lambda=0:1:51")
-    try:
-        values = parse_range(spec)
-    except Fail as err:
-        why = str(err).split(": ", 1)[1].split(" (write")[0]
-        raise Fail(
-            f"{flag} {text}: {why} (write {flag}={name}=-0.5:1:11 when START is negative)"
-        ) from None
-    return name.strip(), values
+    hint = f"(write {flag}={name}=-0.5:1:11 when START is negative)"
+    return name.strip(), parse_range(spec, given=f"{flag} {text}", negative=hint)
 
 
 def _box(items) -> dict:
@@ -206,9 +200,11 @@ def _cmd_map(args) -> int:
     refuse_conflicts(args, [xn, yn], f"--x {xn} / --y {yn}")
     # per run: its Poincare points (4 states), its extremes and its exponent's history
     runs = xv.size * yv.size * args.initial_states
-    require(runs * 8.0 * (4 * (args.periods + 1) + 8 + args.lyapunov_periods) * 2,
-            f"{xv.size} x {yv.size} x {args.initial_states} runs of {args.periods} periods",
-            "map fewer points, initial states or periods")  # fmt: skip
+    require(
+        runs * 8.0 * (4 * (args.periods + 1) + 8 + args.lyapunov_periods) * 2,
+        f"{xv.size} x {yv.size} x {args.initial_states} runs of {args.periods} periods",
+        "map fewer points, initial states or periods",
+    )
     _bounded(args, runs)
     sets = parse_set(args.set)
     box = _box(args.box)
@@ -227,7 +223,6 @@ def _cmd_map(args) -> int:
         except ValueError as err:
             raise Fail(f"{flag} {name}: {err}") from None
     out = out_folder(args.out or f"map_{system.name}_{xn}_{yn}")
-    stored = len(list((out / "store" / "columns").glob("*.json")))
     try:
         result = regime_map(
             system,
@@ -260,8 +255,8 @@ def _cmd_map(args) -> int:
         for record in result.records():
             sys.stdout.write(dumps(record) + "\n")
         return 0
-    if stored:
-        print(f"resumed: {stored} finished columns came from {out / 'store'}")
+    if result.resumed:
+        print(f"resumed: {result.resumed} finished runs came from {out / 'store'}")
     _summary(result)
     print(f"wrote {json_path}, map.csv and {len(figures)} figures in {out}")
     return 0

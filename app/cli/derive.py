@@ -223,8 +223,10 @@ def _cmd_backlash(args) -> int:
     from gearsym.derive.mesh.backlash import fit_dead_zone
 
     if args.continuous and args.step is not None:
-        raise Fail(f"--step {args.step:g} sets the samples of a discrete fit and --continuous "
-                   "asks for none; drop one")  # fmt: skip
+        raise Fail(
+            f"--step {args.step:g} sets the samples of a discrete fit and --continuous "
+            "asks for none; drop one"
+        )
     if args.step is None:
         args.step = 0.01
     try:

@@ -73,13 +73,18 @@ def _cmd_modes(args) -> int:
     print(f"  {'#':>2}  {'Hz':>10}  {'/ mesh':>7}  {'label':<13}  kinetic energy")
     for m in result.modes:
         shares = ", ".join(f"{k} {v:.2f}" for k, v in m.kinetic_shares.items() if v >= 0.005)
-        print(f"  {m.index:2d}  {m.frequency_hz:10.1f}  {result.over_mesh(m):7.3f}  "
-              f"{m.label:<13}  {shares}")  # fmt: skip
+        print(
+            f"  {m.index:2d}  {m.frequency_hz:10.1f}  {result.over_mesh(m):7.3f}  "
+            f"{m.label:<13}  {shares}"
+        )
     res = [r for r in result.resonances(speeds) if r["harmonic"] == 1]
     if res:
-        print(f"  the mesh frequency meets a mode between {speeds[0]:g} and {speeds[1]:g} rpm "
-              "at: " + ", ".join(f"{r['speed_rpm']:.0f} rpm (mode {r['mode']})" for r in res)
-              + " (2x and 3x mesh in --json and --plot)")  # fmt: skip
+        print(
+            f"  the mesh frequency meets a mode between {speeds[0]:g} and {speeds[1]:g} rpm "
+            "at: "
+            + ", ".join(f"{r['speed_rpm']:.0f} rpm (mode {r['mode']})" for r in res)
+            + " (2x and 3x mesh in --json and --plot)"
+        )
     if args.plot:
         print(f"  resonance diagram: {args.plot}")
     return 0

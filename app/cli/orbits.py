@@ -162,8 +162,11 @@ def _cmd_shoot(args) -> int:
     start = resolve_start(args)
     system = start.system
     # Newton's matrix on all segments, dense: (n S)^2 numbers, and its factors
-    require(24.0 * (system.n * args.segments) ** 2, f"--segments {args.segments}",
-            "use fewer segments (one per period is the default; a few suffice)")  # fmt: skip
+    require(
+        24.0 * (system.n * args.segments) ** 2,
+        f"--segments {args.segments}",
+        "use fewer segments (one per period is the default; a few suffice)",
+    )
     bounded_shoot(args)
     if start.x0 is None:
         settle = 300 if args.settle is None else args.settle
@@ -274,8 +277,9 @@ def _cmd_continue(args) -> int:
     if args.settle < 0:
         raise Fail(f"--settle must be >= 0, got {args.settle}")
     if args.from_ == args.to:
-        raise Fail(f"--to {args.to:g} equals --from: there is nothing to continue; give "
-                   "another end")  # fmt: skip
+        raise Fail(
+            f"--to {args.to:g} equals --from: there is nothing to continue; give another end"
+        )
     span = abs(args.to - args.from_)
     if not MIN_STEP <= args.step <= span:
         raise Fail(

@@ -99,8 +99,8 @@ def _cmd_simulate(args) -> int:
     except SimulationError as err:
         raise RunFailed(f"simulate: {err}") from None
     except ValueError as err:
-        raise Fail(f"simulate from {start.source}: {err}" if start.x0 is not None
-                   else f"simulate: {err}") from None  # fmt: skip
+        where = "simulate" if start.x0 is None else f"simulate from {start.source}"
+        raise Fail(f"{where}: {err}") from None
     data = result.describe()
     data["initial_state"] = start.describe()
     if args.out:
@@ -167,7 +167,6 @@ def _cmd_simulate(args) -> int:
 def _cmd_sweep(args) -> int:
     from gearsym.solver.integrate import SimulationError
     from gearsym.solver.sweep import Progress, sweep
-    from gearsym.solver.sweep.store import stored_count
     from gearsym.studies.report import runs_text
 
     figure = not args.no_figure
@@ -187,9 +186,11 @@ def _cmd_sweep(args) -> int:
         raise Fail("--backward orders a continuation, and --independent has none; drop one")
     settings = analysis_settings(args)
     # each point keeps its Poincare points and a summary (about 4 KiB)
-    require(len(values) * (8.0 * 4 * args.periods + 4096) * 2,
-            f"--range {args.range}: {len(values)} points of {args.periods} periods",
-            "sweep fewer points or periods")  # fmt: skip
+    require(
+        len(values) * (8.0 * 4 * args.periods + 4096) * 2,
+        f"--range {args.range}: {len(values)} points of {args.periods} periods",
+        "sweep fewer points or periods",
+    )
     total = len(values) * (args.transient + args.periods + args.lyapunov_periods)
     if len(values) > MAX_SWEEP_POINTS or total > MAX_TOTAL_PERIODS:
         raise Fail(
@@ -215,7 +216,6 @@ def _cmd_sweep(args) -> int:
         raise Fail(f"--param {args.param} --range {args.range}: {err}") from None
     out = out_folder(args.out or f"sweep_{system.name}_{args.param}")
     bar = _Bar(len(values), f"{args.param}", enabled=not args.quiet)
-    stored = stored_count(out / "store")
     try:
         result = sweep(
             system,
@@ -232,8 +232,8 @@ def _cmd_sweep(args) -> int:
     except (SimulationError, ValueError) as err:
         raise Fail(f"sweep: {err}") from None
     failed = [p.value for p in result.points if not p.ok]
-    if stored:
-        print(f"resumed: {stored} of {len(values)} points came from {out / 'store'}")
+    if result.resumed:
+        print(f"resumed: {result.resumed} of {len(values)} points came from {out / 'store'}")
     path = result.save(out / "sweep.json")
     if figure:
         from gearsym.solver import plots

@@ -208,14 +208,21 @@ def _cmd_response(args) -> int:
     out = out_folder(args.out or f"response_{system.name}")
     try:
         resp = frequency_response(
-            system, name, start, stop, points=num, methods=methods,
-            harmonics=args.harmonics, n=args.period, settle=args.settle, sampled=args.sampled,
+            system,
+            name,
+            start,
+            stop,
+            points=num,
+            methods=methods,
+            harmonics=args.harmonics,
+            n=args.period,
+            settle=args.settle,
+            sampled=args.sampled,
             tail=args.tail,
-        )  # fmt: skip
+        )
     except (HarmonicBalanceError, ShootingError) as err:
         raise RunFailed(f"frequency-response: {err}") from None
-    (out / "frequency_response.json").write_text(dumps(resp.to_dict(), indent=1),
-                                                 encoding="utf-8")  # fmt: skip
+    (out / "frequency_response.json").write_text(dumps(resp.to_dict(), indent=1), encoding="utf-8")
     resp.save(out / "frequency_response.csv")
     resp.save(out / "frequency_response.mat")
     figure = None
@@ -241,23 +248,29 @@ def _cmd_response(args) -> int:
     for c in resp.curves:
         stable = int(c.stable.sum())
         if c.method == "integration":
-            print(f"integration, {c.details['direction']} sweep: {len(c.values)} points in "
-                  f"{c.wall_time:.2f} s (both sweeps together)")  # fmt: skip
+            print(
+                f"integration, {c.details['direction']} sweep: {len(c.values)} points in "
+                f"{c.wall_time:.2f} s (both sweeps together)"
+            )
             continue
         extra = ""
         if c.method == "hb":
-            extra = (f"; H = {c.details['harmonics']}, top harmonics carry at most "
-                     f"{c.details['largest_tail_share']:.1e} of the response")  # fmt: skip
-        print(f"{c.method}: {len(c.values)} points ({stable} stable) in {c.wall_time:.2f} s"
-              + extra)  # fmt: skip
+            extra = (
+                f"; H = {c.details['harmonics']}, top harmonics carry at most "
+                f"{c.details['largest_tail_share']:.1e} of the response"
+            )
+        print(
+            f"{c.method}: {len(c.values)} points ({stable} stable) in {c.wall_time:.2f} s" + extra
+        )
         for e in c.events:
+            ev = e.evidence
             check = (
-                f"  (Hill against the monodromy: {e['hill_vs_monodromy']:.1e}; largest "
-                f"|monodromy multiplier| {e['max_monodromy_multiplier']:.9f})"
-                if "hill_vs_monodromy" in e
+                f"  (Hill against the monodromy: {ev['hill_vs_monodromy']:.1e}; largest "
+                f"|monodromy multiplier| {ev['max_monodromy_multiplier']:.9f})"
+                if "hill_vs_monodromy" in ev
                 else ""
             )
-            print(f"  {e['kind']:<16} {name} = {e[name]:.8g}{check}")
+            print(f"  {e.kind:<16} {name} = {e.value:.8g}{check}")
         for note in c.details.get("notes", []):
             print(f"  note: {note}")
         if c.details.get("status") in ("boundary", "max-points"):

@@ -58,8 +58,9 @@ def _figure(torsional, bearing, path: Path) -> Path:
             ):
                 xs = [np.full(len(p.poincare[state]), p.value) for p in sweep.points]
                 ys = [p.poincare[state] for p in sweep.points]
-                ax.scatter(np.concatenate(xs), np.concatenate(ys), s=size, color=colour,
-                           label=label, lw=0)  # fmt: skip
+                ax.scatter(
+                    np.concatenate(xs), np.concatenate(ys), s=size, color=colour, label=label, lw=0
+                )
             ax.set_ylabel(f"{state} (half backlashes)")
             if row == 0:
                 ax.set_title(f"{case} load, f1 = {f1}: Poincaré points against lambda")
@@ -101,8 +102,10 @@ def bearings_section(torsional: list, bearing: list, out: Path) -> str:
     ]
     for m in result.modes:
         shares = ", ".join(f"{k} {v:.2f}" for k, v in m.kinetic_shares.items() if v >= 0.005)
-        lines.append(f"| {m.index} | {m.frequency_hz:.1f} | {result.over_mesh(m):.3f} | "
-                     f"{m.label} | {shares} |")  # fmt: skip
+        lines.append(
+            f"| {m.index} | {m.frequency_hz:.1f} | {result.over_mesh(m):.3f} | "
+            f"{m.label} | {shares} |"
+        )
     lines += [
         "",
         "**The lambda sweeps** (forward, the settings of the torsional sweeps above): "
@@ -132,9 +135,13 @@ def _case_lines(case: str, f1: float, tor, bea) -> list[str]:
             f"| {a.value:g} | {mt} | {mb} | {back_t:.2f} | {back_b:.2f} | {du[-1]:.3g} | "
             f"{dv[-1]:.3g} | {lateral:.3g} | {axial:.3g} |"
         )
-    shift = np.nanmean([np.mean(b.poincare["u"]) - np.mean(a.poincare["u"])
-                        for a, b in zip(tor.points, bea.points, strict=True)
-                        if len(a.poincare["u"]) and len(b.poincare["u"])])  # fmt: skip
+    shift = np.nanmean(
+        [
+            np.mean(b.poincare["u"]) - np.mean(a.poincare["u"])
+            for a, b in zip(tor.points, bea.points, strict=True)
+            if len(a.poincare["u"]) and len(b.poincare["u"])
+        ]
+    )
     n = len(tor.points)
     jumps = [_jump(tor), _jump(bea)]
     backward = [_fully_backward(tor), _fully_backward(bea)]
@@ -164,21 +171,26 @@ def _case_lines(case: str, f1: float, tor, bea) -> list[str]:
         "on bearings. "
         + "Largest jump of v between neighbouring lambda values: "
         + "; ".join(
-            f"{what}, " + (f"{j[1]:.3g} half backlashes from lambda = {j[2]:g} to {j[3]:g}"
-                           if j else "none above 0.2")
+            f"{what}, "
+            + (
+                f"{j[1]:.3g} half backlashes from lambda = {j[2]:g} to {j[3]:g}"
+                if j
+                else "none above 0.2"
+            )
             for what, j in zip(("torsional", "on bearings"), jumps, strict=True)
         )
         + ". v meshes backward throughout the window "
         + (
             "at no lambda in either model"
             if backward == [None, None]
-            else "from lambda = " + " and ".join(
+            else "from lambda = "
+            + " and ".join(
                 f"{'no lambda' if b is None else f'{b:g}'} on ({what})"
                 for what, b in zip(("torsional", "on bearings"), backward, strict=True)
             )
         )
         + ".\n"
-    )  # fmt: skip
+    )
     head = (
         "| lambda | v torsional | v on bearings | v backward, torsional | v backward, on "
         "bearings | Δu | Δv | pinion p across its axis | p along its axis |\n"
@@ -187,9 +199,14 @@ def _case_lines(case: str, f1: float, tor, bea) -> list[str]:
     note = (
         "" if n <= 11 else "rows at every 0.1 and either side of each jump; all points in data/; "
     )
-    return [summary, head, *rows, "",
-            f"({note}Δ in half backlashes; p's displacements in half backlashes of 50 µm, "
-            "over the sampled window.)\n"]  # fmt: skip
+    return [
+        summary,
+        head,
+        *rows,
+        "",
+        f"({note}Δ in half backlashes; p's displacements in half backlashes of 50 µm, "
+        "over the sampled window.)\n",
+    ]
 
 
 def _jump(sweep):

@@ -53,8 +53,10 @@ def sweep_state_figure(sweeps, path: Path, title: str, caption: str) -> Path:
     for sw, mark in zip(sweeps, ("o", "s"), strict=False):
         lam = np.array(sw.values, float)
         exp = [np.nan if p.lyapunov is None else p.lyapunov["exponent"] for p in sw.points]
-        err = [np.nan if p.lyapunov is None else p.lyapunov.get("uncertainty", np.nan)
-               for p in sw.points]  # fmt: skip
+        err = [
+            np.nan if p.lyapunov is None else p.lyapunov.get("uncertainty", np.nan)
+            for p in sw.points
+        ]
         ax.errorbar(lam, exp, yerr=err, fmt=mark, ms=3, capsize=2, label=f"{sw.direction} sweep")
     ax.axhline(0.0, color="k", lw=0.8)
     ax.set_xlabel("lambda")
@@ -163,28 +165,48 @@ def response_figure(responses: dict, path: Path, title: str, caption: str, mark:
     plt = _plt()
     first = next(iter(responses.values()))
     coords = first.system.coordinates
-    fig, axes = plt.subplots(len(coords), 1, figsize=(10, 3.0 * len(coords) + 0.6),
-                             sharex=True, squeeze=False)  # fmt: skip
+    fig, axes = plt.subplots(
+        len(coords), 1, figsize=(10, 3.0 * len(coords) + 0.6), sharex=True, squeeze=False
+    )
     for ax, c in zip(axes[:, 0], coords, strict=True):
         for k, (lam, resp) in enumerate(responses.items()):
             curve = resp.curves[0]
             x, y, st = curve.values, curve.stats[c]["amplitude"], curve.stable
             colour = f"C{k}"
             for xs, ys, stable in _segments(x, y, st):
-                ax.plot(xs, ys, "-" if stable else "--", color=colour, lw=1.3 if stable else 1.0,
-                        label=f"λ = {lam}, {'stable' if stable else 'unstable'}")  # fmt: skip
+                ax.plot(
+                    xs,
+                    ys,
+                    "-" if stable else "--",
+                    color=colour,
+                    lw=1.3 if stable else 1.0,
+                    label=f"λ = {lam}, {'stable' if stable else 'unstable'}",
+                )
             for e in curve.events:
-                if e["kind"] == "fold":
-                    i = min(max(int(e.get("index", 1)) - 1, 0), len(x) - 1)
-                    ax.plot(e["omega"], y[i], "s", color="tab:red", mfc="none", ms=6,
-                            label="fold (a slow sweep jumps here)")  # fmt: skip
+                if e.kind == "fold":
+                    i = min(max(e.index - 1, 0), len(x) - 1)
+                    ax.plot(
+                        e.value,
+                        y[i],
+                        "s",
+                        color="tab:red",
+                        mfc="none",
+                        ms=6,
+                        label="fold (a slow sweep jumps here)",
+                    )
         ax.axvline(mark, color="0.3", lw=0.8, ls=":", label=f"the study's ω̄ = {mark}")
         ax.set_ylabel(f"half peak-to-peak of {c}\n(half backlashes)")
         ax.grid(alpha=0.3)
         handles, labels = ax.get_legend_handles_labels()
         unique = dict(zip(labels, handles, strict=True))
-        ax.legend(unique.values(), unique.keys(), fontsize=7, loc="upper left",
-                  bbox_to_anchor=(1.01, 1.0), frameon=False)  # fmt: skip
+        ax.legend(
+            unique.values(),
+            unique.keys(),
+            fontsize=7,
+            loc="upper left",
+            bbox_to_anchor=(1.01, 1.0),
+            frameon=False,
+        )
     axes[-1, 0].set_xlabel("ω̄ (mesh frequency over ω_n)")
     axes[0, 0].set_title(title, fontsize=10)
     fig.text(0.01, 0.005, caption, fontsize=7, ha="left", va="bottom", wrap=True)

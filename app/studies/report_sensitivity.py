@@ -99,9 +99,10 @@ def sensitivity_section(rows, scales: dict, loads: dict, points: dict) -> str:
         "λ ≥ 0.13 (heavy only; n/a at light load).\n"
     )
     names = list(dict.fromkeys(n for r in rows for n in r.reproduced))
-    w.append("| load | reading | open value | values tried | motion types found | "
-             "critical λ of v | "
-             + " | ".join(f"reproduces: {n}" for n in names) + " |")  # fmt: skip
+    w.append(
+        "| load | reading | open value | values tried | motion types found | "
+        "critical λ of v | " + " | ".join(f"reproduces: {n}" for n in names) + " |"
+    )
     w.append("|---|---|---|---|---|---|" + "---|" * len(names))
     for r in rows:
         tried = ", ".join(_num(v) + ("*" if v == r.stated else "") for v in r.values)
@@ -125,9 +126,12 @@ def sensitivity_section(rows, scales: dict, loads: dict, points: dict) -> str:
     for case in dict.fromkeys(r.case for r in rows):
         here = [r for r in rows if r.case == case]
         for n in here[0].reproduced:
-            found = [f"`{r.key}` = {', '.join(_num(v) for v in r.reproduced[n])} "
-                     f"({READING_NAMES.get(r.reading, r.reading)})"
-                     for r in here if r.reproduced[n]]  # fmt: skip
+            found = [
+                f"`{r.key}` = {', '.join(_num(v) for v in r.reproduced[n])} "
+                f"({READING_NAMES.get(r.reading, r.reading)})"
+                for r in here
+                if r.reproduced[n]
+            ]
             if found:
                 w.append(f"- {case} load, *{n}*: reproduced with {'; '.join(found)}.")
             else:

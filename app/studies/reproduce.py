@@ -185,9 +185,16 @@ def reproduce(
     forward = [by_case[case][0] for case, _, _ in CASES]
     bearings = bearings_section(forward, bearing_sweeps, out)
     text = (
-        head + response_section(response_rows) + "\n" + section + "\n" + bearings + "\n"
-        + sep + tail
-    )  # fmt: skip
+        head
+        + response_section(response_rows)
+        + "\n"
+        + section
+        + "\n"
+        + bearings
+        + "\n"
+        + sep
+        + tail
+    )
     path = out / "report.md"
     path.write_text(text, encoding="utf-8")
     return path
@@ -203,7 +210,7 @@ def _continue_case(args):
         if not motion.startswith("period-") or motion in seen:
             continue
         seen.add(motion)
-        n = int(motion.split("-")[1])
+        n = point.period("u")
         x0 = point.poincare_state(system.states)
         for target in (1.0, 0.0):  # both ways from where the sweep found it
             try:

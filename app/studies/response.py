@@ -36,10 +36,17 @@ def _at(curve, value: float, coords) -> list[dict]:
         a, b = v[k] - value, v[k + 1] - value
         if a == 0 or a * b < 0:
             w = 0.0 if a == 0 else a / (a - b)
-            amp = {c: float((1 - w) * curve.stats[c]["amplitude"][k]
-                            + w * curve.stats[c]["amplitude"][k + 1]) for c in coords}  # fmt: skip
-            mean = {c: float((1 - w) * curve.stats[c]["mean"][k]
-                             + w * curve.stats[c]["mean"][k + 1]) for c in coords}  # fmt: skip
+            amp = {
+                c: float(
+                    (1 - w) * curve.stats[c]["amplitude"][k]
+                    + w * curve.stats[c]["amplitude"][k + 1]
+                )
+                for c in coords
+            }
+            mean = {
+                c: float((1 - w) * curve.stats[c]["mean"][k] + w * curve.stats[c]["mean"][k + 1])
+                for c in coords
+            }
             stable = bool(curve.stable[k]) and bool(curve.stable[k + 1])
             factor = {}
             for c in coords:
@@ -48,9 +55,13 @@ def _at(curve, value: float, coords) -> list[dict]:
             out.append({"amplitude": amp, "mean": mean, "stable": stable, "factor": factor})
     if v[-1] == value:
         k = len(v) - 1
-        out.append({"amplitude": {c: float(curve.stats[c]["amplitude"][k]) for c in coords},
-                    "mean": {c: float(curve.stats[c]["mean"][k]) for c in coords},
-                    "stable": bool(curve.stable[k])})  # fmt: skip
+        out.append(
+            {
+                "amplitude": {c: float(curve.stats[c]["amplitude"][k]) for c in coords},
+                "mean": {c: float(curve.stats[c]["mean"][k]) for c in coords},
+                "stable": bool(curve.stable[k]),
+            }
+        )
     return out
 
 
@@ -131,16 +142,18 @@ def response_section(rows) -> str:
         "both are period-1 and their amplitudes agree within 1e-3 (the simulation's "
         "extremes are sampled 64 times a period).\n"
     )
-    w.append("| load | λ | folds (ω̄) | periodic solutions at ω̄ = 0.5 | the simulated "
-             "operating point (study's ω̄ = 0.5) |")  # fmt: skip
+    w.append(
+        "| load | λ | folds (ω̄) | periodic solutions at ω̄ = 0.5 | the simulated "
+        "operating point (study's ω̄ = 0.5) |"
+    )
     w.append("|---|---|---|---|---|")
     for r in rows:
         coords = r.resp.system.coordinates
         curve = r.resp.curves[0]
-        folds = ", ".join(f"{e['omega']:.4f}" for e in curve.events if e["kind"] == "fold")
-        other = [e for e in curve.events if e["kind"] != "fold"]
+        folds = ", ".join(f"{e.value:.4f}" for e in curve.events if e.kind == "fold")
+        other = [e for e in curve.events if e.kind != "fold"]
         if other:
-            folds += "; " + ", ".join(f"{e['kind']} at {e['omega']:.4f}" for e in other)
+            folds += "; " + ", ".join(f"{e.kind} at {e.value:.4f}" for e in other)
         sols = "; ".join(_fmt_solution(s, coords) for s in r.at_omega) or "none found"
         att = r.attractor
         if att is None:
@@ -159,8 +172,10 @@ def response_section(rows) -> str:
                 match = "on none of the period-1 solutions (nearest amplitude gap "
                 match += f"{att['gap']:.3g})" if np.isfinite(att["gap"]) else "—)"
             seen = f"{motion}; amplitudes {amps}; {match}"
-        w.append(f"| {r.case} (f1 = {r.f1}) | {r.lam} | {folds or 'none'} | "
-                 f"{len(r.at_omega)}: {sols} | {seen} |")  # fmt: skip
+        w.append(
+            f"| {r.case} (f1 = {r.f1}) | {r.lam} | {folds or 'none'} | "
+            f"{len(r.at_omega)}: {sols} | {seen} |"
+        )
     w.append("")
     w.append(
         "Figures: `response_<load>.png` (both load ratios, stable solid, unstable dashed, "

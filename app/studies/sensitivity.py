@@ -105,8 +105,9 @@ def _critical(records, lam_values, value, key) -> float:
     that failed (left the polynomial's valid range) are not attractors and not counted."""
     ok = []
     for lam in lam_values:
-        here = [r for r in records
-                if r["lambda"] == lam and r[key] == value and r["status"] == "ok"]  # fmt: skip
+        here = [
+            r for r in records if r["lambda"] == lam and r[key] == value and r["status"] == "ok"
+        ]
         ok.append(bool(here) and all(r["motion"]["v"].startswith("period-") for r in here))
     for k in range(len(ok)):
         if all(ok[k:]):

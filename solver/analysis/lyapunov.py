@@ -4,9 +4,11 @@ The state and one tangent vector are integrated together,
 
     ``x' = F(tau, x, p)``,   ``w' = J(tau, x, p) w``,
 
-over one forcing period at a time -- with the compiled DOP853 (``integrate/native``) when a
-C compiler is available, else with CasADi's CVODES on the variational system of
-``integrate/variational.py``; after each period the tangent
+over one forcing period at a time -- with the compiled engine through the front door
+(``integrate/run.py``: ``integrate()`` collecting ``"exponent"``) when a C compiler is
+available, else with CasADi's CVODES on the variational system of
+``integrate/variational.py``, the one variational route for a model without C (and an
+independent cross-check of the compiled one); after each period the tangent
 vector is renormalised and ``log |w|`` accumulated (Benettin, Galgani, Giorgilli and
 Strelcyn 1980, "Lyapunov characteristic exponents for smooth dynamical systems",
 Meccanica 15).  The exponent is per unit of non-dimensional time tau; the running
@@ -42,8 +44,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..integrate import native
 from ..integrate._quiet import quiet
+from ..integrate.native.build import NativeUnavailable
+from ..integrate.run import integrate
+from ..integrate.spec import RunSpec
 from ..integrate.variational import casadi_dae
 from ..system import System
 
@@ -141,25 +145,30 @@ def largest_lyapunov(
     if backend not in ("auto", "native", "cvodes"):
         raise ValueError(f"backend must be 'auto', 'native' or 'cvodes', got {backend!r}")
     n = system.n
-    rng = np.random.default_rng(seed)
-    v = rng.standard_normal(n)
-    v /= np.linalg.norm(v)
     if backend != "cvodes":
+        # bound 1e12: the exponent's run stops only where the state truly escapes
+        spec = RunSpec(
+            method="dop853",
+            rtol=rtol,
+            atol=atol,
+            t0=t0,
+            transient=0,
+            periods=periods,
+            collect=("exponent",),
+            lyapunov_periods=periods,
+            seed=seed,
+            valid_range="ignore",
+            bound=1e12,
+        )
         try:
-            running, _ = native.benettin(
-                system.module,
-                system.p,
-                np.concatenate([np.asarray(x0, float), v]),
-                t0=t0,
-                period=system.period,
-                periods=periods,
-                rtol=rtol,
-                atol=atol,
-            )
-        except native.NativeUnavailable:
+            res = integrate(system, x0, spec, backend="native")
+        except NativeUnavailable:
             if backend == "native":
                 raise
         else:
+            if res.status[0] != "ok":
+                raise FloatingPointError(f"variational integration stopped: {res.status[0]}")
+            running = res.exponent[0]
             half = running[periods // 2 :]
             return LyapunovEstimate(
                 float(running[-1]),
@@ -168,9 +177,12 @@ def largest_lyapunov(
                 float(half.max() - half.min()),
                 rtol,
                 atol,
-                "compiled DOP853",
+                res.label,
                 system.period,
             )
+    rng = np.random.default_rng(seed)
+    v = rng.standard_normal(n)
+    v /= np.linalg.norm(v)
     import casadi as ca
 
     # Each period is integrated from 0 with the forcing shifted to start at t0 + k T.

@@ -27,8 +27,14 @@ import scipy.linalg
 __all__ = ["DOMINANT", "Mode", "Modes", "modes"]
 
 DOMINANT = 0.8  # kinetic-energy share of one group that names a mode
-_GROUPS = {"theta": "torsional", "x": "translational", "y": "translational", "z": "axial",
-           "tx": "tilting", "ty": "tilting"}  # fmt: skip
+_GROUPS = {
+    "theta": "torsional",
+    "x": "translational",
+    "y": "translational",
+    "z": "axial",
+    "tx": "tilting",
+    "ty": "tilting",
+}
 
 
 @dataclass(frozen=True)
@@ -109,13 +115,19 @@ def modes(model, omega: float | None = None) -> Modes:
     for i in range(len(w2)):
         v = vec[:, i]
         kinetic = mass * v**2
-        shares = {g: float(sum(e for e, gg in zip(kinetic, groups, strict=True) if gg == g)
-                           / kinetic.sum()) for g in dict.fromkeys(groups)}  # fmt: skip
+        shares = {
+            g: float(
+                sum(e for e, gg in zip(kinetic, groups, strict=True) if gg == g) / kinetic.sum()
+            )
+            for g in dict.fromkeys(groups)
+        }
         strain = k * (R @ v) ** 2
         total = strain.sum()
         # A rigid-body mode strains nothing: its shares would be round-off normalised.
-        strain_shares = {c: 0.0 if rigid[i] else float(e / total)
-                         for c, e in zip(s["coordinates"], strain, strict=True)}  # fmt: skip
+        strain_shares = {
+            c: 0.0 if rigid[i] else float(e / total)
+            for c, e in zip(s["coordinates"], strain, strict=True)
+        }
         if rigid[i]:
             label = "rigid-body"
         else:
@@ -135,5 +147,10 @@ def modes(model, omega: float | None = None) -> Modes:
     if omega is None:
         omega = module.DEFAULTS[module.PARAMETERS.index(forcing)]
     f_mesh = omega * s["omega_n"] / (2 * math.pi)
-    return Modes(module.NAME, tuple(out), f_mesh, int(s["reference_teeth"]),
-                 str(s.get("reference_driver", "")))  # fmt: skip
+    return Modes(
+        module.NAME,
+        tuple(out),
+        f_mesh,
+        int(s["reference_teeth"]),
+        str(s.get("reference_driver", "")),
+    )

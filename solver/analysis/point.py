@@ -22,6 +22,7 @@ from ..integrate import Trajectory, get_method, simulate
 from ..system import System
 from .classify import DIMENSION_POINTS, Classification, classify_points
 from .lyapunov import LyapunovEstimate, largest_lyapunov
+from .record import Extremes, RunRecord
 from .spectra import extremes, meshing_states, spectrum
 
 __all__ = ["PointResult", "analyse_point", "analyse_trajectory", "classification_tolerance"]
@@ -29,26 +30,55 @@ __all__ = ["PointResult", "analyse_point", "analyse_trajectory", "classification
 
 @dataclass(frozen=True)
 class PointResult:
+    """One operating point analysed, with its time series: the live object behind the
+    :class:`~.record.RunRecord` that sweeps and stores keep (:meth:`record`).
+
+    ``lyapunov`` is the estimate with its running history (or None); ``spectra`` the
+    spectra the verdicts were drawn from, per coordinate (None: computed on demand).
+    """
+
     trajectory: Trajectory
     lyapunov: LyapunovEstimate | None
     classification: dict[str, Classification]
-    # the spectra the verdicts were drawn from, per coordinate (kept so that describe()
-    # does not compute them again); None: computed on demand
     spectra: dict | None = None
 
-    def describe(self, poincare: bool = True) -> dict:
+    def record(self, values: dict | None = None, *, start: str = "default", x0=None):
+        """The :class:`~.record.RunRecord` of this point: its verdicts, extremes, Poincare
+        points (copied), meshing shares, exponent's summary, spectral peaks and timings.
+
+        ``values`` names the parameter values the caller varied (a sweep's one);
+        ``start`` and ``x0`` say where the run started (None: the default state).
+        """
         tr = self.trajectory
+        return RunRecord(
+            values={k: float(v) for k, v in (values or {}).items()},
+            status=tr.status,
+            classification=dict(self.classification),
+            extremes={s: Extremes(e["max"], e["min"]) for s, e in extremes(tr).items()},
+            start=start,
+            x0=None if x0 is None else np.array(x0, dtype=float),
+            meshing_states=meshing_states(tr),
+            lyapunov=None if self.lyapunov is None else self.lyapunov.describe(),
+            spectra={c: self._spectrum(c).describe() for c in tr.system.coordinates},
+            poincare={s: tr.poincare[k].copy() for k, s in enumerate(tr.system.states)},
+            x_final=tr.x_final.copy(),
+            integration=tr.describe(),
+        )
+
+    def describe(self, poincare: bool = True) -> dict:
+        """The point's summary (its :meth:`record`) with the system's description."""
+        rec = self.record()
         out = {
-            "system": tr.system.describe(),
-            "integration": tr.describe(),
-            "classification": {c: k.describe() for c, k in self.classification.items()},
-            "extremes": extremes(tr),
-            "meshing_states": meshing_states(tr),
-            "spectra": {c: self._spectrum(c).describe() for c in tr.system.coordinates},
-            "lyapunov": None if self.lyapunov is None else self.lyapunov.describe(),
+            "system": self.trajectory.system.describe(),
+            "integration": rec.integration,
+            "classification": {c: k.describe() for c, k in rec.classification.items()},
+            "extremes": {s: e.to_dict() for s, e in rec.extremes.items()},
+            "meshing_states": rec.meshing_states,
+            "spectra": rec.spectra,
+            "lyapunov": rec.lyapunov,
         }
         if poincare:
-            out["poincare"] = {s: tr.poincare[k].tolist() for k, s in enumerate(tr.system.states)}
+            out["poincare"] = {s: v.tolist() for s, v in rec.poincare.items()}
         return out
 
     def _spectrum(self, c: str):

@@ -110,8 +110,17 @@ def _run(system, req: Request) -> Run:
     except RuntimeError as err:
         # The same event gives the same status from every method: a run that stopped
         # because the state grew past the bound is "divergent", as with the others.
-        diverged = _diverged(system, dae, method, np.asarray(req.x0, float), t0, T,
-                             int(round((grid[-1] - t0) / T)), req.bound, options)  # fmt: skip
+        diverged = _diverged(
+            system,
+            dae,
+            method,
+            np.asarray(req.x0, float),
+            t0,
+            T,
+            int(round((grid[-1] - t0) / T)),
+            req.bound,
+            options,
+        )
         if diverged is None:
             raise SimulationError(failure_message(method, str(err))) from None
         out = np.full((system.n, grid.size), np.nan)

@@ -9,8 +9,7 @@ import numpy as np
 from .._memory import require
 from ..system import System
 
-__all__ = ["SAMPLE_BUDGET", "check_samples", "check_start", "default_initial_state",
-           "samples_for"]  # fmt: skip
+__all__ = ["SAMPLE_BUDGET", "check_samples", "check_start", "default_initial_state", "samples_for"]
 
 
 def check_samples(periods: int, samples_per_period: int, n: int) -> None:

@@ -53,27 +53,72 @@ class Method:
 
 
 _RECORDS = (
-    Method("RK45", "scipy", True, 5, locates_surfaces=True,
-           description="SciPy Dormand-Prince 5(4): the reference study's method"),
-    Method("DOP853", "scipy", True, 8, locates_surfaces=True,
-           description="SciPy Dormand-Prince 8(5,3)"),
-    Method("LSODA", "scipy", True, 12, locates_surfaces=True,
-           description="SciPy LSODA (Adams / BDF switching), with the generated Jacobian"),
-    Method("Radau", "scipy", True, 5, locates_surfaces=True,
-           description="SciPy implicit Radau IIA, with the generated Jacobian"),
-    Method("cvodes", "casadi", True, 5,
-           description="CasADi CVODES (SUNDIALS, variable-order BDF/Adams)"),
-    Method("rk", "casadi", False, 4, step_unit=1,
-           description="CasADi fixed-step RK4, steps_per_period steps"),
-    Method("collocation", "casadi", False, 7, step_unit=4,
-           description="CasADi fixed-step Radau IIA collocation, elements of four points"),
-    Method("dop853", "native", True, 8,
-           description="compiled DOP853 on the generated C right-hand side"),
-    Method("dopri5", "native", True, 5,
-           description="compiled Dormand-Prince 5(4) on the generated C right-hand side"),
-    Method("rk4", "native", False, 4, step_unit=1,
-           description="compiled fixed-step classic RK4"),
-)  # fmt: skip
+    Method(
+        "RK45",
+        "scipy",
+        True,
+        5,
+        locates_surfaces=True,
+        description="SciPy Dormand-Prince 5(4): the reference study's method",
+    ),
+    Method(
+        "DOP853", "scipy", True, 8, locates_surfaces=True, description="SciPy Dormand-Prince 8(5,3)"
+    ),
+    Method(
+        "LSODA",
+        "scipy",
+        True,
+        12,
+        locates_surfaces=True,
+        description="SciPy LSODA (Adams / BDF switching), with the generated Jacobian",
+    ),
+    Method(
+        "Radau",
+        "scipy",
+        True,
+        5,
+        locates_surfaces=True,
+        description="SciPy implicit Radau IIA, with the generated Jacobian",
+    ),
+    Method(
+        "cvodes",
+        "casadi",
+        True,
+        5,
+        description="CasADi CVODES (SUNDIALS, variable-order BDF/Adams)",
+    ),
+    Method(
+        "rk",
+        "casadi",
+        False,
+        4,
+        step_unit=1,
+        description="CasADi fixed-step RK4, steps_per_period steps",
+    ),
+    Method(
+        "collocation",
+        "casadi",
+        False,
+        7,
+        step_unit=4,
+        description="CasADi fixed-step Radau IIA collocation, elements of four points",
+    ),
+    Method(
+        "dop853",
+        "native",
+        True,
+        8,
+        description="compiled DOP853 on the generated C right-hand side",
+    ),
+    Method(
+        "dopri5",
+        "native",
+        True,
+        5,
+        description="compiled Dormand-Prince 5(4) on the generated C right-hand side",
+    ),
+    Method("rk4", "native", False, 4, step_unit=1, description="compiled fixed-step classic RK4"),
+)
 
 REGISTRY: dict[str, Method] = {m.name: m for m in _RECORDS}
 METHODS: tuple[str, ...] = tuple(REGISTRY)

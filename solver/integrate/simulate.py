@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 
 import numpy as np
 
@@ -35,6 +35,7 @@ from .events import SimulationError
 from .limits import check_samples, check_start, default_initial_state, samples_for
 from .methods import METHODS, get_method
 from .result import Request, first_exit
+from .trajectory import Trajectory
 
 __all__ = [
     "METHODS",
@@ -62,98 +63,6 @@ def fastest_method(rtol: float) -> str:
     if compiler() is None or rtol < 100 * np.finfo(float).eps:
         return "cvodes"
     return "dop853"
-
-
-@dataclass(frozen=True)
-class Trajectory:
-    """A sampled response.
-
-    Attributes
-    ----------
-    t : ndarray, shape (K,)
-        Sample times (non-dimensional, tau) of the sampled window.
-    x : ndarray, shape (n, K)
-        States at ``t``.
-    samples_per_period : int
-        Samples per forcing period; ``x[:, ::samples_per_period]`` are Poincare points.
-    status : str
-        ``ok``, ``divergent`` (a state passed ``bound``), ``invalid`` (left the force
-        law's valid range with ``on_invalid="error"``) or ``failed``.
-    """
-
-    system: System
-    method: str
-    rtol: float
-    atol: float
-    transient: int
-    periods: int
-    samples_per_period: int
-    t: np.ndarray
-    x: np.ndarray
-    x_final: np.ndarray
-    t_final: float
-    status: str
-    message: str
-    nfev: int
-    nsteps: int
-    wall_time: float
-    boundary_crossings: int | None = None  # located crossings (SciPy back ends only)
-    left_valid_range: tuple | None = None  # (tau, state, value) of the first exit
-    options: dict = field(default_factory=dict)
-
-    @property
-    def period(self) -> float:
-        return self.system.period
-
-    @property
-    def poincare(self) -> np.ndarray:
-        """Stroboscopic points at the start of each sampled period, shape (n, periods)."""
-        return self.x[:, : self.periods * self.samples_per_period : self.samples_per_period]
-
-    def coordinate(self, name: str) -> np.ndarray:
-        return self.x[self.system.index(name)]
-
-    def velocity(self, coordinate: str) -> np.ndarray:
-        """The time derivative of mesh coordinate ``coordinate``."""
-        return self.x[self.system.velocity_index(coordinate)]
-
-    def describe(self) -> dict:
-        return {
-            "method": self.method,
-            "rtol": self.rtol,
-            "atol": self.atol,
-            "transient_periods": self.transient,
-            "sampled_periods": self.periods,
-            "samples_per_period": self.samples_per_period,
-            "status": self.status,
-            "message": self.message,
-            "nfev": self.nfev,
-            "nsteps": self.nsteps,
-            "wall_time_s": self.wall_time,
-            "boundary_crossings": self.boundary_crossings,
-            "left_valid_range": None
-            if self.left_valid_range is None
-            else dict(zip(("tau", "state", "value"), self.left_valid_range, strict=True)),
-            "options": self.options,
-        }
-
-    def to_dict(self, samples: bool = True) -> dict:
-        """The run's settings and outcome, with the samples (``t`` and each state)."""
-        out = {"system": self.system.describe(), "integration": self.describe()}
-        if samples:
-            out["t"] = self.t.tolist()
-            out["x"] = {s: self.x[k].tolist() for k, s in enumerate(self.system.states)}
-        return out
-
-    def to_table(self) -> tuple[list, list]:
-        """One row per sample: tau and every state."""
-        return ["tau", *self.system.states], np.vstack([self.t, self.x]).T.tolist()
-
-    def save(self, path):
-        """Write to ``path``: ``.json``, ``.csv`` or ``.mat`` (see ``solver/export.py``)."""
-        from ..export import save
-
-        return save(self, path)
 
 
 def _check(system: System, req: Request) -> None:
@@ -233,8 +142,21 @@ def simulate(
         are not computed).
     """
     started = time.perf_counter()
-    req = _request(system, x0, method, rtol, atol, transient, periods, samples_per_period, t0,
-                   steps_per_period, max_step, bound, on_invalid)  # fmt: skip
+    req = _request(
+        system,
+        x0,
+        method,
+        rtol,
+        atol,
+        transient,
+        periods,
+        samples_per_period,
+        t0,
+        steps_per_period,
+        max_step,
+        bound,
+        on_invalid,
+    )
     run = _backend(get_method(req.method).family)(system, req)
     return _trajectory(system, req, run, started)
 
@@ -257,8 +179,18 @@ def simulate_many(systems, x0s=None, *, workers: int = 1, **options) -> list[Tra
     if get_method(method).family != "native" or len({s.module for s in systems}) != 1:
         return [simulate(s, x, **options) for s, x in zip(systems, x0s, strict=True)]
     started = time.perf_counter()
-    keys = ("rtol", "atol", "transient", "periods", "samples_per_period", "t0",
-            "steps_per_period", "max_step", "bound", "on_invalid")  # fmt: skip
+    keys = (
+        "rtol",
+        "atol",
+        "transient",
+        "periods",
+        "samples_per_period",
+        "t0",
+        "steps_per_period",
+        "max_step",
+        "bound",
+        "on_invalid",
+    )
     defaults = (1e-8, 1e-10, 300, 100, 64, 0.0, 512, None, 1e3, "warn")
     unknown = set(options) - set(keys) - {"method"}
     if unknown:
@@ -271,8 +203,21 @@ def simulate_many(systems, x0s=None, *, workers: int = 1, **options) -> list[Tra
     return [_trajectory(s, q, r, started) for s, q, r in zip(systems, reqs, runs, strict=True)]
 
 
-def _request(system, x0, method, rtol, atol, transient, periods, samples_per_period, t0,
-             steps_per_period, max_step, bound, on_invalid) -> Request:  # fmt: skip
+def _request(
+    system,
+    x0,
+    method,
+    rtol,
+    atol,
+    transient,
+    periods,
+    samples_per_period,
+    t0,
+    steps_per_period,
+    max_step,
+    bound,
+    on_invalid,
+) -> Request:
     """The checked request of one run, with its initial state and sample grid."""
     if method is None:
         method = fastest_method(rtol)

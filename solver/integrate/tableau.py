@@ -70,11 +70,12 @@ def rk_step(tab: ButcherTableau, f, t: float, y: np.ndarray, h: float) -> np.nda
 
 
 RK4 = ButcherTableau(
-    "RK4", 4,
+    "RK4",
+    4,
     A=[[0, 0, 0, 0], [0.5, 0, 0, 0], [0, 0.5, 0, 0], [0, 0, 1, 0]],
     b=[1 / 6, 1 / 3, 1 / 3, 1 / 6],
     c=[0, 0.5, 0.5, 1],
-)  # fmt: skip
+)
 
 
 @functools.cache
@@ -119,8 +120,11 @@ def dop853_dense():
 
 def dop853_dense_tables(arr) -> list[str]:
     dense = dop853_dense()
-    return [arr("GS_DOP853_AX", dense["A"]), arr("GS_DOP853_CX", dense["C"]),
-            arr("GS_DOP853_D", dense["D"])]  # fmt: skip
+    return [
+        arr("GS_DOP853_AX", dense["A"]),
+        arr("GS_DOP853_CX", dense["C"]),
+        arr("GS_DOP853_D", dense["D"]),
+    ]
 
 
 def c_tables() -> str:

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import eig
 
-__all__ = ["KINDS", "Floquet", "floquet", "bifurcation_tests"]
+__all__ = ["KINDS", "Floquet", "floquet", "bifurcation_tests", "multiplier_tests"]
 
 KINDS = ("fold", "period-doubling", "neimark-sacker")
 STABILITY = ("stable", "neutral", "unstable")
@@ -136,3 +136,15 @@ def bifurcation_tests(M: np.ndarray) -> np.ndarray:
     complex_pairs = [m for m in mu if m.imag > 1e-9]
     ns = float(np.prod([abs(m) ** 2 - 1.0 for m in complex_pairs])) if complex_pairs else 1.0
     return np.array([np.linalg.det(M - eye), np.linalg.det(M + eye), ns, len(complex_pairs)])
+
+
+def multiplier_tests(mu: np.ndarray) -> np.ndarray:
+    """:func:`bifurcation_tests` from the multipliers themselves, for a method that gives
+    them without a monodromy matrix (Hill's): ``prod (mu_i - 1)``, ``prod (mu_i + 1)``
+    (real, up to round-off, since complex multipliers come in conjugate pairs), the
+    Neimark-Sacker product and the number of complex pairs."""
+    mu = np.asarray(mu, dtype=complex)
+    complex_pairs = [m for m in mu if m.imag > 1e-9]
+    ns = float(np.prod([abs(m) ** 2 - 1.0 for m in complex_pairs])) if complex_pairs else 1.0
+    fold, pd = np.prod(mu - 1.0).real, np.prod(mu + 1.0).real
+    return np.array([float(fold), float(pd), ns, len(complex_pairs)])

@@ -96,8 +96,9 @@ def _symmetric(A, nx, M, H, period):
     # + (c_k + i s_k) e^{-iks}) / 2
     pos = (V[:, 1::2, :] - 1j * V[:, 2::2, :]) / 2
     neg = (V[:, 1::2, :] + 1j * V[:, 2::2, :]) / 2
-    W = np.concatenate([np.abs(neg[:, ::-1, :]) ** 2, np.abs(V[:, :1, :]) ** 2,
-                        np.abs(pos) ** 2], axis=1).sum(axis=0)  # fmt: skip
+    W = np.concatenate(
+        [np.abs(neg[:, ::-1, :]) ** 2, np.abs(V[:, :1, :]) ** 2, np.abs(pos) ** 2], axis=1
+    ).sum(axis=0)
     k = np.arange(-H, H + 1)
     centre = np.abs((k[:, None] * W).sum(axis=0) / W.sum(axis=0))
     return sigma[_distinct(np.argsort(centre, kind="stable"), sigma, nx, period)]

@@ -7,7 +7,7 @@
 * ``progress.py`` -- the progress line.
 """
 
-from .executor import EXECUTORS, map_tasks
+from ..executor import EXECUTORS, map_tasks
 from .points import Extremes, SweepPoint
 from .progress import Progress
 from .store import SweepStoreError

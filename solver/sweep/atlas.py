@@ -18,15 +18,13 @@ line; which one runs is decided once, here, not in every worker.
 Each run is classified and the runs of a grid point grouped into attractors
 (``attractors.py``).  Work goes in tasks -- the forward chain, the backward chain, and one
 task per column of random starts -- run serially, on local processes or with dask
-(``executor.py``); with ``store`` every finished column is written at once and a rerun
-resumes where the last one stopped.
+(``executor.py``); with ``store`` (a :class:`~.store.RunStore`, as for sweeps) every
+finished column is written at once and a rerun resumes where the last one stopped.
 """
 
 from __future__ import annotations
 
 import hashlib
-import json
-import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,15 +32,17 @@ from pathlib import Path
 import numpy as np
 
 from .._json import dumps
+from ..analysis.record import RunRecord
 from ..contract import load_generated
-from ..integrate.native.maps import map_backend, run_map
+from ..executor import map_tasks
+from ..integrate.run import Batch, decide_backend, integrate
 from ..integrate.simulate import default_initial_state
+from ..integrate.spec import RunSpec
 from ..system import System
-from .attractors import RunOutcome, group_runs, outcome
-from .executor import map_tasks
-from .maps_result import Cell, RegimeMap, outcome_from_dict, outcome_to_dict
+from .attractors import group_runs, outcome
+from .maps_result import Cell, RegimeMap
 from .progress import Progress
-from .store import SweepStoreError, lock_store
+from .store import RunStore
 
 __all__ = ["default_box", "regime_map"]
 
@@ -64,7 +64,8 @@ def _random_state(seed: int, ix: int, iy: int, k: int, box, states) -> np.ndarra
 
 @dataclass(frozen=True)
 class _Column:
-    """The runs of one start kind at one x value: per y, the model file, p and x0."""
+    """The runs of one start kind at one x value: per y, the model file, p and x0, and
+    the runs' keys in the store (``key`` to ``key + len(files) - 1``)."""
 
     ix: int
     kind: str  # "forward", "backward" or "random"
@@ -72,29 +73,23 @@ class _Column:
     P: tuple  # ny * m parameter vectors (models may differ along an open-value axis)
     X0: np.ndarray | None  # (ny * m, n); None: chained (previous column's end states)
     starts: tuple[str, ...]
+    values: tuple[dict, ...]  # each run's grid point: {x name: value, y name: value}
+    key: int
 
 
-def _run_column(col: _Column, X0: np.ndarray, opts: dict) -> list[RunOutcome]:
+def _run_column(col: _Column, X0: np.ndarray, opts: dict) -> list[RunRecord]:
     """Integrate one column (grouped by model file and forcing frequency) and classify."""
-    out: list[RunOutcome | None] = [None] * len(col.files)
+    out: list[RunRecord | None] = [None] * len(col.files)
     modules = {f: load_generated(f) for f in set(col.files)}
     by_model: dict = {}
     for i, f in enumerate(col.files):
         c = modules[f].CONTRACT
         w = col.P[i][list(c["parameters"]).index(c["forcing_frequency"])]
         by_model.setdefault((f, float(w)), []).append(i)
-    run_opts = {k: opts[k] for k in ("method", "rtol", "atol", "transient", "periods")}
     for (f, _), idx in by_model.items():
         module = modules[f]
-        res = run_map(
-            module,
-            np.array([col.P[i] for i in idx]),
-            X0[idx],
-            lyapunov_periods=opts["lyapunov_periods"],
-            seed=opts["seed"],
-            backend=opts["backends"][f],
-            **run_opts,
-        )
+        batch = Batch.of(module, np.array([col.P[i] for i in idx]))
+        res = integrate(batch, X0[idx], opts["spec"], backend=opts["backends"][f])
         base = System(module, col.P[idx[0]])
         for r, i in enumerate(idx):
             system = System(module, col.P[i], {}, base.contract)
@@ -102,55 +97,35 @@ def _run_column(col: _Column, X0: np.ndarray, opts: dict) -> list[RunOutcome]:
                 system,
                 col.starts[i],
                 res.status[r],
-                res.poincare[r],
+                res.x[r],
                 res.xmin[r],
                 res.xmax[r],
-                None if res.lyapunov is None else res.lyapunov[r],
+                None if res.exponent is None else res.exponent[r],
                 tol=opts["tol"],
                 rtol=opts["rtol"],
-                engine=f"{'compiled' if res.backend == 'native' else 'SciPy'} "
-                f"{run_opts['method'].upper()} (map)",
+                engine=f"{res.label} (map)",
                 atol=opts["atol"],
+                values=col.values[i],
+                x0=X0[i],
             )
     return out  # type: ignore[return-value]
 
 
-def _column_file(store: Path, kind: str, ix: int) -> Path:
-    return store / "columns" / f"{kind}-{ix:04d}.json"
-
-
-def _save_column(store: Path | None, col: _Column, runs: list[RunOutcome]) -> None:
-    if store is None:
-        return
-    path = _column_file(store, col.kind, col.ix)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_text(dumps([outcome_to_dict(r) for r in runs]), encoding="utf-8")
-    os.replace(tmp, path)
-
-
-def _load_column(store: Path | None, kind: str, ix: int) -> list[RunOutcome] | None:
-    if store is None:
-        return None
-    path = _column_file(store, kind, ix)
-    try:
-        return [outcome_from_dict(d) for d in json.loads(path.read_text(encoding="utf-8"))]
-    except (OSError, ValueError, KeyError, TypeError):
-        return None
-
-
-def _task(task) -> list[tuple[str, int, list[RunOutcome]]]:
+def _task(task) -> list[tuple[str, int, list[RunRecord]]]:
     """One task: a chain of columns (each from the previous one's end states) or one
-    column of independent starts.  Finished columns go to the store at once."""
-    columns, first_x0, opts, store = task
+    column of independent starts.  Finished columns go to the store at once; columns
+    the store holds (``stored``, by key) are not run again."""
+    columns, first_x0, opts, store, stored = task
     done = []
     x0 = first_x0
     for col in columns:
-        runs = _load_column(store, col.kind, col.ix)
+        keys = range(col.key, col.key + len(col.files))
+        runs = [stored[k] for k in keys] if all(k in stored for k in keys) else None
         if runs is None:
             start = col.X0 if col.X0 is not None else x0
             runs = _run_column(col, start, opts)
-            _save_column(store, col, runs)
+            if store is not None:
+                store.append(dict(zip(keys, runs, strict=True)))
         done.append((col.kind, col.ix, runs))
         # the next column of a chain starts where this one ended (or, after a failure,
         # from the column's own start)
@@ -158,24 +133,6 @@ def _task(task) -> list[tuple[str, int, list[RunOutcome]]]:
         start = col.X0 if col.X0 is not None else x0
         x0 = np.array([e if e is not None else start[k] for k, e in enumerate(ends)])
     return done
-
-
-def _check_store(store: Path, manifest: dict) -> None:
-    store.mkdir(parents=True, exist_ok=True)
-    lock_store(store)  # one writer at a time, as for sweeps
-    path = store / "manifest.json"
-    if path.exists():
-        old = json.loads(path.read_text(encoding="utf-8"))
-        differs = [k for k in manifest if old.get(k) != json.loads(dumps(manifest[k]))]
-        if differs:
-            raise SweepStoreError(
-                f"{store} holds another map ({', '.join(differs)} differ); choose another "
-                "output folder or delete it"
-            )
-        return
-    tmp = store / ".manifest.json.tmp"
-    tmp.write_text(dumps(manifest, indent=1), encoding="utf-8")
-    os.replace(tmp, path)
 
 
 def regime_map(
@@ -215,10 +172,18 @@ def regime_map(
         raise ValueError(f"the two axes must be different parameters, both are '{xn}'")
     if initial_states < 1:
         raise ValueError(f"initial_states must be >= 1, got {initial_states}")
-    if not 0 <= lyapunov_periods <= transient + periods:
-        raise ValueError(
-            f"lyapunov_periods must be in [0, transient + periods = {transient + periods}]"
-        )
+    # the run's options, checked once here (before any work), for every task
+    spec = RunSpec(
+        method=method,
+        rtol=rtol,
+        atol=atol,
+        transient=transient,
+        periods=periods,
+        collect=("samples", "extremes", "exponent")[: 3 if lyapunov_periods else 2],
+        lyapunov_periods=lyapunov_periods,
+        seed=seed,
+        valid_range="stop",
+    )
     resolve = resolve or (lambda values: system.with_values(**values))
     grid = [[resolve({xn: float(a), yn: float(b)}) for b in yv] for a in xv]
     states = system.states
@@ -237,20 +202,9 @@ def regime_map(
         seed=seed,
         tol=classification_tolerance(method, rtol),
     )
-    root = None if store is None else Path(store)
     hashes = sorted({g.model_hash for col in grid for g in col})
-    if root is not None:
-        _check_store(
-            root,
-            {
-                "kind": "regime map",
-                "model_hashes": hashes,
-                "x": {xn: xv.tolist()},
-                "y": {yn: yv.tolist()},
-                "values": {k: float(v) for k, v in system.values.items()},
-                "settings": {**opts, "initial_states": initial_states, "box": box},
-            },
-        )
+    nx, ny = len(xv), len(yv)
+    first_key = {"forward": 0, "backward": nx * ny, "random": 2 * nx * ny}
 
     def column(ix: int, kind: str) -> _Column:
         cells = grid[ix]
@@ -265,32 +219,56 @@ def regime_map(
                     for k in range(n_random)
                 ]
             )
-            return _Column(ix, kind, tuple(files), P, X0, tuple(starts))
+            named = tuple({xn: float(xv[ix]), yn: float(b)} for b in yv for _ in range(n_random))
+            key = first_key[kind] + ix * ny * n_random
+            return _Column(ix, kind, tuple(files), P, X0, tuple(starts), named, key)
         files = tuple(g.module.__file__ for g in cells)
-        return _Column(ix, kind, files, tuple(g.p for g in cells), None, (kind,) * len(cells))
+        named = tuple({xn: float(xv[ix]), yn: float(b)} for b in yv)
+        P = tuple(g.p for g in cells)
+        return _Column(ix, kind, files, P, None, (kind,) * ny, named, first_key[kind] + ix * ny)
 
     # the compiled library of every model, built once here (or the fallback, warned once)
-    tangent = lyapunov_periods > 0
     models = {g.module.__file__: g.module for col in grid for g in col}
-    run_opts = {**opts, "backends": {f: map_backend(m, tangent) for f, m in models.items()}}
-    tasks = []
-    chains = {"forward": range(len(xv)), "backward": range(len(xv) - 1, -1, -1)}
-    for kind in list(chains)[: min(initial_states, 2)]:
-        order = list(chains[kind])
-        first = np.array([default_initial_state(g) for g in grid[order[0]]])
-        tasks.append(([column(ix, kind) for ix in order], first, run_opts, root))
-    if n_random:
-        tasks += [([column(ix, "random")], None, run_opts, root) for ix in range(len(xv))]
-    bar = Progress(len(tasks), "map", enabled=progress)
-    results = map_tasks(
-        _task,
-        tasks,
-        executor=executor,
-        workers=workers,
-        scheduler=scheduler,
-        on_result=lambda _r: bar.step(),
-    )
-    runs: dict[tuple[int, int], list[RunOutcome]] = {}
+    backends = {f: decide_backend(m, spec) for f, m in models.items()}
+    run_opts = {**opts, "spec": spec, "backends": backends}
+    chains = {"forward": range(nx), "backward": range(nx - 1, -1, -1)}
+    planned = [
+        ([column(ix, kind) for ix in chains[kind]], grid[chains[kind][0]])
+        for kind in list(chains)[: min(initial_states, 2)]
+    ]
+    planned += [([column(ix, "random")], None) for ix in range(nx) if n_random]
+    opened = None
+    if store is not None:
+        opened = RunStore.open(
+            Path(store),
+            kind="map",
+            model_hash=hashes,
+            values={xn: xv.tolist(), yn: yv.tolist()},
+            model=system.name,
+            base_values={k: float(v) for k, v in system.values.items()},
+            settings={**opts, "initial_states": initial_states, "box": box},
+        )
+    try:
+        stored = {} if opened is None else opened.read()
+        tasks = []
+        for columns, cells in planned:
+            first = None if cells is None else np.array([default_initial_state(g) for g in cells])
+            keys = {k for col in columns for k in range(col.key, col.key + len(col.files))}
+            held = {k: r for k, r in stored.items() if k in keys}
+            tasks.append((columns, first, run_opts, opened, held))
+        bar = Progress(len(tasks), "map", enabled=progress)
+        results = map_tasks(
+            _task,
+            tasks,
+            executor=executor,
+            workers=workers,
+            scheduler=scheduler,
+            on_result=lambda _r: bar.step(),
+        )
+    finally:
+        if opened is not None:
+            opened.close()
+    runs: dict[tuple[int, int], list[RunRecord]] = {}
     order = {"forward": 0, "backward": 1, "random": 2}
     for part in results:
         for kind, ix, column_runs in sorted(part, key=lambda p: order[p[0]]):
@@ -318,9 +296,10 @@ def regime_map(
         cells=cells,
         wall_time=time.perf_counter() - started,
         digest=hashlib.sha256(dumps([hashes, xv.tolist(), yv.tolist()]).encode()).hexdigest(),
+        resumed=len(stored),
     )
 
 
-def _ordered(runs: list[RunOutcome]) -> list[RunOutcome]:
+def _ordered(runs: list[RunRecord]) -> list[RunRecord]:
     rank = {"forward": 0, "backward": 1}
     return sorted(runs, key=lambda r: (rank.get(r.start, 2), r.start))

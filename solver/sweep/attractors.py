@@ -28,10 +28,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..analysis.classify import classify_points
+from ..analysis.classify import Classification, classify_points
 from ..analysis.lyapunov import LyapunovEstimate
+from ..analysis.record import Extremes, RunRecord
 
-__all__ = ["Attractor", "RunOutcome", "group_runs", "meshing_regime", "outcome"]
+__all__ = ["Attractor", "group_runs", "meshing_regime", "outcome"]
 
 SAME_TOL = 1e-4  # periodic orbits: Poincare sets closer than this (relative) are one
 CLOUD_TOL = 0.05  # non-periodic sets: extremes closer than this (relative) are one
@@ -52,27 +53,6 @@ def meshing_regime(lo: float, hi: float, lower: float, upper: float) -> str:
     return "no contact"
 
 
-@dataclass(frozen=True)
-class RunOutcome:
-    """One run: start label, status, motion and period per coordinate, exponent with its
-    uncertainty (``analysis.lyapunov.uncertainty``), extremes per state, meshing regime
-    per mesh, the Poincare cloud's spread per coordinate, and the last Poincare points (to
-    compare runs and to restart from)."""
-
-    start: str
-    status: str
-    motion: dict
-    period: dict
-    lyapunov: float | None
-    lyapunov_uncertainty: float | None  # a bound on the exponent's error (about 95 %)
-    xmax: np.ndarray
-    xmin: np.ndarray
-    meshing: dict
-    spread: dict
-    tail: np.ndarray  # (m, n): the last Poincare points
-    evidence: dict = field(default_factory=dict)
-
-
 def outcome(
     system,
     start: str,
@@ -85,10 +65,16 @@ def outcome(
     tol,
     rtol,
     atol,
+    values: dict | None = None,
+    x0=None,
     engine: str = "compiled DOP853 (map)",
-) -> RunOutcome:
-    """Classify one run of a map (``poincare`` (K, n), ``running`` exponent or None);
-    ``engine`` names what integrated it (the exponent's record says so)."""
+) -> RunRecord:
+    """The record of one run of a map: ``poincare`` (K, n) its Poincare points,
+    ``xmin``/``xmax`` (n,) its extremes, ``running`` its running exponent (or None);
+    ``values`` the grid point's named values, ``x0`` (n,) where it started; ``engine``
+    names what integrated it (the exponent's record says so).  The record keeps the last
+    64 Poincare points, the whole window's spread per coordinate, and of the evidence
+    the reason of an undetermined verdict (``why``)."""
     c = system.contract
     lyap = None
     if running is not None and status == "ok" and np.all(np.isfinite(running)):
@@ -103,38 +89,37 @@ def outcome(
             engine,
             system.period,
         )
-    motion, period, spread, evidence = {}, {}, {}, {}
+    verdicts, spread = {}, {}
     for coord in system.coordinates:
         i, j = c.index(coord), c.velocity(coord)
         pts = poincare[:, [i, j]].T
         spread[coord] = float(np.ptp(pts[0])) if np.all(np.isfinite(pts)) else None
         if status == "ok":
             v = classify_points(pts, tol=tol, lyapunov=lyap, period=system.period)
-            motion[coord], period[coord] = v.motion, v.period
-            if "why" in v.evidence:
-                evidence[coord] = v.evidence["why"]
+            why = {"why": v.evidence["why"]} if "why" in v.evidence else {}
+            verdicts[coord] = Classification(v.motion, v.period, why)
         else:
-            motion[coord] = "divergent" if status == "divergent" else "undetermined"
-            period[coord] = None
+            motion = "divergent" if status == "divergent" else "undetermined"
+            verdicts[coord] = Classification(motion, None, {})
     meshing = {}
     for coord, (lower, upper) in c.contact.items():
         k = c.index(coord)
         meshing[coord] = (
             meshing_regime(xmin[k], xmax[k], lower, upper) if status == "ok" else "undetermined"
         )
-    return RunOutcome(
-        start=start,
+    tail = np.asarray(poincare[-min(len(poincare), 2 * 32) :], float)
+    summary = None if lyap is None else {"exponent": lyap.exponent, "uncertainty": lyap.uncertainty}
+    return RunRecord(
+        values=dict(values or {}),
         status=status,
-        motion=motion,
-        period=period,
-        lyapunov=None if lyap is None else lyap.exponent,
-        lyapunov_uncertainty=None if lyap is None else lyap.uncertainty,
-        xmax=np.asarray(xmax, float),
-        xmin=np.asarray(xmin, float),
-        meshing=meshing,
+        classification=verdicts,
+        extremes={s: Extremes(float(xmax[k]), float(xmin[k])) for k, s in enumerate(system.states)},
+        start=start,
+        x0=None if x0 is None else np.array(x0, dtype=float),
+        meshing_regime=meshing,
+        lyapunov=summary,
+        poincare={s: tail[:, k].copy() for k, s in enumerate(system.states)},
         spread=spread,
-        tail=np.asarray(poincare[-min(len(poincare), 2 * 32) :], float),
-        evidence=evidence,
     )
 
 
@@ -145,38 +130,39 @@ class Attractor:
 
     share: float
     starts: tuple[str, ...]
-    run: RunOutcome  # the representative: the first run with the majority's verdicts
+    run: RunRecord  # the representative: the first run with the majority's verdicts
     votes: dict = field(default_factory=dict)  # per coordinate, when the runs disagree
 
     def to_dict(self, states) -> dict:
         r = self.run
+        why = {c: k.evidence["why"] for c, k in r.classification.items() if "why" in k.evidence}
         return {
             "share": self.share,
             "starts": list(self.starts),
             "status": r.status,
-            "motion": dict(r.motion),
-            "period": dict(r.period),
-            "lyapunov": r.lyapunov,
+            "motion": {c: k.motion for c, k in r.classification.items()},
+            "period": {c: k.period for c, k in r.classification.items()},
+            "lyapunov": r.lyapunov_exponent,
             "lyapunov_uncertainty": r.lyapunov_uncertainty,
-            "max": dict(zip(states, map(float, r.xmax), strict=True)),
-            "min": dict(zip(states, map(float, r.xmin), strict=True)),
-            "meshing": dict(r.meshing),
+            "max": {s: r.max(s) for s in states},
+            "min": {s: r.min(s) for s in states},
+            "meshing": dict(r.meshing_regime),
             "poincare_spread": dict(r.spread),
             "state": [float(v) for v in r.tail[-1]],
-            **({"why": dict(r.evidence)} if r.evidence else {}),
+            **({"why": why} if why else {}),
             **({"verdicts": self.votes} if self.votes else {}),
         }
 
 
-def _cycle(run: RunOutcome) -> int | None:
+def _cycle(run: RunRecord) -> int | None:
     """The common period of all coordinates (their least common multiple), or None."""
-    periods = list(run.period.values())
+    periods = [k.period for k in run.classification.values()]
     if run.status != "ok" or not periods or any(p is None for p in periods):
         return None
     return int(np.lcm.reduce(periods))
 
 
-def _kind(run: RunOutcome) -> tuple:
+def _kind(run: RunRecord) -> tuple:
     """What two runs must share before their geometry is compared: the failure status,
     or periodic with the same period per coordinate, or not periodic (quasi-periodic,
     chaotic and undetermined verdicts of one set differ only in finite-sample evidence)."""
@@ -184,10 +170,10 @@ def _kind(run: RunOutcome) -> tuple:
         return (run.status,)
     if _cycle(run) is None:
         return ("not periodic",)
-    return ("periodic", tuple(sorted(run.period.items())))
+    return ("periodic", tuple(sorted((c, k.period) for c, k in run.classification.items())))
 
 
-def same_attractor(a: RunOutcome, b: RunOutcome) -> bool:
+def same_attractor(a: RunRecord, b: RunRecord) -> bool:
     if _kind(a) != _kind(b):
         return False
     if a.status != "ok":
@@ -203,24 +189,24 @@ def same_attractor(a: RunOutcome, b: RunOutcome) -> bool:
     return gap <= CLOUD_TOL * size
 
 
-def _attractor(members: list[RunOutcome], total: int) -> Attractor:
+def _attractor(members: list[RunRecord], total: int) -> Attractor:
     """The majority's verdicts (ties: the earlier start) and, if the runs disagree, the
     count of each verdict per coordinate."""
-    verdicts = [tuple(sorted(r.motion.items())) for r in members]
+    verdicts = [tuple(sorted((c, k.motion) for c, k in r.classification.items())) for r in members]
     best = max(verdicts, key=lambda v: (verdicts.count(v), -verdicts.index(v)))
     run = members[verdicts.index(best)]
     votes = {}
-    for coord in run.motion:
-        seen = [r.motion[coord] for r in members]
+    for coord in run.classification:
+        seen = [r.motion(coord) for r in members]
         if len(set(seen)) > 1:
             votes[coord] = {m: seen.count(m) for m in dict.fromkeys(seen)}
     return Attractor(len(members) / total, tuple(r.start for r in members), run, votes)
 
 
-def group_runs(runs: list[RunOutcome]) -> list[Attractor]:
+def group_runs(runs: list[RunRecord]) -> list[Attractor]:
     """Group the runs of one grid point into attractors, largest share first (ties: the
     order of the starts, so the forward start's attractor comes first)."""
-    groups: list[list[RunOutcome]] = []
+    groups: list[list[RunRecord]] = []
     for r in runs:
         for g in groups:
             if same_attractor(g[0], r):

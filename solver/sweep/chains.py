@@ -12,17 +12,16 @@ unpicklable crosses processes; each finished point is written to the store at on
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
 from ..analysis.point import analyse_point, analyse_trajectory
+from ..analysis.record import RunRecord
 from ..integrate import SimulationError
 from ..integrate.methods import get_method
 from ..integrate.simulate import check_start, fastest_method, simulate_many
 from ..system import System
-from .points import SweepPoint
-from .store import point_text, store_chunk, store_point
+from .store import RunStore, record_text
 
 __all__ = ["Chain", "ChainDone", "checked_values", "module_ref", "plan", "run_chain"]
 
@@ -31,10 +30,13 @@ CHUNK = 64
 CHUNK_BYTES = 256 << 20  # and at most this much of samples per chunk (issue 14)
 SPREAD = 4
 _FAILURES = (SimulationError, ValueError, FloatingPointError)
-_SIMULATE = ("method", "rtol", "atol", "transient", "periods", "samples_per_period",
-             "steps_per_period", "on_invalid")  # fmt: skip
-_ANALYSE = ("rtol", "atol", "lyapunov_periods", "steps_per_period", "on_invalid",
-            "dimension_points")  # fmt: skip
+# the settings that go to the integration, and those that go to the analysis
+_SIMULATE = (
+    *("method", "rtol", "atol", "transient", "periods", "samples_per_period"),
+    *("steps_per_period", "on_invalid"),
+)
+_ANALYSE = ("rtol", "atol", "lyapunov_periods", "steps_per_period", "on_invalid")
+_ANALYSE += ("dimension_points",)
 
 
 @dataclass(frozen=True)
@@ -54,8 +56,9 @@ class Chain:
     settings: dict
     continuation: bool
     indices: list = field(default_factory=list)
-    store: str | None = None
+    store: RunStore | None = None
     batch: bool = False
+    continued: bool = False  # x0 is an earlier point's end state (a resumed chain)
 
 
 @dataclass(frozen=True)
@@ -94,14 +97,24 @@ def checked_values(system: System, parameter: str, values, x0=None) -> np.ndarra
     return values
 
 
-def _one(system: System, parameter: str, value: float, state, settings: dict) -> SweepPoint:
+def _start(state, continued: bool) -> dict:
+    """Where a point starts, as its record says it."""
+    if state is None:
+        return {"start": "default"}
+    return {"start": "continued" if continued else "given", "x0": np.array(state, dtype=float)}
+
+
+def _one(
+    system: System, parameter: str, value: float, state, settings: dict, continued=False
+) -> RunRecord:
     """One point by :func:`analyse_point`; a failure is tried once more, then recorded."""
+    values, start = {parameter: value}, _start(state, continued)
     for attempt in (1, 2):
         try:
-            result = analyse_point(system.with_values(**{parameter: value}), state, **settings)
-            return SweepPoint.from_result(result, value)
+            result = analyse_point(system.with_values(**values), state, **settings)
+            return result.record(values, **start)
         except _FAILURES as err:
-            point = SweepPoint.failed(system, value, err, attempt)
+            point = RunRecord.failed(system, values, err, attempt, **start)
     return point
 
 
@@ -122,7 +135,8 @@ def _batch(chain: Chain, system: System):
 
     def analysed(value, tr):
         try:
-            return SweepPoint.from_result(analyse_trajectory(tr, **rest), value)
+            record = analyse_trajectory(tr, **rest).record
+            return record({chain.parameter: value}, **_start(state, False))
         except _FAILURES:
             return _one(system, chain.parameter, value, state, chain.settings)
 
@@ -136,10 +150,11 @@ def _points(chain: Chain, system: System):
             yield from points
             return
     state = None if chain.x0 is None else np.asarray(chain.x0, dtype=float)
+    continued = chain.continued
     for value in chain.values:
-        point = _one(system, chain.parameter, value, state, chain.settings)
+        point = _one(system, chain.parameter, value, state, chain.settings, continued)
         if chain.continuation and point.ok:
-            state = np.asarray(point.x_final)
+            state, continued = np.asarray(point.x_final), True
         yield point
 
 
@@ -151,15 +166,16 @@ def run_chain(chain: Chain, on_point=None) -> ChainDone:
     for k, point in enumerate(_points(chain, system)):
         text = None
         if chain.store is not None and chain.batch:
-            text = point_text(point)
+            text = record_text(point)
         elif chain.store is not None:
-            text = store_point(Path(chain.store), chain.indices[k], point)
+            text = chain.store.append({chain.indices[k]: point})[chain.indices[k]]
         points.append(point)
         texts.append(text)
         if on_point is not None:
             on_point(point)
     if chain.store is not None and chain.batch:
-        store_chunk(Path(chain.store), chain.indices, texts)
+        records = dict(zip(chain.indices, points, strict=True))
+        chain.store.append(records, dict(zip(chain.indices, texts, strict=True)))
     return ChainDone(points, texts)
 
 
@@ -172,8 +188,8 @@ def plan(
     backward: bool,
     x0,
     settings: dict,
-    done: dict[int, SweepPoint] | None = None,
-    store: Path | None = None,
+    done: dict[int, RunRecord] | None = None,
+    store: RunStore | None = None,
 ) -> list[Chain]:
     """The chains of a sweep, without the points already ``done`` (from the store)."""
     values = checked_values(system, parameter, values, x0)
@@ -181,19 +197,21 @@ def plan(
     x0 = None if x0 is None else [float(v) for v in x0]
     done = done or {}
     base = (module_ref(system), dict(system.values), parameter)
-    where = None if store is None else str(store)
+    where = store
     if continuation:
         # Resume after the last finished point, from the last state that was reached.
         k = 0
         while k in done:
             k += 1
+        continued = False
         for j in range(k - 1, -1, -1):
             if done[j].ok:
-                x0 = [float(v) for v in done[j].x_final]
+                x0, continued = [float(v) for v in done[j].x_final], True
                 break
         if k == len(order):
             return []
-        return [Chain(*base, order[k:], x0, settings, True, list(range(k, len(order))), where)]
+        rest = list(range(k, len(order)))
+        return [Chain(*base, order[k:], x0, settings, True, rest, where, continued=continued)]
     todo = [i for i in range(len(order)) if i not in done]
     method = settings.get("method") or fastest_method(settings.get("rtol", 1e-8))
     if get_method(method).family != "native" or len(order) < 2:

@@ -11,11 +11,11 @@ method, its events (folds and stability changes, located) and its wall time.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..system import System
+from .frequency_result import Curve, FrequencyResponse
 
 __all__ = [
     "MAX_HARMONICS",
@@ -40,96 +40,6 @@ def harmonics_cap(system: System) -> int:
     """The most harmonics the model may take: at most :data:`MAX_HARMONICS` and
     :data:`MAX_UNKNOWNS` unknowns (n_states (2H + 1))."""
     return max(1, min(MAX_HARMONICS, (MAX_UNKNOWNS // system.n - 1) // 2))
-
-
-@dataclass(frozen=True)
-class Curve:
-    """One method's solution curve: per point the parameter value, stability and, per
-    coordinate, mean, amplitude and RMS; the located events."""
-
-    method: str
-    parameter: str
-    values: np.ndarray
-    stable: np.ndarray
-    stats: dict  # coordinate -> {"mean", "amplitude", "rms", "max", "min",
-    # "dynamic_factor"}: arrays
-    events: tuple = ()
-    wall_time: float = 0.0
-    details: dict = field(default_factory=dict)
-    # the state at tau = 0 (mod n T) of each point (harmonic balance, shooting), kept for
-    # checks and restarts; not written to the result files
-    states: tuple = ()
-
-    def records(self) -> list[dict]:
-        out = []
-        for k, v in enumerate(self.values):
-            rec = {"method": self.method, self.parameter: float(v), "stable": bool(self.stable[k])}
-            if "direction" in self.details:
-                rec["direction"] = self.details["direction"]
-            for c, s in self.stats.items():
-                rec[c] = {q: float(s[q][k]) for q in ("mean", "amplitude", "rms")}
-                if "dynamic_factor" in s:
-                    rec[c]["dynamic_factor"] = float(s["dynamic_factor"][k])
-            out.append(rec)
-        return out
-
-
-@dataclass(frozen=True)
-class FrequencyResponse:
-    system: System
-    parameter: str
-    start: float
-    stop: float
-    curves: tuple[Curve, ...]
-
-    def records(self) -> list[dict]:
-        return [r for c in self.curves for r in c.records()]
-
-    def to_dict(self) -> dict:
-        d = self.system.describe()
-        return {
-            "model": d["model"],
-            "model_hash": d["model_hash"],
-            "values": {k: float(v) for k, v in self.system.values.items()},
-            "scales": self.system.scales(),
-            "parameter": self.parameter,
-            "range": [self.start, self.stop],
-            "curves": [
-                {
-                    "method": c.method,
-                    "points": len(c.values),
-                    "wall_time_s": c.wall_time,
-                    "events": list(c.events),
-                    **c.details,
-                }
-                for c in self.curves
-            ],
-            "records": self.records(),
-        }
-
-    def to_table(self) -> tuple[list, list]:
-        coords = self.system.coordinates
-        columns = ["method", self.parameter, "stable"] + [
-            f"{c}_{q}" for c in coords for q in ("mean", "amplitude", "rms", "dynamic_factor")
-        ]
-        rows = []
-        for r in self.records():
-            method = r["method"] + (f" {r['direction']}" if "direction" in r else "")
-            rows.append(
-                [method, r[self.parameter], r["stable"]]
-                + [
-                    r[c].get(q, float("nan"))
-                    for c in coords
-                    for q in ("mean", "amplitude", "rms", "dynamic_factor")
-                ]  # fmt: skip
-            )
-        return columns, rows
-
-    def save(self, path):
-        """Write to ``path``: ``.json``, ``.csv`` or ``.mat`` (see ``solver/export.py``)."""
-        from ..export import save
-
-        return save(self, path)
 
 
 def dynamic_factor(system: System, tau, x, p) -> dict:
@@ -158,15 +68,18 @@ def _hb_factors(system, parameter, br, n, samples: int = 512) -> dict:
     mod = system.module
     if not npts or not (hasattr(mod, "mesh_force") and hasattr(mod, "static_mesh_force")):
         return {c: np.full(npts, np.nan) for c in coords}
-    prob = br._problem()
+    prob = br.harmonic_balance
     phases = 2 * np.pi * np.arange(samples) / samples
     C = np.array([pt.coefficients for pt in br.points])  # (P, nx, M)
     X = prob.time_series(C.reshape(-1, prob.M), phases).reshape(npts, system.n, samples)
     P = np.array([system.parameters_with(**{parameter: pt.value}) for pt in br.points])
     iw = mod.PARAMETERS.index(system.contract.forcing_frequency)
     tau = n * phases[None, :] / P[:, iw, None]  # (P, samples)
-    F = np.asarray(mod.mesh_force(tau.ravel(), X.transpose(1, 0, 2).reshape(system.n, -1),
-                                  np.repeat(P.T, samples, axis=1)))  # fmt: skip
+    F = np.asarray(
+        mod.mesh_force(
+            tau.ravel(), X.transpose(1, 0, 2).reshape(system.n, -1), np.repeat(P.T, samples, axis=1)
+        )
+    )
     F = F.reshape(len(coords), npts, samples)
     static = np.array([mod.static_mesh_force(p) for p in P])  # (P, m)
     out = {}
@@ -181,8 +94,17 @@ def _hb_curve(system, parameter, start, stop, harmonics, n, ds) -> Curve:
     from ..periodic.hb_continuation import continue_hb
 
     span = abs(stop - start)
-    br = continue_hb(system, parameter, start, stop, harmonics=harmonics, n=n, ds=ds,
-                     ds_max=span / 10, dlam_max=ds)  # fmt: skip
+    br = continue_hb(
+        system,
+        parameter,
+        start,
+        stop,
+        harmonics=harmonics,
+        n=n,
+        ds=ds,
+        ds_max=span / 10,
+        dlam_max=ds,
+    )
     stats = {}
     for c in system.coordinates:
         y = br.series(c)
@@ -202,17 +124,17 @@ def _hb_curve(system, parameter, start, stop, harmonics, n, ds) -> Curve:
         br.values,
         br.stable,
         stats,
-        br.events,
+        br.bifurcations,
         br.wall_time,
         {
             "harmonics": harmonics,
-            "samples": br.samples,
+            "samples": br.harmonic_balance.N,
             "largest_tail_share": tail,
             "notes": list(br.notes),
             "status": br.status,
             "message": br.message,
-        },  # fmt: skip
-        tuple(br._problem().time_series(pt.coefficients, np.zeros(1))[:, 0] for pt in br.points),
+        },
+        br.states,
     )
 
 
@@ -221,8 +143,9 @@ def _shooting_curve(system, parameter, start, stop, n, ds, guess) -> Curve:
     from ..periodic import continue_orbit
 
     started = time.perf_counter()
-    br = continue_orbit(system, parameter, start, stop, guess, n=n, ds=ds, ds_max=2 * ds,
-                        max_points=20_000)  # fmt: skip
+    br = continue_orbit(
+        system, parameter, start, stop, guess, n=n, ds=ds, ds_max=2 * ds, max_points=20_000
+    )
     keys = ("mean", "amplitude", "rms", "max", "min", "dynamic_factor")
     stats = {c: {q: [] for q in keys} for c in system.coordinates}
     for v, x0 in zip(br.values, br.states, strict=True):
@@ -238,14 +161,13 @@ def _shooting_curve(system, parameter, start, stop, n, ds, guess) -> Curve:
             stats[c]["max"].append(float(y.max()))
             stats[c]["min"].append(float(y.min()))
     stats = {c: {q: np.array(v) for q, v in d.items()} for c, d in stats.items()}
-    events = tuple({"kind": b.kind, parameter: float(b.value)} for b in br.bifurcations)
     return Curve(
         "shooting",
         parameter,
         np.asarray(br.values, float),
         np.asarray(br.stable, bool),
         stats,
-        events,
+        br.bifurcations,
         time.perf_counter() - started,
         {"status": br.status, "message": br.message},
         tuple(np.asarray(x, float) for x in br.states),
@@ -279,8 +201,14 @@ def _integration_curves(system, parameter, start, stop, points, settle, sampled,
     poincare = [[] for _ in lanes]
     for k in range(points):
         P = np.array([system.parameters_with(**{parameter: float(w[k])}) for w in lanes])
-        run = run_phase(system.module, P, x, transient=max(settle, 300) if k == 0 else settle,
-                        periods=sampled, samples_per_period=spp)  # fmt: skip
+        run = run_phase(
+            system.module,
+            P,
+            x,
+            transient=max(settle, 300) if k == 0 else settle,
+            periods=sampled,
+            samples_per_period=spp,
+        )
         for j in range(2):
             status[j].append(run.status[j])
             xs = run.x[j, :-1]  # the closing sample starts the next period
@@ -317,7 +245,7 @@ def _integration_curves(system, parameter, start, stop, points, settle, sampled,
                     "samples_per_period": spp,
                     "failed": int((~good).sum()),
                     "poincare": [q for q, g in zip(poincare[j], good, strict=True) if g],
-                },  # fmt: skip
+                },
             )
         )
     return out
@@ -363,10 +291,14 @@ def frequency_response(
             if tail is not None:
                 from ..periodic.harmonic_balance import harmonic_balance
 
-                harmonics = harmonic_balance(system.with_values(**{parameter: start}),
-                                             harmonics=harmonics, n=n, tail=tail,
-                                             max_harmonics=harmonics_cap(system),
-                                             stability=False).harmonics  # fmt: skip
+                harmonics = harmonic_balance(
+                    system.with_values(**{parameter: start}),
+                    harmonics=harmonics,
+                    n=n,
+                    tail=tail,
+                    max_harmonics=harmonics_cap(system),
+                    stability=False,
+                ).harmonics
             curve = _hb_curve(system, parameter, start, stop, harmonics, n, ds)
             curves.append(curve)
             if curve.details["status"] not in ("complete", "boundary"):
@@ -374,14 +306,19 @@ def frequency_response(
                 # other end (the solution a simulation settles on there)
                 curves.append(_hb_curve(system, parameter, stop, start, harmonics, n, ds))
         elif m == "integration":
-            curves += _integration_curves(system, parameter, start, stop, points, settle,
-                                          sampled, samples_per_period)  # fmt: skip
+            curves += _integration_curves(
+                system, parameter, start, stop, points, settle, sampled, samples_per_period
+            )
         else:
             from ..periodic.harmonic_balance import harmonic_balance
 
             if guess is None:
-                first = harmonic_balance(system.with_values(**{parameter: start}),
-                                         harmonics=harmonics, n=n, stability=False)  # fmt: skip
+                first = harmonic_balance(
+                    system.with_values(**{parameter: start}),
+                    harmonics=harmonics,
+                    n=n,
+                    stability=False,
+                )
                 guess = first.state(0.0)
             curves.append(_shooting_curve(system, parameter, start, stop, n, ds, guess))
     return FrequencyResponse(system, parameter, float(start), float(stop), tuple(curves))

@@ -8,47 +8,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .attractors import Attractor, RunOutcome
+from ..analysis.classify import Classification
+from ..analysis.record import Extremes, RunRecord
+from .attractors import Attractor
 
-__all__ = ["Cell", "RegimeMap", "outcome_from_dict", "outcome_to_dict"]
-
-
-def outcome_to_dict(r: RunOutcome) -> dict:
-    return {
-        "start": r.start,
-        "status": r.status,
-        "motion": r.motion,
-        "period": r.period,
-        "lyapunov": r.lyapunov,
-        "lyapunov_uncertainty": r.lyapunov_uncertainty,
-        "xmax": r.xmax.tolist(),
-        "xmin": r.xmin.tolist(),
-        "meshing": r.meshing,
-        "spread": r.spread,
-        "tail": r.tail.tolist(),
-        "evidence": r.evidence,
-    }
-
-
-def outcome_from_dict(d: dict) -> RunOutcome:
-    def arr(v):
-        return np.array([np.nan if e is None else e for e in v], dtype=float)
-
-    tail = np.array([[np.nan if e is None else e for e in row] for row in d["tail"]], float)
-    return RunOutcome(
-        start=d["start"],
-        status=d["status"],
-        motion=dict(d["motion"]),
-        period=dict(d["period"]),
-        lyapunov=d["lyapunov"],
-        lyapunov_uncertainty=d["lyapunov_uncertainty"],
-        xmax=arr(d["xmax"]),
-        xmin=arr(d["xmin"]),
-        meshing=dict(d["meshing"]),
-        spread=dict(d["spread"]),
-        tail=tail,
-        evidence=dict(d.get("evidence", {})),
-    )
+__all__ = ["Cell", "RegimeMap"]
 
 
 @dataclass(frozen=True)
@@ -87,11 +51,13 @@ class RegimeMap:
     cells: tuple[tuple[Cell, ...], ...]
     wall_time: float
     digest: str = ""
+    resumed: int = 0  # runs that came from the store
 
     @property
     def meshes(self) -> tuple[str, ...]:
         """The coordinates with contact edges (a meshing regime)."""
-        return tuple(c for c in self.coordinates if c in self.cells[0][0].dominant.run.meshing)
+        meshing = self.cells[0][0].dominant.run.meshing_regime
+        return tuple(c for c in self.coordinates if c in meshing)
 
     def records(self) -> list[dict]:
         """One record per (grid point, attractor), the two values under their names."""
@@ -117,8 +83,8 @@ class RegimeMap:
             d = cell.dominant.to_dict(self.states)[field]
             return d if key is None else d.get(key)
 
-        rows = [[value(self.cells[ix][iy]) for ix in range(len(self.x_values))]
-                for iy in range(len(self.y_values))]  # fmt: skip
+        nx, ny = len(self.x_values), len(self.y_values)
+        rows = [[value(self.cells[ix][iy]) for ix in range(nx)] for iy in range(ny)]
         if field in ("motion", "meshing", "status"):
             return np.array(rows, dtype=object)
         return np.array([[np.nan if v is None else v for v in r] for r in rows], dtype=float)
@@ -172,19 +138,23 @@ class RegimeMap:
         states = tuple(d["states"])
         cells: dict = {}
         for r in d["records"]:
-            run = RunOutcome(
-                start=r["starts"][0],
+            why = r.get("why", {})
+            lyapunov = None
+            if r["lyapunov"] is not None:
+                lyapunov = {"exponent": r["lyapunov"], "uncertainty": r["lyapunov_uncertainty"]}
+            run = RunRecord(
+                values={x: float(r[x]), y: float(r[y])},
                 status=r["status"],
-                motion=r["motion"],
-                period=r["period"],
-                lyapunov=r["lyapunov"],
-                lyapunov_uncertainty=r["lyapunov_uncertainty"],
-                xmax=np.array([r["max"][s] for s in states], float),
-                xmin=np.array([r["min"][s] for s in states], float),
-                meshing=r["meshing"],
+                classification={
+                    c: Classification(m, r["period"][c], {"why": why[c]} if c in why else {})
+                    for c, m in r["motion"].items()
+                },
+                extremes={s: Extremes(r["max"][s], r["min"][s]) for s in states},
+                start=r["starts"][0],
+                meshing_regime=r["meshing"],
+                lyapunov=lyapunov,
+                poincare={s: np.array([v], float) for s, v in zip(states, r["state"], strict=True)},
                 spread=r["poincare_spread"],
-                tail=np.array([r["state"]], float),
-                evidence=r.get("why", {}),
             )
             key = (float(r[x]), float(r[y]))
             votes = r.get("verdicts", {})

@@ -1,4 +1,4 @@
-"""The result of a sweep: one :class:`~.points.SweepPoint` per value, in order.
+"""The result of a sweep: one :class:`~..analysis.record.RunRecord` per value, in order.
 
 ``save`` writes JSON, CSV or MATLAB files (``solver/export.py``).  A sweep that ran with a
 store already holds every point's JSON text (written once, in the worker that computed
@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from .._json import dumps
-from .points import SweepPoint
+from ..analysis.record import RunRecord
 from .store import write_atomic
 
 __all__ = ["SweepResult"]
@@ -32,10 +32,11 @@ class SweepResult:
     direction: str  # "forward", "backward" or "independent"
     base_values: dict
     settings: dict
-    points: list = field(default_factory=list)  # SweepPoint, in the order of values
+    points: list = field(default_factory=list)  # RunRecord, in the order of values
     scales: dict = field(default_factory=dict)  # omega_n and half backlash: back to SI
     # Each point's JSON text, dumps(point.to_dict()), when the store already wrote it.
     texts: list | None = field(default=None, compare=False, repr=False)
+    resumed: int = field(default=0, compare=False)  # points that came from the store
 
     def poincare(self, state: str) -> list[np.ndarray]:
         return [np.asarray(p.poincare[state]) for p in self.points]
@@ -115,7 +116,11 @@ class SweepResult:
 
     @classmethod
     def load(cls, path: Path) -> SweepResult:
+        """A sweep saved with ``save(... .json)``, by this version or an older one (whose
+        points name their value ``value``)."""
         d = json.loads(Path(path).read_text(encoding="utf-8"))
+        for p in d["points"]:  # before one record served every run: "value" alone
+            p.setdefault("values", {d["parameter"]: p.get("value")})
         return cls(
             d["model"],
             d["model_hash"],
@@ -124,6 +129,6 @@ class SweepResult:
             d["direction"],
             d["base_values"],
             d["settings"],
-            [SweepPoint.from_dict(p) for p in d["points"]],
+            [RunRecord.from_dict(p) for p in d["points"]],
             d.get("scales", {}),
         )

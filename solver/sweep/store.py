@@ -1,16 +1,21 @@
-"""The resumable sweep store: a manifest and the finished points, every file written
-atomically (temporary file, then rename), so that nothing computed is lost and a torn
-file cannot exist.
+"""The one store of classified runs, for sweeps and regime maps: a folder with its
+metadata and the finished runs, every file written atomically (temporary file, then
+rename), so that nothing computed is lost and a torn file cannot exist.
 
-A point of a continuation chain, or an independent point run on its own, is one file
-(``points/00012.json``) written as soon as it is done.  A lockstep chunk of independent
-points (integrated together, so finished together) is one file
-(``points/chunk-00048-50.json``: first index, number of points) holding the indices and
-the points: creating 400 small files took 0.2 s of a 400-point sweep's CPU time.
+:class:`RunStore` is the whole interface: :meth:`RunStore.open` creates the folder or
+checks that it holds this very work (metadata: kind, model hash, parameter values,
+settings), :meth:`~RunStore.append` writes finished runs under integer keys,
+:meth:`~RunStore.read` gives them back, :meth:`~RunStore.done` says which keys are done
+(resume), :meth:`~RunStore.count` how many runs it holds without reading them.  What
+the files inside are called is this module's business alone.
 
-One process writes into a store at a time (a lock the kernel frees when the process ends,
-however it ends).  A point file that holds no valid point is moved to ``damaged/`` and
-its points computed again; a damaged manifest is refused, as is one of another sweep.
+Runs that finish together (a lockstep chunk, a map's column) are one file, not one each:
+creating 400 small files took 0.2 s of a 400-point sweep's CPU time.  One process writes
+into a store at a time (a lock the kernel frees when the process ends, however it ends;
+its workers append under the parent's lock).  A file that holds no valid run is moved to
+``damaged/`` and its runs computed again; damaged metadata is refused, as is that of
+other work.  A store of gearsym's first format (before one format served sweeps and
+maps) is refused in one line: delete it and the work is computed again.
 """
 
 from __future__ import annotations
@@ -19,32 +24,31 @@ import json
 import os
 import time
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from .._json import dumps
-from .points import SweepPoint
+from ..analysis.record import RunRecord
 
 __all__ = [
     "STORE_FORMAT",
+    "RunStore",
     "SweepStoreError",
-    "close_store",
-    "lock_store",
-    "open_store",
-    "point_text",
-    "store_chunk",
-    "store_point",
+    "record_text",
     "stored_count",
     "write_atomic",
 ]
 
-STORE_FORMAT = 1
+STORE_FORMAT = 2
+_MANIFEST = "manifest.json"
+_RUNS = "points"  # the runs' files: <first key>-<count>.json
 
 
 class SweepStoreError(ValueError):
-    """A sweep folder that cannot be written or resumed: another model, another sweep, a
-    damaged manifest, or another process writing into it."""
+    """A store that cannot be written or resumed: another model, other work, damaged
+    metadata, a store of an older format, or another process writing into it."""
 
 
 try:
@@ -55,11 +59,11 @@ except ImportError:  # not POSIX: stores are not locked
 _HELD: dict[Path, int] = {}  # store folder -> descriptor of its lock, held by this process
 
 
-def lock_store(store: Path) -> None:
+def _lock(store: Path) -> None:
     """Lock ``store`` for this process, or refuse at once if another process holds it.
 
     The lock (``flock`` on ``store/lock``, which holds the holder's pid) lasts until
-    :func:`close_store` or the end of the process, however it ends: the kernel frees it
+    :meth:`RunStore.close` or the end of the process, however it ends: the kernel frees it
     with the process (SIGKILL included) and its pool workers.  Locking a store this
     process holds already does nothing.
     """
@@ -101,8 +105,8 @@ def _holder(fd: int) -> str:
     return "unknown"
 
 
-def close_store(store: Path) -> None:
-    """Free the lock of ``store`` taken by :func:`open_store` (or :func:`lock_store`)."""
+def _unlock(store: Path) -> None:
+    """Free the lock of ``store`` taken by :func:`_lock`."""
     fd = _HELD.pop(Path(store).resolve(), None)
     if fd is not None:
         os.close(fd)  # closing the last descriptor frees the lock
@@ -123,85 +127,66 @@ def write_atomic(path: Path, text: str) -> None:
         tmp.unlink(missing_ok=True)
 
 
-def point_text(point: SweepPoint) -> str:
-    """``dumps(point.to_dict())``: the point's JSON, with NaN written as null."""
-    d = point.to_dict()
+def record_text(record: RunRecord) -> str:
+    """``dumps(record.to_dict())``: the run's JSON, with NaN written as null."""
+    d = record.to_dict()
     try:
-        # A point's dict is plain Python but for NumPy floats (floats to json) and the odd
+        # A record's dict is plain Python but for NumPy floats (floats to json) and the odd
         # NaN; the cleaning walk (a third of the time) is needed only then.
         return json.dumps(d, allow_nan=False)
     except (TypeError, ValueError):
         return dumps(d)
 
 
-def store_point(store: Path, index: int, point: SweepPoint) -> str:
-    """Write one finished point atomically; return its text."""
-    text = point_text(point)
-    write_atomic(Path(store) / "points" / f"{index:05d}.json", text)
-    return text
-
-
-def store_chunk(store: Path, indices: list[int], texts: list[str]) -> None:
-    """Write the points of a chunk (their texts from :func:`point_text`) as one file."""
-    body = f'{{"indices": {json.dumps([int(i) for i in indices])}, "points": ['
-    body += ", ".join(texts) + "]}"
-    write_atomic(Path(store) / "points" / f"chunk-{indices[0]:05d}-{len(indices)}.json", body)
-
-
-def stored_count(store: Path) -> int:
-    """How many points a store holds (without reading them)."""
-    folder = Path(store) / "points"
-    single = len(list(folder.glob("[0-9]*.json")))
-    return single + sum(int(f.stem.rsplit("-", 1)[1]) for f in folder.glob("chunk-*-*.json"))
+def stored_count(root: Path) -> int:
+    """How many runs the store at ``root`` holds, without reading them (0: none yet)."""
+    folder = Path(root) / _RUNS
+    return sum(int(f.stem.rsplit("-", 1)[1]) for f in folder.glob("[0-9]*-[0-9]*.json"))
 
 
 class _Damaged(Exception):
-    """A point file that holds no valid point: why, in a few words."""
+    """A file that holds no valid run: why, in a few words."""
 
 
-def _point(d, index: int, order: list[float]) -> SweepPoint:
-    """The point of ``d`` at ``index``, checked against the sweep's ``order`` of values."""
-    point = SweepPoint.from_dict(d)
-    if not 0 <= index < len(order) or point.value != order[index]:
-        raise ValueError("another value")
-    if any(np.ndim(v) != 1 for v in point.poincare.values()):
+def _checked(record: RunRecord) -> RunRecord:
+    """A record read back, its arrays checked to be one value per state."""
+    if any(np.ndim(v) != 1 for v in record.poincare.values()):
         raise ValueError("Poincare points of another shape")
-    x = point.x_final  # one value per state, as the Poincare points are
-    if x is not None and (x.ndim != 1 or x.size != len(point.poincare)):
-        raise ValueError("end state of another shape")
-    return point
+    for x in (record.x_final, record.x0):  # one value per state, as the Poincare points
+        if x is not None and (x.ndim != 1 or x.size != len(record.poincare)):
+            raise ValueError("a state of another shape")
+    return record
 
 
-def _read_points(f: Path, order: list[float]) -> tuple[dict[int, SweepPoint], dict[int, str]]:
-    """The points of one file and their texts; raises :class:`_Damaged`."""
+def _read_file(f: Path, check) -> dict[int, RunRecord]:
+    """The runs of one file by key; raises :class:`_Damaged`."""
     try:
-        text = f.read_text(encoding="utf-8")
+        data = json.loads(f.read_text(encoding="utf-8"))
     except UnicodeDecodeError:
         raise _Damaged("not text") from None
     except OSError as err:
         raise _Damaged(f"cannot be read: {err.strerror or err}") from None
-    try:
-        data = json.loads(text)
     except ValueError:
         raise _Damaged("not JSON, or cut short") from None
     try:
-        if f.name.startswith("chunk-"):
-            first, count = (int(n) for n in f.stem.split("-")[1:])
-            indices = [int(i) for i in data["indices"]]
-            if len(indices) != count or indices[0] != first:
-                raise ValueError("indices other than the name says")
-            pairs = zip(indices, data["points"], strict=True)
-            found = {i: _point(d, i, order) for i, d in pairs}
-            return found, {i: point_text(p) for i, p in found.items()}
-        index = int(f.stem)
-        return {index: _point(data, index, order)}, {index: text}
+        first, count = (int(n) for n in f.stem.split("-"))
+        keys = [int(k) for k in data["keys"]]
+        if len(keys) != count or keys[0] != first:
+            raise ValueError("keys other than the name says")
+        found = {}
+        for key, d in zip(keys, data["runs"], strict=True):
+            record = _checked(RunRecord.from_dict(d))
+            if check is not None:
+                check(key, record)
+            found[key] = record
+        return found
     except (KeyError, TypeError, ValueError, AttributeError, IndexError):
-        raise _Damaged("not a sweep point this version reads") from None
+        raise _Damaged("not a run this version reads") from None
 
 
-def _set_aside(store: Path, f: Path, why: str) -> None:
-    """Move a damaged point file to ``store/damaged`` (never delete what may be evidence)."""
-    folder = store / "damaged"
+def _set_aside(root: Path, f: Path, why: str) -> None:
+    """Move a damaged file to ``root/damaged`` (never delete what may be evidence)."""
+    folder = root / "damaged"
     folder.mkdir(exist_ok=True)
     target, k = folder / f.name, 0
     while target.exists():
@@ -214,65 +199,128 @@ def _set_aside(store: Path, f: Path, why: str) -> None:
     )
 
 
-def _old_manifest(store: Path, manifest: dict) -> dict | None:
-    """The manifest stored in ``store`` (None if there is none yet), checked to be whole."""
-    path = store / "manifest.json"
+def _stored_metadata(root: Path, metadata: dict) -> dict | None:
+    """The metadata stored in ``root`` (None if there is none yet), checked to be whole
+    and of this format."""
+    path = root / _MANIFEST
     if not path.exists():
         return None
-    fix = f"delete {store} to start this sweep again, or choose another --out"
+    fix = f"delete {root} to start this work again, or choose another --out"
     try:
         old = json.loads(path.read_text(encoding="utf-8"))
     except ValueError as err:  # not UTF-8, not JSON or cut short
         why = err.msg if isinstance(err, json.JSONDecodeError) else "not text"
         raise SweepStoreError(f"{path} is damaged ({why}); {fix}") from None
     if not isinstance(old, dict):
-        raise SweepStoreError(f"{path} is damaged (not a sweep manifest); {fix}")
-    missing = [k for k in manifest if k not in old]
+        raise SweepStoreError(f"{path} is damaged (not a store's metadata); {fix}")
+    if "format" in old or "kind" in old:
+        if old.get("format") != STORE_FORMAT:
+            raise SweepStoreError(
+                f"{root} was written by an older gearsym (store format "
+                f"{old.get('format', 1)}, this one reads {STORE_FORMAT}); {fix}"
+            )
+    missing = [k for k in metadata if k not in old]
     if missing:
         raise SweepStoreError(f"{path} is damaged or incomplete (no {', '.join(missing)}); {fix}")
     return old
 
 
-def open_store(
-    store: Path, manifest: dict, texts: dict[int, str] | None = None
-) -> dict[int, SweepPoint]:
-    """Create the store, or check that it holds this very sweep; return its points (and
-    put their texts into ``texts``).
+@dataclass(frozen=True)
+class RunStore:
+    """A folder of classified runs (:class:`RunRecord`) under integer keys, with the
+    metadata of the work they belong to.  Picklable: a worker process appends to the
+    store its parent opened (and locked)."""
 
-    The store is locked for this process (:func:`lock_store`) until :func:`close_store`
-    or the process's end.  A point file that holds no valid point is moved to
-    ``store/damaged`` with a warning, and its points are left to be computed again; a
-    damaged manifest, or one of another model or sweep, is refused.
-    """
-    store = Path(store)
-    store.mkdir(parents=True, exist_ok=True)
-    lock_store(store)
-    old = _old_manifest(store, manifest)
-    if old is None:
-        write_atomic(store / "manifest.json", dumps(manifest, indent=1))
-    elif old["model_hash"] != manifest["model_hash"]:
-        raise SweepStoreError(
-            f"{store} was written by another model version (hash "
-            f"{str(old['model_hash'])[:12]}, this model {manifest['model_hash'][:12]}); "
-            "choose another output folder or delete it"
-        )
-    elif differs := [k for k in manifest if old[k] != manifest[k]]:
-        raise SweepStoreError(
-            f"{store} holds another sweep ({', '.join(differs)} differ); choose another "
-            "output folder or delete it"
-        )
-    values = [float(v) for v in manifest["values"]]
-    order = values[::-1] if manifest["direction"] == "backward" else values
-    done: dict[int, SweepPoint] = {}
-    folder = store / "points"
-    files = sorted(folder.glob("chunk-*-*.json")) + sorted(folder.glob("[0-9]*.json"))
-    for f in files:
+    root: Path
+    metadata: dict
+
+    @classmethod
+    def open(cls, root: Path, *, kind: str, model_hash, values: dict, **more) -> RunStore:
+        """Create the store at ``root``, or check that it holds this very work.
+
+        ``kind`` names the work (``sweep``, ``map``); ``model_hash`` the model (a list
+        of hashes when the work spans several); ``values`` the varied parameters' values,
+        ``{name: [value, ...]}``; ``more`` whatever else makes the work (the values every
+        run shares, the settings).  The store is locked for this process until :meth:`close` or the
+        process's end.  Refused (:class:`SweepStoreError`, one line): damaged metadata,
+        a store of another model version, of other work or of an older format, or one
+        another process is writing into.
+        """
+        root = Path(root)
+        metadata = json.loads(
+            dumps(
+                {
+                    "format": STORE_FORMAT,
+                    "kind": kind,
+                    "model_hash": model_hash,
+                    "values": values,
+                    **more,
+                }
+            )
+        )  # as stored: NumPy numbers and tuples made JSON
+        root.mkdir(parents=True, exist_ok=True)
+        _lock(root)
         try:
-            found, found_texts = _read_points(f, order)
-        except _Damaged as why:
-            _set_aside(store, f, str(why))
-            continue
-        done.update(found)
-        if texts is not None:
-            texts.update(found_texts)
-    return done
+            old = _stored_metadata(root, metadata)
+            if old is None:
+                write_atomic(root / _MANIFEST, dumps(metadata, indent=1))
+            elif old["kind"] != kind:
+                raise SweepStoreError(
+                    f"{root} holds a {old['kind']}, not a {kind}; choose another output "
+                    "folder or delete it"
+                )
+            elif old["model_hash"] != metadata["model_hash"]:
+                was, now = (str(h)[:12] for h in (old["model_hash"], metadata["model_hash"]))
+                raise SweepStoreError(
+                    f"{root} was written by another model version (hash {was}, this model "
+                    f"{now}); choose another output folder or delete it"
+                )
+            elif differs := [k for k in metadata if old[k] != metadata[k]]:
+                raise SweepStoreError(
+                    f"{root} holds another {kind} ({', '.join(differs)} differ); choose "
+                    "another output folder or delete it"
+                )
+        except BaseException:
+            _unlock(root)
+            raise
+        return cls(root, metadata)
+
+    def append(self, records: dict[int, RunRecord], texts: dict[int, str] | None = None):
+        """Write finished runs as one file, atomically; return their JSON texts (those
+        in ``texts`` are taken as the records' :func:`record_text`)."""
+        texts = texts or {}
+        out = {int(k): texts.get(k) or record_text(r) for k, r in records.items()}
+        keys = list(out)
+        if not keys:
+            return {}
+        body = f'{{"keys": {json.dumps(keys)}, "runs": [' + ", ".join(out.values()) + "]}"
+        write_atomic(self.root / _RUNS / f"{keys[0]:05d}-{len(keys)}.json", body)
+        return out
+
+    def read(self, check=None, texts: dict[int, str] | None = None) -> dict[int, RunRecord]:
+        """The stored runs by key (and their texts into ``texts``).  ``check(key,
+        record)`` may raise ValueError for a run that is not this work's; a file with
+        such a run, or none valid, is moved to ``damaged/`` with a warning."""
+        done: dict[int, RunRecord] = {}
+        for f in sorted((self.root / _RUNS).glob("[0-9]*-[0-9]*.json")):
+            try:
+                found = _read_file(f, check)
+            except _Damaged as why:
+                _set_aside(self.root, f, str(why))
+                continue
+            done.update(found)
+            if texts is not None:
+                texts.update({k: record_text(r) for k, r in found.items()})
+        return done
+
+    def done(self) -> set[int]:
+        """The keys of the runs the store holds (what a resumed run need not compute)."""
+        return set(self.read())
+
+    def count(self) -> int:
+        """How many runs the store holds, without reading them."""
+        return stored_count(self.root)
+
+    def close(self) -> None:
+        """Free the lock, for the next writer."""
+        _unlock(self.root)

@@ -10,7 +10,7 @@ Work goes out as chains (``chains.py``: a continuation chain, one independent po
 with a compiled method a chunk of independent points integrated together in the lockstep
 engine) through the one executor (``executor.py``); workers rebuild the system from the
 generated module's name, so nothing unpicklable crosses processes, and each point comes
-back as a :class:`~.points.SweepPoint`, already written to the store.
+back as a :class:`~..analysis.record.RunRecord`, already written to the store.
 """
 
 from __future__ import annotations
@@ -24,13 +24,13 @@ from pathlib import Path
 import numpy as np
 
 from .._json import dumps
+from ..analysis.record import RunRecord
+from ..executor import EXECUTORS, map_tasks
 from ..system import System
 from .chains import Chain, ChainDone, checked_values, module_ref, plan, run_chain
-from .executor import EXECUTORS, map_tasks
-from .points import SweepPoint
 from .progress import Progress
 from .result import SweepResult
-from .store import STORE_FORMAT, SweepStoreError, close_store, open_store
+from .store import RunStore, SweepStoreError
 
 __all__ = [
     "Progress",
@@ -161,7 +161,7 @@ class _Planned:
     backward: bool
     settings: dict
     x0: list | None
-    store: Path | None
+    store: RunStore | None
     chains: list
     done: dict
     texts: dict
@@ -169,21 +169,22 @@ class _Planned:
     @classmethod
     def of(cls, system, parameter, values, continuation, backward, x0, settings, store) -> _Planned:
         x0_list = None if x0 is None else [float(v) for v in x0]
-        done: dict[int, SweepPoint] = {}
+        done: dict[int, RunRecord] = {}
         texts: dict[int, str] = {}
+        opened = None
         if store is not None:
-            manifest = {
-                "format": STORE_FORMAT,
-                "model": system.name,
-                "model_hash": system.model_hash,
-                "parameter": parameter,
-                "values": [float(v) for v in values],
-                "direction": _direction(continuation, backward),
-                "base_values": {k: float(v) for k, v in system.values.items()},
-                "settings": json.loads(dumps(settings)),
-                "x0": x0_list,
-            }
-            done = open_store(Path(store), manifest, texts)
+            opened = RunStore.open(
+                Path(store),
+                kind="sweep",
+                model_hash=system.model_hash,
+                values={parameter: [float(v) for v in values]},
+                model=system.name,
+                direction=_direction(continuation, backward),
+                base_values={k: float(v) for k, v in system.values.items()},
+                settings=json.loads(dumps(settings)),
+                x0=x0_list,
+            )
+            done = opened.read(_in_order(parameter, values, backward), texts)
         try:
             chains = plan(
                 system,
@@ -194,13 +195,12 @@ class _Planned:
                 x0=x0,
                 settings=settings,
                 done=done,
-                store=store,
+                store=opened,
             )
         except BaseException:
-            if store is not None:
-                close_store(Path(store))
+            if opened is not None:
+                opened.close()
             raise
-        where = None if store is None else Path(store)
         values = np.asarray(values, dtype=float)
         return cls(
             system,
@@ -210,7 +210,7 @@ class _Planned:
             backward,
             dict(settings),
             x0_list,
-            where,
+            opened,
             chains,
             done,
             texts,
@@ -228,13 +228,27 @@ class _Planned:
         settings = dict(self.settings, x0=self.x0)
         direction = _direction(self.continuation, self.backward)
         result = _result(self.system, self.parameter, self.values, direction, settings, points)
+        result = replace(result, resumed=len(self.done))
         if self.store is None or None in stored:
             return result
         return replace(result, texts=stored)
 
     def close(self) -> None:
         if self.store is not None:
-            close_store(self.store)  # the lock, for the next writer
+            self.store.close()  # the lock, for the next writer
+
+
+def _in_order(parameter: str, values, backward: bool):
+    """The store's check of a sweep's run: its key is its place in the sweep's order,
+    and its value the one there."""
+    values = [float(v) for v in values]
+    order = values[::-1] if backward else values
+
+    def check(key: int, record: RunRecord) -> None:
+        if not 0 <= key < len(order) or record.values != {parameter: order[key]}:
+            raise ValueError("another value")
+
+    return check
 
 
 @dataclass(frozen=True)

@@ -14,11 +14,13 @@ import pytest
 from gearsym.solver.analysis import largest_lyapunov
 from gearsym.solver.analysis.lyapunov import uncertainty
 from gearsym.solver.integrate.native import run_batch
-from gearsym.solver.integrate.native.maps import run_map
+from gearsym.solver.integrate.run import Batch, integrate
+from gearsym.solver.integrate.spec import RunSpec
 from gearsym.solver.periodic import shoot
 from gearsym.solver.sweep.atlas import regime_map
 from gearsym.solver.sweep.attractors import meshing_regime
 from gearsym.solver.sweep.maps_result import RegimeMap
+from gearsym.solver.sweep.store import stored_count
 from gearsym.solver.system import System
 from scipy.optimize import brentq
 
@@ -48,18 +50,20 @@ def test_map_engine_agrees_with_sampled_runs(reference_light_system):
     P = np.array([s.parameters_with(**{"lambda": v}) for v in lam])
     X0 = np.tile([1.0, 0.0, 0.0, 0.0], (6, 1))
     ref = run_batch(s.module, P, X0, transient=150, periods=20)
-    got = run_map(s.module, P, X0, transient=150, periods=20, lyapunov_periods=0)
+    spec = RunSpec(transient=150, periods=20, collect=("samples", "extremes"), valid_range="stop")
+    got = integrate(Batch.of(s.module, P), X0, spec)
     assert got.status == ("ok",) * 6
-    assert np.max(np.abs(got.poincare - ref.x)) < 1e-6
+    assert np.max(np.abs(got.x - ref.x)) < 1e-6
     assert np.all(got.xmax >= ref.x.max(axis=1) - 1e-6)
     assert np.all(got.xmin <= ref.x.min(axis=1) + 1e-6)
 
 
 def test_map_exponent_agrees_with_per_point_benettin(reference_light_system):
     s = reference_light_system.with_values(**{"lambda": 0.3})
-    res = run_map(s.module, s.p[None], np.array([[1.0, 0, 0, 0]]), lyapunov_periods=200)
-    running = res.lyapunov[0]
-    ref = largest_lyapunov(s, res.poincare[0, -1], t0=0.0, periods=400)
+    spec = RunSpec(collect=("samples", "exponent"), lyapunov_periods=200, valid_range="stop")
+    res = integrate(s, np.array([1.0, 0, 0, 0]), spec)
+    running = res.exponent[0]
+    ref = largest_lyapunov(s, res.x[0, -1], t0=0.0, periods=400)
     bound = uncertainty(running, s.period)["uncertainty"] + ref.uncertainty
     assert abs(running[-1] - ref.exponent) <= bound
 
@@ -156,11 +160,15 @@ def test_map_store_resumes_and_refuses_another_map(duffing, tmp_path):
     kw |= dict(executor="serial", store=tmp_path)
     axes = (("omega", [1.1, 1.2, 1.3]), ("B", [0.25, 0.3]))
     first = regime_map(s, *axes, **kw)
-    files = sorted((tmp_path / "columns").glob("*.json"))
-    assert len(files) == 3 * 3  # forward and backward chains, random starts: 3 columns each
-    for name in ("forward-0001.json", "forward-0002.json", "random-0002.json"):
-        (tmp_path / "columns" / name).unlink()  # as if interrupted there
+    assert first.resumed == 0
+    assert stored_count(tmp_path) == 3 * 3 * 2  # 3 x values, 2 y values, 3 starts each
+    # forward and backward chains, random starts: 3 columns each, one file a column
+    files = sorted((tmp_path / "points").glob("*.json"))
+    assert len(files) == 3 * 3
+    for f in files[1:3] + files[-1:]:
+        f.unlink()  # as if interrupted there: forward x = 1.2, 1.3 and the last random
     again = regime_map(s, *axes, **kw)
+    assert again.resumed == 3 * 3 * 2 - 3 * 2
     assert json.dumps(again.records()) == json.dumps(first.records())
     with pytest.raises(ValueError, match="holds another map"):
         regime_map(s, ("omega", [1.1, 1.2]), axes[1], **kw)
@@ -169,9 +177,15 @@ def test_map_store_resumes_and_refuses_another_map(duffing, tmp_path):
 def test_map_records_round_trip(duffing, tmp_path):
     s = duffing.with_values(a=1.0, c=0.1, k=0.1, B=0.3, omega=1.2)
     m = regime_map(
-        s, ("omega", [1.1, 1.2]), ("B", [0.3]), initial_states=2, lyapunov_periods=50,
-        transient=100, periods=32, executor="serial",
-    )  # fmt: skip
+        s,
+        ("omega", [1.1, 1.2]),
+        ("B", [0.3]),
+        initial_states=2,
+        lyapunov_periods=50,
+        transient=100,
+        periods=32,
+        executor="serial",
+    )
     for r in m.records():
         assert {"omega", "B", "share", "motion", "lyapunov", "meshing", "max", "min"} <= set(r)
     back = RegimeMap.load(m.save(tmp_path / "map.json"))
@@ -184,9 +198,15 @@ def test_map_figures_label_a_text_axis_and_write_only_the_kinds_asked(duffing, t
 
     s = duffing.with_values(a=1.0, c=0.1, k=0.1, B=0.3, omega=1.2)
     m = regime_map(
-        s, ("omega", [1.1, 1.2]), ("B", [0.0, 1.0]), initial_states=1, lyapunov_periods=0,
-        transient=50, periods=32, executor="serial",
-    )  # fmt: skip
+        s,
+        ("omega", [1.1, 1.2]),
+        ("B", [0.0, 1.0]),
+        initial_states=1,
+        lyapunov_periods=0,
+        transient=50,
+        periods=32,
+        executor="serial",
+    )
     paths = map_figures(
         m, tmp_path, "t", ticks={"B": ["low", "high"]}, title="a title", kinds=("motion",)
     )

@@ -164,15 +164,20 @@ def test_continuation_through_the_hysteresis_band_of_a_hardening_duffing():
 
     system = _hardening(0.8, k=0.05, B=0.5)
     branch = continue_hb(system, "omega", 0.8, 2.6, harmonics=16)
-    folds = [e for e in branch.events if e["kind"] == "fold"]
-    assert len(folds) == 2 and folds[0]["omega"] > folds[1]["omega"]
-    lo, hi = folds[0]["index"], folds[1]["index"]
+    folds = [b for b in branch.bifurcations if b.kind == "fold"]
+    assert len(folds) == 2 and folds[0].value > folds[1].value
+    lo, hi = folds[0].index, folds[1].index
     assert not branch.stable[lo:hi].any() and branch.stable[:lo].all()
     assert branch.stable[hi:].all() and branch.values[-1] == 2.6
+    # at each fold a multiplier is +1, by Hill's method and by the monodromy of a time
+    # integration from the located state (the record's evidence)
+    for b in folds:
+        assert abs(b.multiplier - 1.0) < 1e-4, b.multiplier
+        assert abs(b.evidence["max_monodromy_multiplier"] - 1.0) < 1e-6, b.evidence
     # the folds are converged in H: 12 harmonics give the same values
     again = continue_hb(system, "omega", 0.8, 2.6, harmonics=12)
     np.testing.assert_allclose(
-        [e["omega"] for e in again.events], [e["omega"] for e in folds], rtol=0, atol=1e-8
+        [b.value for b in again.bifurcations], [b.value for b in folds], rtol=0, atol=1e-8
     )
     problem = HarmonicBalance(system, 16)
     smap = StroboscopicMap(system, 1)
@@ -215,9 +220,8 @@ def test_integration_sweeps_in_the_phase_agree_with_harmonic_balance():
     assert checked >= 3
     amp = up.stats["u"]["amplitude"]
     jump = int(np.argmax(np.abs(np.diff(amp))))
-    folds = [
-        e["omega"] for e in continue_hb(system, "omega", 0.5, 0.7).events if e["kind"] == "fold"
-    ]
+    branch = continue_hb(system, "omega", 0.5, 0.7)
+    folds = [b.value for b in branch.bifurcations if b.kind == "fold"]
     step = up.values[1] - up.values[0]
     assert any(up.values[jump] - 1e-9 <= f <= up.values[jump + 1] + 1e-9 for f in folds), (
         up.values[jump],

@@ -19,6 +19,7 @@ states, of order 1):
   of that).
 """
 
+import json
 import os
 import re
 import subprocess
@@ -28,7 +29,8 @@ import warnings
 import numpy as np
 import pytest
 from gearsym.solver.integrate import native
-from gearsym.solver.integrate.native.maps import run_map
+from gearsym.solver.integrate.run import Batch, integrate
+from gearsym.solver.integrate.spec import RunSpec
 from gearsym.solver.sweep.atlas import regime_map
 from gearsym.solver.system import System
 
@@ -45,6 +47,17 @@ def no_compiler(monkeypatch):
     monkeypatch.setenv("GEARSYM_CC", "none")
     yield
     native.reset()
+
+
+def _map(module, P, X0, backend="auto", *, lyapunov_periods, **options):
+    """A map run: Poincare points, extremes and the exponent, stopped at the valid range."""
+    spec = RunSpec(
+        collect=("samples", "extremes", "exponent"),
+        lyapunov_periods=lyapunov_periods,
+        valid_range="stop",
+        **options,
+    )
+    return integrate(Batch.of(module, P), X0, spec, backend=backend)
 
 
 def _compiled(fn):
@@ -64,20 +77,22 @@ def test_fallback_fills_every_field_as_the_compiled_engine(no_compiler, monkeypa
     with pytest.warns(
         UserWarning, match="GEARSYM_CC='none' turns the C compiler off.*NumPy instead"
     ):
-        got = run_map(s.module, P, X0, **kw)
+        got = _map(s.module, P, X0, **kw)
     with pytest.raises(native.NativeUnavailable):
-        run_map(s.module, P, X0, backend="native", **kw)
+        _map(s.module, P, X0, backend="native", **kw)
     monkeypatch.delenv("GEARSYM_CC")
-    ref = _compiled(lambda: run_map(s.module, P, X0, backend="native", **kw))
+    ref = _compiled(lambda: _map(s.module, P, X0, backend="native", **kw))
     assert (got.backend, ref.backend) == ("numpy", "native")
+    assert (got.label, ref.label) == ("NumPy fallback DOP853", "compiled DOP853")
     assert got.status == ref.status == ("ok",) * len(P)
-    assert got.poincare.shape == ref.poincare.shape == (len(P), 11, 4)
-    scale = np.max(np.abs(ref.poincare))
-    assert np.max(np.abs(got.poincare - ref.poincare)) <= 10 * RTOL * scale
-    assert got.lyapunov.shape == ref.lyapunov.shape == (len(P), 20)
-    assert np.max(np.abs(got.lyapunov - ref.lyapunov)) <= 10 * RTOL / s.period
+    assert got.x.shape == ref.x.shape == (len(P), 11, 4)
+    np.testing.assert_array_equal(got.t, ref.t)
+    scale = np.max(np.abs(ref.x))
+    assert np.max(np.abs(got.x - ref.x)) <= 10 * RTOL * scale
+    assert got.exponent.shape == ref.exponent.shape == (len(P), 20)
+    assert np.max(np.abs(got.exponent - ref.exponent)) <= 10 * RTOL / s.period
     for r in (got, ref):
-        assert np.all(r.xmin <= r.poincare.min(axis=1)) and np.all(r.xmax >= r.poincare.max(axis=1))
+        assert np.all(r.xmin <= r.x.min(axis=1)) and np.all(r.xmax >= r.x.max(axis=1))
     m = min(got.nsteps.min(), ref.nsteps.min()) / (kw["transient"] + kw["periods"])
     miss = (ref.xmax - ref.xmin) * (1 - np.cos(2 * np.pi / m)) / 2
     assert np.all(np.abs(got.xmax - ref.xmax) <= miss)
@@ -97,17 +112,18 @@ def test_fallback_stops_a_failing_point_as_the_compiled_engine(
     )
     X0 = np.tile([1.0, 0.0, 0.0, 0.0], (2, 1))
     kw = dict(transient=20, periods=5, lyapunov_periods=10, rtol=RTOL, atol=1e-10, bound=bound)
-    got = run_map(s.module, P, X0, backend="numpy", **kw)
+    got = _map(s.module, P, X0, backend="numpy", **kw)
     monkeypatch.delenv("GEARSYM_CC")
-    ref = _compiled(lambda: run_map(s.module, P, X0, backend="native", **kw))
+    ref = _compiled(lambda: _map(s.module, P, X0, backend="native", **kw))
     assert got.status == ref.status == ("ok", status)
-    assert np.all(np.isnan(got.poincare[1])) and np.all(np.isnan(got.lyapunov[1]))
-    assert np.all(np.isfinite(got.lyapunov[0]))
+    assert np.all(np.isnan(got.x[1])) and np.all(np.isnan(got.exponent[1]))
+    assert np.all(np.isfinite(got.exponent[0]))
     # each stops at the end of the accepted step that crossed: within a step of each other
     # (both take 15 to 20 steps per period T here, see nsteps)
     assert abs(got.t_fail[1] - ref.t_fail[1]) < s.period / 10
 
 
+@pytest.mark.slow  # some 30 s: the fallback steps every point in Python
 def test_a_map_without_a_compiler_gives_the_compiled_verdicts(no_compiler, monkeypatch):
     s = System.load("reference_light")
     kw = dict(initial_states=2, transient=60, periods=20, lyapunov_periods=40)
@@ -125,11 +141,18 @@ def test_a_map_without_a_compiler_gives_the_compiled_verdicts(no_compiler, monke
         for a, b in zip(row_got, row_ref, strict=True):
             assert len(a.attractors) == len(b.attractors)
             for ga, gb in zip(a.attractors, b.attractors, strict=True):
-                ra, rb = ga.run, gb.run
-                verdict_a = (ga.starts, ra.status, ra.motion, ra.period, ra.meshing)
-                assert verdict_a == (gb.starts, rb.status, rb.motion, rb.period, rb.meshing)
-                assert np.max(np.abs(ra.tail - rb.tail)) <= 10 * RTOL * np.max(np.abs(rb.tail))
-                assert abs(ra.lyapunov - rb.lyapunov) <= 10 * RTOL / s.period
+                da, db = ga.to_dict(s.states), gb.to_dict(s.states)
+                assert _verdict(da) == _verdict(db)
+                end_a, end_b = np.array(da["state"]), np.array(db["state"])
+                assert np.max(np.abs(end_a - end_b)) <= 10 * RTOL * np.max(np.abs(end_b))
+                assert abs(da["lyapunov"] - db["lyapunov"]) <= 10 * RTOL / s.period
+
+
+def _verdict(attractor: dict) -> tuple:
+    """What a map says of an attractor: which starts reach it, its status, motion, period
+    and meshing regime per coordinate."""
+    keys = ("starts", "status", "motion", "period", "meshing")
+    return tuple(json.dumps(attractor[k], sort_keys=True) for k in keys)
 
 
 def _cli_map(tmp_path, cc: str):
@@ -138,6 +161,32 @@ def _cli_map(tmp_path, cc: str):
     argv = ["map", "reference-light", *grid, *SMALL, f"--out={tmp_path / 'map'}"]
     done = subprocess.run([*GEARSYM, *argv], capture_output=True, text=True, env=env)
     return done.returncode, done.stderr.splitlines()
+
+
+@pytest.mark.slow  # some 40 s: the fallback steps every point in Python
+def test_gearsym_map_without_a_compiler_gives_the_compiled_verdicts(tmp_path):
+    """Issue 24's acceptance test: ``gearsym map`` with GEARSYM_CC=none runs (slower) and
+    says what the compiled engine says of every attractor of a small map (periods enough
+    for the motions to be determined)."""
+    env = os.environ | {"GEARSYM_CACHE": str(tmp_path / "cache")}
+    grid = ["--x=lambda=0:1:3", "--y=f1=0.1:0.2:2", "--initial-states=2", "--quiet"]
+    runs = ["--transient", "60", "--periods", "20", "--lyapunov-periods", "40"]
+    maps = {}
+    for cc in ("none", "cc"):
+        out = tmp_path / cc
+        argv = [*GEARSYM, "map", "reference-light", *grid, *runs, f"--out={out}"]
+        done = subprocess.run(argv, capture_output=True, text=True, env=env | {"GEARSYM_CC": cc})
+        assert done.returncode == 0, done.stderr
+        maps[cc] = json.loads((out / "map.json").read_text(encoding="utf-8"))["records"]
+    got, ref = maps["none"], maps["cc"]
+    period = System.load("reference_light").period
+    assert len(got) == len(ref) >= 6
+    assert any(r["motion"]["u"] != "undetermined" for r in ref)  # verdicts, not shrugs
+    for a, b in zip(got, ref, strict=True):
+        where = ("lambda", "f1", "attractor", "attractors", "share")
+        assert [a[k] for k in where] == [b[k] for k in where]
+        assert _verdict(a) == _verdict(b)
+        assert abs(a["lyapunov"] - b["lyapunov"]) <= 10 * RTOL / period
 
 
 def test_map_cli_without_a_compiler_is_one_warning_line(tmp_path):

@@ -93,8 +93,15 @@ def test_lockstep_dense_output_equals_scipy_dop853_dense_output():
     X0 = np.array([x0, x0])
     kw = dict(method="dop853", rtol=1e-8, atol=1e-10, transient=5, periods=3)
     dense = native.run_batch(system.module, P, X0, samples_per_period=16, **kw)
-    ref = solve_ivp(system.rhs, (0.0, dense.t[-1]), x0, method="DOP853", rtol=1e-8,
-                    atol=1e-10, dense_output=True)  # fmt: skip
+    ref = solve_ivp(
+        system.rhs,
+        (0.0, dense.t[-1]),
+        x0,
+        method="DOP853",
+        rtol=1e-8,
+        atol=1e-10,
+        dense_output=True,
+    )
     assert dense.status == ("ok", "ok")
     assert dense.nsteps[0] == ref.t.size - 1  # the same steps
     np.testing.assert_allclose(dense.x[0], ref.sol(dense.t).T, rtol=0, atol=1e-12)
@@ -119,8 +126,16 @@ def test_phase_runs_of_three_frequencies_in_one_group_equal_scipy_in_tau():
     assert run.status == ("ok",) * 3
     assert np.allclose(run.t, 2 * np.pi * (60 + np.arange(4 * 16 + 1) / 16))
     for j, w in enumerate(omegas):
-        ref = simulate(system.with_values(omega=w), X0[j], method="DOP853", rtol=1e-11,
-                       atol=1e-13, transient=60, periods=4, samples_per_period=16)  # fmt: skip
+        ref = simulate(
+            system.with_values(omega=w),
+            X0[j],
+            method="DOP853",
+            rtol=1e-11,
+            atol=1e-13,
+            transient=60,
+            periods=4,
+            samples_per_period=16,
+        )
         np.testing.assert_allclose(ref.t * w, run.t[: ref.t.size], rtol=1e-12)
         np.testing.assert_allclose(run.x[j, : ref.t.size], ref.x.T, rtol=0, atol=1e-7)
 
@@ -226,3 +241,156 @@ def test_fallback_with_workers_and_a_diverging_point(monkeypatch):
         res = native.run_batch(module, P, X0, method="dop853", transient=40, periods=2, workers=2)
     assert res.backend == "numpy"
     assert res.status == ("ok", "divergent")
+
+
+# ---- the one C entry, gs_integrate, and its job (native/abi.py, native/engine.py) ----
+
+
+def _job_parts(module, N=2, **changes):
+    """The arguments of abi.fill for a small sampled run of ``module``."""
+    from gearsym.solver.contract import Contract
+
+    n, n_p = len(Contract.of(module).states), len(Contract.of(module).parameters)
+    P = np.ascontiguousarray(np.repeat(module.parameters()[None, :], N, axis=0))
+    arrays = {
+        "P": P,
+        "X0": np.zeros((N, n)),
+        "x": np.empty((N, 3, n)),
+        "nfev": np.zeros(N, dtype=np.int64),
+        "nsteps": np.zeros(N, dtype=np.int64),
+        "status": np.zeros(N, dtype=np.int32),
+        "t_fail": np.zeros(N),
+    }
+    ints = dict(
+        abi=1,
+        n_points=N,
+        n_states=n,
+        n_params=n_p,
+        group=2,
+        transient=1,
+        periods=2,
+        samples_per_period=1,
+        steps_per_period=16,
+        lyapunov_periods=0,
+        max_steps=10**6,
+        method=1,
+        time_mode=0,
+        omega_index=0,
+        valid_range=2,
+        flags=0,
+    )
+    ints.update(changes)
+    doubles = dict(t0=0.0, period=2 * np.pi, rtol=1e-8, atol=1e-10, bound=1e3)
+    return ints, doubles, arrays, {k: v.size for k, v in arrays.items()}
+
+
+def test_job_layout_is_checked_against_the_c_struct():
+    # The library exports gs_job's fields (name and kind, in order) and offsets; abi.bind
+    # accepted them at load, and a library that lays the struct out otherwise is refused
+    # with one line naming the first difference.
+    from gearsym.solver.integrate.native import abi
+
+    lib, _ = native.library(System.load("reference_light").module)
+    names = lib.gs_job_fields().decode().split()
+    assert names == [f"{n}:{abi._KIND[t]}" for n, t in abi.Job._fields_]
+
+    class Swapped:
+        def __init__(self):
+            self.gs_job_fields = lambda: lib.gs_job_fields().replace(b"rtol", b"RTOL")
+            self.gs_job_layout = lib.gs_job_layout
+
+    with pytest.raises(abi.LayoutMismatch, match=r"field \d+: C 'RTOL:d', Python 'rtol:d'"):
+        abi.bind(Swapped(), "fake.so")
+
+
+def test_oversized_and_mismatched_sizes_are_refused_before_the_call():
+    from gearsym.solver.integrate.native import abi
+
+    module = System.load("reference_light").module
+    ints, doubles, arrays, lengths = _job_parts(module, n_points=2**64)
+    with pytest.raises(ValueError, match="n_points = 18446744073709551616 is outside the 64-bit"):
+        abi.fill(ints, doubles, arrays, lengths)
+    ints, doubles, arrays, lengths = _job_parts(module)
+    arrays["x"] = np.empty((2, 2, 4))  # one sample short
+    with pytest.raises(ValueError, match=r"^x holds 16 numbers where the run needs 24$"):
+        abi.fill(ints, doubles, arrays, lengths)
+
+
+def test_the_c_refuses_what_python_would_have_caught_and_writes_nothing():
+    # The C checks every size again (products in int64 with an overflow check): a job
+    # whose lengths lie, whose sample count overflows or whose group would need a huge
+    # allocation is refused with a code, the outputs untouched.
+    from gearsym.solver.integrate.native import abi
+
+    module = System.load("reference_light").module
+    lib, _ = native.library(module)
+    cases = [
+        ({}, {"x_len": 23}, "length"),
+        ({"periods": 2**62, "samples_per_period": 4}, {}, "length"),
+        ({"group": 10**9}, {}, "option"),
+        ({"abi": 2}, {}, "version"),
+    ]
+    for changes, lie, words in cases:
+        ints, doubles, arrays, lengths = _job_parts(module, **changes)
+        lengths = {k: v for k, v in lengths.items()}
+        job, keep = abi.fill(ints, doubles, arrays, lengths)
+        for name, value in lie.items():
+            setattr(job, name, value)
+        arrays["status"][:] = 7
+        with pytest.raises(RuntimeError, match=words):
+            abi.call(lib, job)
+        assert np.all(arrays["status"] == 7)
+    ints, doubles, arrays, lengths = _job_parts(module)  # the honest job runs
+    job, keep = abi.fill(ints, doubles, arrays, lengths)
+    abi.call(lib, job)
+    assert np.all(arrays["status"] == 0) and np.all(np.isfinite(arrays["x"]))
+
+
+def test_rk4_through_the_tableau_equals_the_classic_formula():
+    # Reference: classic RK4 written out (y + h/6 (k1 + 2 k2 + 2 k3 + k4)) on the NumPy
+    # right-hand side, on the engine's grid t0 + j h.  The compiled step is the generic
+    # one with tableau.RK4's coefficients; the two differ only by rounding (C vs NumPy
+    # right-hand side, weights 1/6, 1/3 vs h/6, 2).
+    from gearsym.solver.integrate.native.engine import run_compiled
+    from gearsym.solver.integrate.spec import RunSpec
+
+    system = System.load("reference_light", **{"lambda": 0.5})
+    x0 = default_initial_state(system)
+    spec = RunSpec(
+        method="rk4",
+        transient=0,
+        periods=1,
+        samples_per_period=4,
+        steps_per_period=64,
+        valid_range="ignore",
+        lockstep=False,
+    )
+    res = run_compiled(system.module, system.p[None], x0[None], spec)
+    h, y, ref = system.period / 64, x0.copy(), [x0.copy()]
+    for j in range(64):
+        t = j * h
+        k1 = system.rhs(t, y)
+        k2 = system.rhs(t + 0.5 * h, y + 0.5 * h * k1)
+        k3 = system.rhs(t + 0.5 * h, y + 0.5 * h * k2)
+        k4 = system.rhs(t + h, y + h * k3)
+        y = y + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        if (j + 1) % 16 == 0:
+            ref.append(y.copy())
+    assert res.status == ("ok",) and res.nsteps[0] == 64 and res.nfev[0] == 4 * 64 + 1
+    np.testing.assert_allclose(res.x[0], np.array(ref), rtol=0, atol=1e-12)
+
+
+def test_a_start_outside_the_valid_range_is_an_exit_at_t0():
+    from gearsym.solver.contract import Contract
+    from gearsym.solver.integrate.native.engine import run_compiled
+    from gearsym.solver.integrate.spec import RunSpec
+
+    system = System.load("diso")
+    (i, bound), *_ = Contract.of(system.module).valid_bounds()
+    x0 = default_initial_state(system)
+    x0[i] = 1.5 * bound
+    for mode, status in (("record", "ok"), ("stop", "left the valid range")):
+        spec = RunSpec(transient=1, periods=1, t0=2.0, valid_range=mode, bound=1e6)
+        res = run_compiled(system.module, system.p[None], x0[None], spec)
+        assert res.status == (status,)
+        np.testing.assert_array_equal(res.exits[0], [2.0, i, 1.5 * bound])

@@ -197,3 +197,90 @@ def test_known_nonlinear_orbit_and_its_multipliers():
     expected = np.sort_complex(np.linalg.eigvals(Y))
     assert np.max(np.abs(np.sort_complex(orbit.floquet.multipliers) - expected)) < 1e-8
     assert abs(np.prod(orbit.floquet.multipliers).real - np.exp(-k * T)) < 1e-9
+
+
+class _CubicMap:
+    """The engine's problem protocol on a closed form: the map x -> lambda + 2 x - x^3,
+    whose fixed points lie on lambda = x^3 - x with the multiplier mu = 2 - 3 x^2.  The
+    branch folds at x = -+1/sqrt(3), lambda = +-2/(3 sqrt(3)) (mu = +1) and doubles its
+    period at x = -+1, lambda = 0 (mu = -1)."""
+
+    parameter, n = "lambda", 1
+
+    def __init__(self):
+        from gearsym.solver.periodic._bounds import Interval
+
+        self.valid = Interval("lambda")
+
+    def linearise(self, z, column=None):
+        from gearsym.solver.periodic.engine import Linearisation
+
+        x, lam = z[0], z[1]
+        mu = 2.0 - 3.0 * x**2
+        return Linearisation(np.array([lam + x - x**3]), np.array([[mu - 1.0]]), np.ones(1), mu)
+
+    def frozen_column(self, z):
+        return None
+
+    def stability(self, z, lin):
+        from gearsym.solver.periodic import floquet
+
+        return floquet(np.array([[lin.extra]]), float(np.log(abs(lin.extra))))
+
+    def tests(self, z, lin, floquet=None):
+        from gearsym.solver.periodic.floquet import multiplier_tests
+
+        return multiplier_tests(np.array([lin.extra]))
+
+    def multipliers(self, z, lin):
+        return np.array([complex(lin.extra)])
+
+    def state(self, z):
+        return z[:-1].copy()
+
+    def point(self, z, sign, fl):
+        from gearsym.solver.periodic import BranchPoint
+
+        return BranchPoint(z[-1], z[:-1].copy(), fl.multipliers, fl.stable, fl.stability, sign)
+
+    def solve_at(self, lam, guess, sign):
+        roots = np.roots([1.0, 0.0, -1.0, -lam])  # x^3 - x = lambda
+        z = np.array([roots[np.argmin(np.abs(roots - guess[0]))].real, lam])
+        return self.point(z, sign, self.stability(z, self.linearise(z)))
+
+    def evidence(self, z):
+        return {}
+
+    def branch_fields(self):
+        return {"state_names": ("x",)}
+
+
+def test_the_engine_locates_folds_and_period_doublings_of_a_closed_form_map():
+    # Reference: the closed forms of _CubicMap.  From lambda = -1 (x = -1.3247) to 1 the
+    # branch doubles its period at lambda = 0, turns at both folds, doubles again at 0 and
+    # ends at lambda = 1 exactly.
+    from gearsym.solver.periodic.engine import Settings, continue_branch
+
+    x0 = float(np.real(np.roots([1.0, 0.0, -1.0, 1.0])).min())  # x^3 - x = -1, real root
+    settings = Settings(ds=0.05, ds_min=1e-6, ds_max=0.1, tol=1e-13, locate_tol=1e-12)
+    branch = continue_branch(_CubicMap(), np.array([x0, -1.0]), 1.0, settings)
+    assert branch.status == "complete" and branch.values[-1] == 1.0
+    assert abs(branch.states[-1][0] ** 3 - branch.states[-1][0] - 1.0) < 1e-12
+    kinds = [b.kind for b in branch.bifurcations]
+    assert kinds == ["period-doubling", "fold", "fold", "period-doubling"], kinds
+    fold = 2 / (3 * np.sqrt(3))
+    expected = [
+        (0.0, -1.0, -1.0),
+        (fold, -1 / np.sqrt(3), 1.0),
+        (-fold, 1 / np.sqrt(3), 1.0),
+        (0.0, 1.0, -1.0),
+    ]  # (lambda, x, mu)
+    for b, (lam, x, mu) in zip(branch.bifurcations, expected, strict=True):
+        assert abs(b.value - lam) < 1e-9 and abs(b.x0[0] - x) < 1e-6, (b, lam, x)
+        assert abs(b.multiplier - mu) < 1e-6 and b.parameter == "lambda"
+        assert b.to_dict()["lambda"] == b.value
+        # the first branch point past it lies past it along the branch
+        assert 0 < b.index < len(branch.points)
+    # stability by the multiplier 2 - 3 x^2 at every point, unstable between the folds
+    x = np.array([s[0] for s in branch.states])
+    assert np.array_equal(branch.stable, np.abs(2 - 3 * x**2) < 1 - 1e-9)

@@ -21,10 +21,30 @@ pytestmark = pytest.mark.skipif(
 
 # Forty independent CVODES points (about a tenth of a second each) on a pool of worker
 # processes: long enough to be killed with points stored and points to come.
-SWEEP = [sys.executable, "-m", "gearsym.cli", "sweep", "reference-light", "--param",
-         "lambda", "--range", "0:1:40", "--independent", "--executor", "processes",
-         "--method", "cvodes", "--transient", "60", "--periods", "8",
-         "--lyapunov-periods", "40", "--quiet", "--no-figure"]  # fmt: skip
+SWEEP = [
+    sys.executable,
+    "-m",
+    "gearsym.cli",
+    "sweep",
+    "reference-light",
+    "--param",
+    "lambda",
+    "--range",
+    "0:1:40",
+    "--independent",
+    "--executor",
+    "processes",
+    "--method",
+    "cvodes",
+    "--transient",
+    "60",
+    "--periods",
+    "8",
+    "--lyapunov-periods",
+    "40",
+    "--quiet",
+    "--no-figure",
+]
 REPRODUCE = [sys.executable, "-m", "gearsym.cli", "reproduce", "--quick", "--quiet", "--out"]
 
 

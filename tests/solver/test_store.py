@@ -1,4 +1,4 @@
-"""Sweeps that lose nothing: per-point store, resume after SIGKILL, refusal, determinism."""
+"""Sweeps that lose nothing: the run store, resume after SIGKILL, refusal, determinism."""
 
 import json
 import os
@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 import pytest
 from gearsym.solver.sweep import SweepStoreError, sweep
-from gearsym.solver.sweep.store import close_store, open_store
+from gearsym.solver.sweep.store import RunStore
 from gearsym.solver.system import System
 
 SETTINGS = dict(method="cvodes", transient=40, periods=8, lyapunov_periods=20)
@@ -122,10 +122,10 @@ def _damage_a_point(store, kind):
     """Damage one stored file as a crash, a full disk or a stray edit may; its name."""
     points = store / "points"
     if kind == "truncated-chunk":
-        f = points / "chunk-00002-2.json"
+        f = points / "00002-2.json"
         f.write_text(f.read_text()[: f.stat().st_size // 2])
         return f
-    f = points / "00001.json"
+    f = points / "00001-1.json"
     f.write_text({"empty-object": "{}", "not-json": "not json", "no-keys": '{"value": 0.5}'}[kind])
     return f
 
@@ -181,8 +181,8 @@ def test_a_damaged_manifest_is_refused_in_one_line(tmp_path, text, why):
 
 
 # a sweep on the command line into the folder that follows
-SHORT_SWEEP = [sys.executable, "-m", "gearsym.cli", "sweep", "reference-light", "--param",
-               "lambda", "--range", "0:1:3", "--quiet", "--no-figure", "--out"]  # fmt: skip
+SHORT_SWEEP = [sys.executable, "-m", "gearsym.cli", "sweep", "reference-light"]
+SHORT_SWEEP += ["--param", "lambda", "--range", "0:1:3", "--quiet", "--no-figure", "--out"]
 
 
 def test_the_cli_refuses_a_truncated_manifest_in_one_line(tmp_path):
@@ -199,8 +199,8 @@ def test_the_cli_refuses_a_truncated_manifest_in_one_line(tmp_path):
 
 _HOLD = (
     "import json, sys; from pathlib import Path; "
-    "from gearsym.solver.sweep.store import open_store; "
-    "open_store(Path(sys.argv[1]), json.loads(sys.argv[2])); "
+    "from gearsym.solver.sweep.store import RunStore; "
+    "RunStore.open(Path(sys.argv[1]), **json.loads(sys.argv[2])); "
     "print('locked', flush=True); sys.stdin.read()"
 )
 
@@ -210,9 +210,7 @@ def test_a_store_has_one_writer_at_a_time(tmp_path):
     # makes a second writer stop at once, in one line naming the holder's pid; the lock
     # goes with its holder, even when that is killed with SIGKILL.
     store = tmp_path / "store"
-    manifest = dict(format=1, model="m", model_hash="0" * 12, parameter="lambda",
-                    values=[0.0], direction="independent", base_values={}, settings={},
-                    x0=None)  # fmt: skip
+    manifest = dict(kind="sweep", model_hash="0" * 12, values={"lambda": [0.0]})
     holder = subprocess.Popen(
         [sys.executable, "-c", _HOLD, str(store), json.dumps(manifest)],
         stdin=subprocess.PIPE,
@@ -223,7 +221,7 @@ def test_a_store_has_one_writer_at_a_time(tmp_path):
         assert holder.stdout.readline().strip() == "locked"
         assert (store / "lock").read_text().strip() == str(holder.pid)
         with pytest.raises(SweepStoreError, match=f"in use by another sweep .process {holder.pid}"):
-            open_store(store, manifest)
+            RunStore.open(store, **manifest)
         done = subprocess.run([*SHORT_SWEEP, str(tmp_path)], capture_output=True, text=True)
         lines = done.stderr.strip().splitlines()
         assert done.returncode == 2 and len(lines) == 1, done.stderr
@@ -234,6 +232,36 @@ def test_a_store_has_one_writer_at_a_time(tmp_path):
     finally:
         holder.kill()
         holder.wait()
-    assert open_store(store, manifest) == {}  # the kernel freed the lock with its holder
+    again = RunStore.open(store, **manifest)  # the kernel freed the lock with its holder
+    assert again.read() == {} and again.count() == 0
     assert (store / "lock").read_text().strip() == str(os.getpid())
-    close_store(store)
+    again.close()
+
+
+def test_one_store_format_for_sweeps_and_maps_refuses_others_in_one_line(tmp_path):
+    # A sweep's store and a map's store are one format: a store of the other kind, or
+    # one of the first format (points/ for sweeps, columns/ for maps), is refused in one
+    # line naming the folder and the fix.
+    system = System.load("reference_light")
+    sweep(system, "lambda", [0.0], store=tmp_path / "sweep", **SETTINGS)
+    with pytest.raises(SweepStoreError, match="holds a sweep, not a map; choose another"):
+        RunStore.open(tmp_path / "sweep", kind="map", model_hash="0", values={})
+    old = tmp_path / "old"
+    old.mkdir()
+    (old / "manifest.json").write_text('{"kind": "regime map", "model_hashes": []}')
+    with pytest.raises(SweepStoreError, match=r"older gearsym \(store format 1.*another --out"):
+        sweep(system, "lambda", [0.0], store=old, **SETTINGS)
+
+
+def test_a_record_survives_its_dict_bit_for_bit():
+    from gearsym.solver.analysis import analyse_point
+    from gearsym.solver.analysis.record import RunRecord
+
+    system = System.load("reference_light")
+    record = analyse_point(system, **SETTINGS).record(
+        {"lambda": 0.8}, start="given", x0=[1, 0, 0, 0]
+    )
+    back = RunRecord.from_dict(json.loads(json.dumps(record.to_dict())))
+    assert back.to_dict() == record.to_dict() and back.value == 0.8 and back.start == "given"
+    assert all(np.array_equal(back.poincare[s], record.poincare[s]) for s in system.states)
+    assert back.lyapunov_exponent == record.lyapunov_exponent is not None

@@ -109,11 +109,12 @@ def test_sweep_json_from_the_stored_texts_is_the_plain_encoding(light, tmp_path)
         assert result.to_json() == dumps(result.to_dict())
         # a lockstep chunk is one file: first index and number of points in its name
         files = sorted(f.name for f in (store / "points").iterdir())
-        assert files == [f"chunk-{i:05d}-2.json" for i in (0, 2, 4, 6)]
+        assert files == [f"{i:05d}-2.json" for i in (0, 2, 4, 6)]
         assert stored_count(store) == len(VALUES)
-        (store / "points" / "chunk-00002-2.json").unlink()  # as if killed before it
+        (store / "points" / "00002-2.json").unlink()  # as if killed before it
         assert stored_count(store) == len(VALUES) - 2
         again = sweep(light, "lambda", VALUES, continuation=False, store=store, **settings)
+        assert again.resumed == len(VALUES) - 2
         assert [_plain(p) for p in again.points] == [_plain(p) for p in result.points]
         assert again.to_json() == dumps(again.to_dict())
         path = again.save(tmp_path / "sweep.json")

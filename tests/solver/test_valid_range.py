@@ -23,8 +23,9 @@ def fast():
 
 @pytest.fixture(scope="module")
 def reference_exit(fast):
-    run = simulate(fast, method="DOP853", rtol=1e-12, atol=1e-14, transient=10, periods=20,
-                   on_invalid="error")  # fmt: skip
+    run = simulate(
+        fast, method="DOP853", rtol=1e-12, atol=1e-14, transient=10, periods=20, on_invalid="error"
+    )
     assert run.status == "invalid"
     return run.left_valid_range
 
@@ -48,8 +49,15 @@ def test_the_lockstep_engine_locates_each_points_exit(fast, method):
     systems = [fast.with_values(**{"lambda": lam}) for lam in (0.1, 0.5, 1.0)]
     runs = simulate_many(systems, method=method, transient=10, periods=20, on_invalid="error")
     for system, run in zip(systems, runs, strict=True):
-        ref = simulate(system, method="DOP853", rtol=1e-12, atol=1e-14, transient=10,
-                       periods=20, on_invalid="error")  # fmt: skip
+        ref = simulate(
+            system,
+            method="DOP853",
+            rtol=1e-12,
+            atol=1e-14,
+            transient=10,
+            periods=20,
+            on_invalid="error",
+        )
         assert run.status == ref.status
         if ref.left_valid_range is None:
             assert run.left_valid_range is None
@@ -75,12 +83,29 @@ def test_a_start_outside_the_range_is_an_input_error_naming_the_state():
 def test_exit_codes_0_ok_2_bad_input_3_run_ended_badly(capsys):
     quick = ["--transient", "10", "--periods", "20", "--lyapunov-periods", "0"]
     assert main(["simulate", "reference-light", *quick]) == 0
-    assert main(["simulate", "reference-light", "--set", "omega=50", "--on-invalid", "error",
-                 *quick]) == 3  # fmt: skip
+    assert (
+        main(["simulate", "reference-light", "--set", "omega=50", "--on-invalid", "error", *quick])
+        == 3
+    )
     diverging = ["--set", "xi_u_u=-0.5", "--set", "xi_v_v=-0.5", "--transient", "6"]
     for method in ("dop853", "RK45", "cvodes", "rk"):
-        assert main(["simulate", "reference-light", *diverging, "--method", method,
-                     "--periods", "2", "--lyapunov-periods", "0", "--json"]) == 3  # fmt: skip
+        assert (
+            main(
+                [
+                    "simulate",
+                    "reference-light",
+                    *diverging,
+                    "--method",
+                    method,
+                    "--periods",
+                    "2",
+                    "--lyapunov-periods",
+                    "0",
+                    "--json",
+                ]
+            )
+            == 3
+        )
         assert '"status": "divergent"' in capsys.readouterr().out, method
     assert main(["simulate", "reference-light", "--set", "f1=5"]) == 2
     err = capsys.readouterr().err

@@ -1,12 +1,14 @@
 """Compiled integration: the generated C right-hand side driven by C integrators.
 
 * ``build.py`` -- compile and cache the library of a generated model;
-* ``batch.py`` -- many parameter points in one call (lockstep groups or point by point),
-  the NumPy fallback without a compiler, and the compiled Lyapunov run;
-* ``maps.py`` -- the same engine for regime maps: Poincare points, extremes at every step,
-  the valid range and the exponent's tangent vector, with no Python step per point;
-* ``_native.c`` -- the integrators (DOPRI5, DOP853, RK4, Benettin), whose tableaux come
-  from ``../tableau.py``.
+* ``batch.py`` -- sampled runs of many points (lockstep groups or point by point), and
+  ``run_batch``, a spec constructor over the front door ``integrate()`` (``../run.py``);
+* ``phase.py`` -- the same in the excitation phase (several forcing frequencies at once);
+* ``maps.py`` -- the same engine for maps: Poincare points, extremes at every step, the
+  valid range and the exponent's tangent vector, with no Python step per point;
+* ``fallback.py`` -- the one NumPy/SciPy fallback without a compiler, for every spec;
+* ``_native.c`` -- the integrators (DOPRI5, DOP853, RK4), whose tableaux come from
+  ``../tableau.py``.
 
 :func:`run` is the ``simulate`` back end of the ``native`` family: one point.
 """
@@ -16,16 +18,15 @@ from __future__ import annotations
 import numpy as np
 
 from ..result import Request, Run
-from . import batch, build
-from .batch import NATIVE_METHODS, STATUS, BatchResult, benettin, run_batch
+from ..spec import RunSpec
+from . import build, fallback
+from .batch import NATIVE_METHODS, STATUS, run_batch
 from .build import NativeUnavailable, cache_dir, compiler, library, source
 
 __all__ = [
     "NATIVE_METHODS",
     "STATUS",
-    "BatchResult",
     "NativeUnavailable",
-    "benettin",
     "cache_dir",
     "compiler",
     "library",
@@ -43,40 +44,30 @@ def reset() -> None:
     build._loaded.clear()
     build._paths.clear()
     build._failed.clear()
-    batch._warned.clear()
+    fallback._warned.clear()
 
 
 def run(system, req: Request) -> Run:
-    """One point through :func:`run_batch`, on its own steps."""
-    res = run_batch(
-        system.module,
-        system.p[None, :],
-        np.asarray(req.x0, float)[None, :],
-        lockstep=False,
-        **_options(req, system),
-    )
+    """One point through ``integrate()``, on its own steps."""
+    from ..run import integrate
+
+    res = integrate(system, req.x0, _spec(req, lockstep=False))
     return _as_run(res, 0, req, system)
 
 
 def run_many(systems, reqs, workers: int = 1) -> list[Run]:
     """Many points of one model with one request each (same options, own ``x0``) in one
     call of the lockstep engine; ``workers`` processes."""
-    first = reqs[0]
+    from ..run import Batch, integrate
+
     P = np.array([s.p for s in systems])
     X0 = np.array([np.asarray(q.x0, float) for q in reqs])
-    res = run_batch(
-        systems[0].module, P, X0, lockstep=True, workers=workers, **_options(first, systems[0])
-    )
+    res = integrate(Batch.of(systems[0].module, P), X0, _spec(reqs[0]), workers=workers)
     return [_as_run(res, i, q, s) for i, (q, s) in enumerate(zip(reqs, systems, strict=True))]
 
 
-def _options(req: Request, system) -> dict:
-    bounds = np.full(system.n, np.inf)
-    for i, b in system.contract.valid_bounds():
-        bounds[i] = b
-    return dict(
-        valid_range=bounds,
-        stop_on_exit=req.on_invalid == "error",
+def _spec(req: Request, lockstep: bool = True) -> RunSpec:
+    return RunSpec(
         method=req.method,
         rtol=req.rtol,
         atol=req.atol,
@@ -86,6 +77,8 @@ def _options(req: Request, system) -> dict:
         samples_per_period=req.samples_per_period,
         steps_per_period=req.steps_per_period,
         bound=req.bound,
+        valid_range="stop" if req.on_invalid == "error" else "record",
+        lockstep=lockstep,
     )
 
 

@@ -1,29 +1,97 @@
-/* gearsym compiled integrators: Dormand-Prince 5(4), DOP853 and classic RK4, many parameter
- * points per call, stroboscopic/uniform sampling after a transient.
+/* gearsym compiled integrators: one entry, gs_integrate(const gs_job *), for every run.
  *
- * The step-size control follows SciPy's RK45 and DOP853 (Hairer, Norsett and Wanner,
- * "Solving Ordinary Differential Equations I", II.4 and II.10): RMS error norm with
- * scale atol + rtol max(|y|, |y_new|), safety 0.9, factor in [0.2, 10], no growth right after
- * a rejection, and the same initial-step selection.  Steps are clipped to land on every
- * sample time; after a clipped step the unclipped proposal is kept.
+ * Methods are data: the Butcher tableaux of ../tableau.py (Dormand-Prince 5(4), DOP853 and
+ * the classic RK4, printed as C arrays by build.py) drive one explicit step, gs_stages.
+ * The adaptive step control follows SciPy's RK45 and DOP853 (Hairer, Norsett and Wanner,
+ * "Solving Ordinary Differential Equations I", II.4 and II.10): RMS error norm with scale
+ * atol + rtol max(|y|, |y_new|), safety 0.9, factor in [0.2, 10], no growth right after a
+ * rejection, the same initial-step selection.  Steps are clipped to land on every stop;
+ * after a clipped step the unclipped proposal is kept.  RK4 steps on the fixed grid
+ * t0 + j T / steps_per_period.
  *
- * The model (gs_prep, gs_rhs, GS_NX, GS_NP, GS_NQ) and the Butcher tables (the checked
- * tableaux of ../tableau.py, SciPy's coefficient arrays) are inserted above this text by
- * build.py.
+ * One step loop serves every run: points go in groups that share time and step size
+ * (a group of one is a point on its own steps); the time mode, what is collected and the
+ * valid-range mode are fields of the job, not copies of the loop.  Benettin's tangent
+ * renormalisation (gs_benettin) is the one used by every exponent.
+ *
+ * The model (gs_prep, gs_rhs, gs_rhs_batch, GS_NX, GS_NP, GS_NQ; GS_VARIATIONAL when the
+ * state carries a tangent vector) and the tables are inserted above this text by build.py.
  */
 
 #include <math.h>
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
+#define GS_ABI_VERSION 1
+
+/* a point's status */
 #define GS_OK 0
 #define GS_DIVERGENT 1
 #define GS_TOO_MANY_STEPS 2
 #define GS_NOT_FINITE 3
 #define GS_STEP_TOO_SMALL 4
-#define GS_LEFT_RANGE 5 /* left the force law's valid range (maps; runs that stop there) */
+#define GS_LEFT_RANGE 5
+
+/* gs_integrate's refusals (nothing is written): abi.py words them */
+#define GS_E_ABI (-1)
+#define GS_E_SIZE (-2)
+#define GS_E_OPTION (-3)
+#define GS_E_NOMEM (-4)
+#define GS_E_OMEGA (-5)
+
+#define GS_DENSE 1        /* DOP853 samples by its dense output (samples-only runs) */
+#define GS_BATCHED 2      /* the group's excitation once per stage (gs_rhs_batch) */
+#define GS_PERIOD_STOPS 4 /* stop at every period of the transient too (map iteration) */
+#define GS_MOST_GROUP 4096
+#define GS_MOST_STOP ((int64_t)1 << 53)
+
+/* The job: X(type, name) in order; 'i' int64_t, 'd' double, 'p' a pointer, each array
+ * followed by its length in elements.  gs_job_fields() and gs_job_layout() export it so
+ * that abi.py's ctypes.Structure is checked against it when the library loads. */
+#define GS_JOB(X)                                                                          \
+    X(i, int64_t, abi) X(i, int64_t, n_points) X(i, int64_t, n_states)                    \
+    X(i, int64_t, n_params) X(i, int64_t, group) X(i, int64_t, transient)                \
+    X(i, int64_t, periods) X(i, int64_t, samples_per_period)                              \
+    X(i, int64_t, steps_per_period) X(i, int64_t, lyapunov_periods)                       \
+    X(i, int64_t, max_steps) X(i, int64_t, method) X(i, int64_t, time_mode)               \
+    X(i, int64_t, omega_index) X(i, int64_t, valid_range) X(i, int64_t, flags)           \
+    X(d, double, t0) X(d, double, period) X(d, double, rtol) X(d, double, atol)           \
+    X(d, double, bound)                                                                    \
+    X(p, const double *, P) X(i, int64_t, P_len)                                           \
+    X(p, const double *, X0) X(i, int64_t, X0_len)                                         \
+    X(p, const double *, bounds) X(i, int64_t, bounds_len)                                 \
+    X(p, const double *, tangent0) X(i, int64_t, tangent0_len)                             \
+    X(p, double *, x) X(i, int64_t, x_len)                                                 \
+    X(p, double *, xmin) X(i, int64_t, xmin_len)                                           \
+    X(p, double *, xmax) X(i, int64_t, xmax_len)                                           \
+    X(p, double *, exponent) X(i, int64_t, exponent_len)                                   \
+    X(p, int64_t *, nfev) X(i, int64_t, nfev_len)                                          \
+    X(p, int64_t *, nsteps) X(i, int64_t, nsteps_len)                                      \
+    X(p, int32_t *, status) X(i, int64_t, status_len)                                      \
+    X(p, double *, t_fail) X(i, int64_t, t_fail_len)                                       \
+    X(p, double *, exits) X(i, int64_t, exits_len)
+
+#define GS_MEMBER(code, type, name) type name;
+typedef struct {
+    GS_JOB(GS_MEMBER)
+} gs_job;
+
+#define GS_NAME(code, type, name) #name ":" #code " "
+const char *gs_job_fields(void) { return GS_JOB(GS_NAME); }
+
+#define GS_OFFSET(code, type, name) (int64_t) offsetof(gs_job, name),
+int64_t gs_job_layout(int64_t *out, int64_t size)
+{
+    static const int64_t table[] = {GS_ABI_VERSION, (int64_t)sizeof(gs_job), GS_JOB(GS_OFFSET)};
+    const int64_t count = (int64_t)(sizeof table / sizeof table[0]);
+    for (int64_t k = 0; k < count && k < size; ++k) out[k] = table[k];
+    return count;
+}
 
 typedef struct {
     int ns;           /* stages */
@@ -33,14 +101,34 @@ typedef struct {
     const double *E;  /* ns + 1 (RK45) or NULL */
     const double *E3; /* ns + 1 (DOP853) or NULL */
     const double *E5; /* ns + 1 (DOP853) or NULL */
-    int error_order;
+    int error_order;  /* 0: a fixed-step method */
 } gs_tableau;
 
-#define GS_MAXS 13
+static const gs_tableau GS_TABLEAUX[3] = {
+    {6, GS_RK45_A, GS_RK45_B, GS_RK45_C, GS_RK45_E, 0, 0, 4},
+    {12, GS_DOP853_A, GS_DOP853_B, GS_DOP853_C, 0, GS_DOP853_E3, GS_DOP853_E5, 7},
+    {4, GS_RK4_A, GS_RK4_B, GS_RK4_C, 0, 0, 0, 0},
+};
+#define GS_KROWS 16 /* DOP853: 12 stages, the FSAL stage and 3 of the dense output */
 
-static const gs_tableau GS_RK45 = {6, GS_RK45_A, GS_RK45_B, GS_RK45_C, GS_RK45_E, 0, 0, 4};
-static const gs_tableau GS_DOP853 = {12, GS_DOP853_A, GS_DOP853_B, GS_DOP853_C, 0,
-                                     GS_DOP853_E3, GS_DOP853_E5, 7};
+#ifdef GS_VARIATIONAL
+#define GS_NSTATE (GS_NX / 2)
+#else
+#define GS_NSTATE GS_NX
+#endif
+
+/* One run: the job, what it derives, and the work arrays of one group (structure of
+ * arrays: component i of point j at [i n + j]). */
+typedef struct {
+    const gs_job *job;
+    const gs_tableau *T;
+    int phase, batched, dense, tangent, extremes, range, stop;
+    int64_t n_pre, n_stops, lyap_from, done; /* done: fixed steps taken by the group */
+    double *Pg, *Qg, *Y, *YT, *YN, *K, *F, *E5s, *E3s, *growth;
+    int *alive, *leave;
+    long long nfev, nsteps;
+    int group_status;
+} gs_ctx;
 
 static double gs_rms(const double *v, const double *scale)
 {
@@ -52,55 +140,13 @@ static double gs_rms(const double *v, const double *scale)
     return sqrt(s / GS_NX);
 }
 
-/* One explicit RK step: fills K[0..ns] (K[ns] = f(t + h, y_new)) and y_new. */
-static void gs_step(const gs_tableau *T, double t, const double *y, const double *f, double h,
-                    const double *p, const double *q, double K[GS_MAXS + 1][GS_NX],
-                    double *ynew)
+static int gs_check(const double *y, int n_bounded, double bound)
 {
-    double yt[GS_NX];
-    memcpy(K[0], f, sizeof(double) * GS_NX);
-    for (int s = 1; s < T->ns; ++s) {
-        for (int i = 0; i < GS_NX; ++i) {
-            double acc = 0.0;
-            for (int j = 0; j < s; ++j) acc += T->A[s * T->ns + j] * K[j][i];
-            yt[i] = y[i] + h * acc;
-        }
-        gs_rhs(t + T->C[s] * h, yt, p, q, K[s]);
-    }
     for (int i = 0; i < GS_NX; ++i) {
-        double acc = 0.0;
-        for (int j = 0; j < T->ns; ++j) acc += T->B[j] * K[j][i];
-        ynew[i] = y[i] + h * acc;
+        if (!isfinite(y[i])) return GS_NOT_FINITE;
+        if (i < n_bounded && fabs(y[i]) > bound) return GS_DIVERGENT;
     }
-    gs_rhs(t + h, ynew, p, q, K[T->ns]);
-}
-
-static double gs_error_norm(const gs_tableau *T, double K[GS_MAXS + 1][GS_NX], double h,
-                            const double *scale)
-{
-    double e[GS_NX];
-    if (T->E) {
-        for (int i = 0; i < GS_NX; ++i) {
-            double acc = 0.0;
-            for (int j = 0; j <= T->ns; ++j) acc += T->E[j] * K[j][i];
-            e[i] = acc * h;
-        }
-        return gs_rms(e, scale);
-    }
-    double e5 = 0.0, e3 = 0.0;
-    for (int i = 0; i < GS_NX; ++i) {
-        double a5 = 0.0, a3 = 0.0;
-        for (int j = 0; j <= T->ns; ++j) {
-            a5 += T->E5[j] * K[j][i];
-            a3 += T->E3[j] * K[j][i];
-        }
-        a5 /= scale[i];
-        a3 /= scale[i];
-        e5 += a5 * a5;
-        e3 += a3 * a3;
-    }
-    if (e5 == 0.0 && e3 == 0.0) return 0.0;
-    return fabs(h) * e5 / sqrt((e5 + 0.01 * e3) * GS_NX);
+    return GS_OK;
 }
 
 static double gs_initial_step(double t0, const double *y0, const double *f0, double length,
@@ -125,26 +171,11 @@ static double gs_initial_step(double t0, const double *y0, const double *f0, dou
     return h;
 }
 
-static int gs_check(const double *y, double bound)
-{
-    for (int i = 0; i < GS_NX; ++i) {
-        if (!isfinite(y[i])) return GS_NOT_FINITE;
-        if (fabs(y[i]) > bound) return GS_DIVERGENT;
-    }
-    return GS_OK;
-}
-
-/* ---- The force law's valid range (|x_i| <= range_i), checked at every accepted step. ----
+/* ---- The force law's valid range (|x_i| <= bounds_i), checked at every accepted step.
  * A step from (t, a0) to (t + h, a1) with slopes f0, f1 (NULL: a fixed step, straight
  * line) left the range of state i when the cubic Hermite interpolant of the step passes
  * |x| = r; the crossing is found by bisection on it.  A cheap bound skips almost every
- * step: |p| <= max(|a0|, |a1|) + (4/27) h (|f0| + |f1|) on the step (0.15 > 4/27 below). */
-typedef struct {
-    const double *range; /* GS_NX bounds (INFINITY: none), or NULL */
-    int stop;            /* 1: the point stops at its first exit (status GS_LEFT_RANGE) */
-    double *exit;        /* npts x 3: tau, state index, value of the first exit (tau NaN) */
-} gs_range_t;
-
+ * step: |p| <= max(|a0|, |a1|) + (4/27) h (|f0| + |f1|) on the step (0.15 > 4/27). */
 static double gs_hermite(double a0, double a1, double f0, double f1, double h, double x)
 {
     const double x2 = x * x, x3 = x2 * x;
@@ -152,18 +183,22 @@ static double gs_hermite(double a0, double a1, double f0, double f1, double h, d
            (x3 - x2) * h * f1;
 }
 
+static double gs_on_step(double a0, double a1, const double *f0, const double *f1, double h,
+                         double x)
+{
+    return f0 ? gs_hermite(a0, a1, f0[0], f1[0], h, x) : a0 + x * (a1 - a0);
+}
+
 /* Fraction x in (0, 1] of the step where |x_i| first passes r, or -1. */
 static double gs_crossing(double a0, double a1, const double *f0, const double *f1, double h,
                           double r)
 {
-    const double d0 = f0 ? f0[0] : 0.0, d1 = f1 ? f1[0] : 0.0;
-    const double reach = fmax(fabs(a0), fabs(a1)) + (f0 ? 0.15 * fabs(h) * (fabs(d0) + fabs(d1)) : 0.0);
-    if (!(reach > r) || fabs(a0) > r) return -1.0;
+    const double slope = f0 ? 0.15 * fabs(h) * (fabs(f0[0]) + fabs(f1[0])) : 0.0;
+    if (!(fmax(fabs(a0), fabs(a1)) + slope > r) || fabs(a0) > r) return -1.0;
     double lo = 0.0, hi = -1.0;
     for (int k = 1; k <= 16; ++k) {
         const double x = k / 16.0;
-        const double v = f0 ? gs_hermite(a0, a1, d0, d1, h, x) : a0 + x * (a1 - a0);
-        if (fabs(v) > r) {
+        if (fabs(gs_on_step(a0, a1, f0, f1, h, x)) > r) {
             hi = x;
             break;
         }
@@ -172,53 +207,310 @@ static double gs_crossing(double a0, double a1, const double *f0, const double *
     if (hi < 0) return -1.0;
     for (int it = 0; it < 50; ++it) {
         const double x = 0.5 * (lo + hi);
-        const double v = f0 ? gs_hermite(a0, a1, d0, d1, h, x) : a0 + x * (a1 - a0);
-        if (fabs(v) > r) hi = x; else lo = x;
+        if (fabs(gs_on_step(a0, a1, f0, f1, h, x)) > r) hi = x;
+        else lo = x;
     }
     return hi;
 }
 
-/* Record point j's first exit in a step of length h from t (state i of y0 / y1 at
- * stride `st`, slopes likewise or NULL); returns 1 when the point must stop. */
-static int gs_range_step(const gs_range_t *rg, int j, double t, double h, const double *y0,
+/* Record point `pt`'s first exit in a step of length h from t (component i of y0 / y1 at
+ * [i st], slopes likewise or NULL); returns 1 when the point must stop there. */
+static int gs_range_step(const gs_ctx *c, int64_t pt, double t, double h, const double *y0,
                          const double *y1, const double *f0, const double *f1, long st)
 {
-    if (!rg || !rg->range || !isnan(rg->exit[3 * (long)j])) return 0;
+    double *exit = c->job->exits + 3 * pt;
+    if (!c->range || !isnan(exit[0])) return 0;
     double best = 2.0, value = 0.0;
     int which = -1;
-    for (int i = 0; i < GS_NX; ++i) {
-        const double r = rg->range[i];
+    for (int i = 0; i < GS_NSTATE; ++i) {
+        const double r = c->job->bounds[i];
         if (!isfinite(r)) continue;
         const long e = (long)i * st;
-        const double x = gs_crossing(y0[e], y1[e], f0 ? f0 + e : 0, f1 ? f1 + e : 0, h, r);
+        const double *g0 = f0 ? f0 + e : 0, *g1 = f1 ? f1 + e : 0;
+        const double x = gs_crossing(y0[e], y1[e], g0, g1, h, r);
         if (x >= 0.0 && x < best) {
             best = x;
             which = i;
-            value = f0 ? gs_hermite(y0[e], y1[e], f0[e], f1[e], h, x) : y0[e] + x * (y1[e] - y0[e]);
+            value = gs_on_step(y0[e], y1[e], g0, g1, h, x);
         }
     }
     if (which < 0) return 0;
-    rg->exit[3 * (long)j] = t + best * h;
-    rg->exit[3 * (long)j + 1] = which;
-    rg->exit[3 * (long)j + 2] = value;
-    return rg->stop;
+    exit[0] = t + best * h;
+    exit[1] = which;
+    exit[2] = value;
+    return c->stop;
 }
 
-/* Advance (t, y, f) to `target` with the adaptive method. */
-static int gs_adaptive_to(const gs_tableau *T, double *t, double *y, double *f, double *h_abs,
-                          double target, double rtol, double atol, const double *p,
-                          const double *q, double bound, long long max_steps, long long *nfev,
-                          long long *nsteps, const gs_range_t *rg, int j)
+/* A start outside the valid range is an exit at t0; returns 1 when the point stops. */
+static int gs_range_start(const gs_ctx *c, int64_t pt, const double *y)
 {
-    double K[GS_MAXS + 1][GS_NX], ynew[GS_NX], scale[GS_NX];
-    const double exponent = -1.0 / (T->error_order + 1);
-    while (*t < target) {
+    for (int i = 0; c->range && i < GS_NSTATE; ++i) {
+        if (!(fabs(y[i]) > c->job->bounds[i])) continue;
+        double *exit = c->job->exits + 3 * pt;
+        exit[0] = c->job->t0;
+        exit[1] = i;
+        exit[2] = y[i];
+        return c->stop;
+    }
+    return 0;
+}
+
+/* The group's right-hand side.  Phase mode: s = omega tau, each point with its own
+ * omega = P[iw]: dX/ds = f(s / omega, X) / omega, so points of different forcing frequency
+ * share the time grid.  Batched: the excitation once for the group (gs_rhs_batch).
+ * Otherwise point by point. */
+static void gs_rhs_group(const gs_ctx *c, double t, int n, const double *Y, double *K)
+{
+    if (c->batched && !c->phase) {
+        gs_rhs_batch(t, n, Y, c->Pg, c->Qg, K);
+        return;
+    }
+    for (int j = 0; j < n; ++j) {
+        double x[GS_NX], p[GS_NP], q[GS_NQ > 0 ? GS_NQ : 1], dx[GS_NX];
+        for (int i = 0; i < GS_NX; ++i) x[i] = Y[(long)i * n + j];
+        for (int k = 0; k < GS_NP; ++k) p[k] = c->Pg[(long)k * n + j];
+        for (int k = 0; k < GS_NQ; ++k) q[k] = c->Qg[(long)k * n + j];
+        if (!c->phase) {
+            gs_rhs(t, x, p, q, dx);
+            for (int i = 0; i < GS_NX; ++i) K[(long)i * n + j] = dx[i];
+            continue;
+        }
+        const double w = p[c->job->omega_index];
+        gs_rhs(t / w, x, p, q, dx);
+        for (int i = 0; i < GS_NX; ++i) K[(long)i * n + j] = dx[i] / w;
+    }
+}
+
+/* The explicit step of the tableau from (t, Y) with K[0] = f(t, Y): stages into K, the
+ * new state into YN and its slope at t_new (first same as last) into K[ns]. */
+static void gs_stages(gs_ctx *c, double t, double hh, double t_new, int n)
+{
+    const gs_tableau *T = c->T;
+    const int ns = T->ns;
+    const long S = (long)GS_NX * n;
+    double *K = c->K, *Y = c->Y, *YT = c->YT, *YN = c->YN;
+    for (int s = 1; s < ns; ++s) {
+        for (long e = 0; e < S; ++e) {
+            double acc = 0.0;
+            for (int r = 0; r < s; ++r) acc += T->A[s * ns + r] * K[r * S + e];
+            YT[e] = Y[e] + hh * acc;
+        }
+        gs_rhs_group(c, t + T->C[s] * hh, n, YT, K + s * S);
+    }
+    for (long e = 0; e < S; ++e) {
+        double acc = 0.0;
+        for (int r = 0; r < ns; ++r) acc += T->B[r] * K[r * S + e];
+        YN[e] = Y[e] + hh * acc;
+    }
+    gs_rhs_group(c, t_new, n, YN, K + ns * S);
+    c->nfev += ns;
+}
+
+/* Point j of the group stops with `status` at t (its state zeroed: it leaves the error
+ * norm and the arithmetic stays finite). */
+static void gs_stop_point(gs_ctx *c, int64_t g0, int n, int j, int status, double t)
+{
+    c->alive[j] = 0;
+    c->job->status[g0 + j] = status;
+    c->job->t_fail[g0 + j] = t;
+    for (int i = 0; i < GS_NX; ++i) c->Y[(long)i * n + j] = 0.0;
+}
+
+/* The group's error norm of the step just taken: the largest of its points' norms
+ * (each meets the tolerance); a point whose norm is not finite leaves the group. */
+static double gs_error(gs_ctx *c, int64_t g0, int n, double t, double hh)
+{
+    const gs_tableau *T = c->T;
+    const int ns = T->ns;
+    const long S = (long)GS_NX * n;
+    const double rtol = c->job->rtol, atol = c->job->atol;
+    const double *restrict K = c->K;
+    double *restrict E5s = c->E5s, *restrict E3s = c->E3s;
+    for (int j = 0; j < n; ++j) E5s[j] = E3s[j] = 0.0;
+    for (int i = 0; i < GS_NX; ++i) {
+        const double *y0 = c->Y + (long)i * n, *y1 = c->YN + (long)i * n;
+        for (int j = 0; j < n; ++j) {
+            double a5 = 0.0, a3 = 0.0;
+            const long e = (long)i * n + j;
+            if (T->E) {
+                for (int r = 0; r <= ns; ++r) a5 += T->E[r] * K[r * S + e];
+                a5 *= hh;
+            } else {
+                for (int r = 0; r <= ns; ++r) {
+                    a5 += T->E5[r] * K[r * S + e];
+                    a3 += T->E3[r] * K[r * S + e];
+                }
+            }
+            const double a = fabs(y0[j]), b = fabs(y1[j]);
+            const double sc = atol + (a > b ? a : b) * rtol;
+            a5 /= sc;
+            a3 /= sc;
+            E5s[j] += a5 * a5;
+            E3s[j] += a3 * a3;
+        }
+    }
+    double err = 0.0;
+    for (int j = 0; j < n; ++j) {
+        if (!c->alive[j]) continue;
+        double ej;
+        if (T->E)
+            ej = sqrt(E5s[j] / GS_NX);
+        else
+            ej = (E5s[j] == 0.0 && E3s[j] == 0.0)
+                     ? 0.0
+                     : fabs(hh) * E5s[j] / sqrt((E5s[j] + 0.01 * E3s[j]) * GS_NX);
+        if (!isfinite(ej)) {
+            gs_stop_point(c, g0, n, j, GS_NOT_FINITE, t);
+            continue;
+        }
+        if (ej > err) err = ej;
+    }
+    return err;
+}
+
+static double gs_sample_time(const gs_ctx *c, int64_t k)
+{
+    const gs_job *J = c->job;
+    return J->t0 + (double)(J->transient * J->samples_per_period + k) * J->period /
+                       (double)J->samples_per_period;
+}
+
+/* Write sample k of the group's points (alive and ok: from V; else NaN). */
+static void gs_write_sample(gs_ctx *c, int64_t g0, int n, int64_t k, const double *V, int ok)
+{
+    const int64_t K = c->job->periods * c->job->samples_per_period + 1;
+    for (int j = 0; j < n; ++j) {
+        double *out = c->job->x + ((g0 + j) * K + k) * GS_NSTATE;
+        for (int i = 0; i < GS_NSTATE; ++i)
+            out[i] = ok && c->alive[j] ? V[(long)i * n + j] : NAN;
+    }
+}
+
+/* DOP853's dense output over the accepted step [t, t + hh] (SciPy's Dop853DenseOutput):
+ * the three extra stages into K rows 13..15, the seven interpolant coefficients into F
+ * (7 x S); y(t + x hh) = Y + a Horner-like sum in x and 1 - x. */
+static void gs_dense_coefficients(gs_ctx *c, double t, double hh, int n)
+{
+    const long S = (long)GS_NX * n;
+    double *K = c->K, *F = c->F;
+    for (int x = 0; x < 3; ++x) {
+        const int row = 13 + x;
+        for (long e = 0; e < S; ++e) {
+            double acc = 0.0;
+            for (int r = 0; r < row; ++r) acc += GS_DOP853_AX[x * GS_KROWS + r] * K[r * S + e];
+            c->YT[e] = c->Y[e] + hh * acc;
+        }
+        gs_rhs_group(c, t + GS_DOP853_CX[x] * hh, n, c->YT, K + row * S);
+    }
+    for (long e = 0; e < S; ++e) {
+        const double dy = c->YN[e] - c->Y[e], f0 = K[e], f1 = K[12 * S + e];
+        F[e] = dy;
+        F[S + e] = hh * f0 - dy;
+        F[2 * S + e] = 2.0 * dy - hh * (f1 + f0);
+        for (int i = 0; i < 4; ++i) {
+            double acc = 0.0;
+            for (int r = 0; r < GS_KROWS; ++r) acc += GS_DOP853_D[i * GS_KROWS + r] * K[r * S + e];
+            F[(3 + i) * S + e] = hh * acc;
+        }
+    }
+    c->nfev += 3;
+}
+
+/* The samples in (t, t + hh] of an accepted step, from its dense output. */
+static void gs_dense_samples(gs_ctx *c, int64_t g0, int n, double t, double t_new,
+                             int64_t *next)
+{
+    const int64_t n_samples = c->job->periods * c->job->samples_per_period + 1;
+    const long S = (long)GS_NX * n;
+    const double hh = t_new - t;
+    int have_f = 0;
+    for (; *next < n_samples; ++*next) {
+        const double ts = gs_sample_time(c, *next);
+        if (ts > t_new) break;
+        if (ts == t_new) {
+            gs_write_sample(c, g0, n, *next, c->YN, 1);
+            continue;
+        }
+        if (!have_f) gs_dense_coefficients(c, t, hh, n);
+        have_f = 1;
+        const double x = (ts - t) / hh;
+        for (int j = 0; j < n; ++j) {
+            double *out = c->job->x + ((g0 + j) * n_samples + *next) * GS_NSTATE;
+            for (int i = 0; i < GS_NSTATE; ++i) {
+                const long e = (long)i * n + j;
+                double y = 0.0;
+                for (int r = 0; r < 7; ++r) {
+                    y += c->F[(6 - r) * S + e];
+                    y *= (r % 2 == 0) ? x : 1.0 - x;
+                }
+                out[i] = c->alive[j] ? y + c->Y[e] : NAN;
+            }
+        }
+    }
+}
+
+static void gs_extremes(gs_ctx *c, int64_t g0, int n)
+{
+    for (int j = 0; j < n; ++j) {
+        if (!c->alive[j]) continue;
+        double *lo = c->job->xmin + (g0 + j) * GS_NSTATE, *hi = c->job->xmax + (g0 + j) * GS_NSTATE;
+        for (int i = 0; i < GS_NSTATE; ++i) {
+            const double y = c->Y[(long)i * n + j];
+            if (y < lo[i]) lo[i] = y;
+            if (y > hi[i]) hi[i] = y;
+        }
+    }
+}
+
+/* After an accepted step from t to t_new (YN, K[ns] its end): the valid range on the
+ * step (slopes: Hermite; a fixed step: straight line), the step taken, every point checked
+ * (finite, bound, range), the extremes in the window.  `sample_from`: the first sample
+ * the step wrote by dense output (NaN again for a point that fails on it). */
+static void gs_accept(gs_ctx *c, int64_t g0, int n, double t, double t_new, int slopes,
+                      int in_window, int64_t sample_from, int64_t sample_to)
+{
+    const long S = (long)GS_NX * n;
+    const int ns = c->T->ns;
+    for (int j = 0; j < n; ++j)
+        c->leave[j] = c->range && c->alive[j] && gs_range_step(c, g0 + j, t, t_new - t, c->Y + j, c->YN + j,
+                                                   slopes ? c->K + j : 0,
+                                                   slopes ? c->K + ns * S + j : 0, n);
+    memcpy(c->Y, c->YN, sizeof(double) * S);
+    memcpy(c->K, c->K + ns * S, sizeof(double) * S); /* first same as last */
+    c->nsteps += 1;
+    if (c->nsteps >= c->job->max_steps && c->group_status == GS_OK)
+        c->group_status = GS_TOO_MANY_STEPS;
+    int dead = 0;
+    for (int j = 0; j < n; ++j) {
+        if (!c->alive[j]) continue;
+        double y[GS_NX];
+        for (int i = 0; i < GS_NX; ++i) y[i] = c->Y[(long)i * n + j];
+        int status = gs_check(y, GS_NSTATE, c->job->bound);
+        if (status == GS_OK && c->leave[j]) status = GS_LEFT_RANGE;
+        if (status == GS_OK) continue;
+        gs_stop_point(c, g0, n, j, status, c->leave[j] ? c->job->exits[3 * (g0 + j)] : t_new);
+        dead = 1;
+        for (int64_t k = sample_from; k < sample_to; ++k) gs_write_sample(c, g0 + j, 1, k, y, 0);
+    }
+    if (dead) gs_rhs_group(c, t_new, n, c->Y, c->K); /* the first stage of the next step */
+    if (in_window) gs_extremes(c, g0, n);
+}
+
+/* Advance the group to `target` by adaptive steps; dense output writes the samples the
+ * steps pass. */
+static void gs_adaptive_to(gs_ctx *c, int64_t g0, int n, double *t, double *h_abs,
+                           double target, int in_window, int64_t *next_sample)
+{
+    const double exponent = -1.0 / (c->T->error_order + 1);
+    while (*t < target && c->group_status == GS_OK) {
         const double min_step = 10.0 * fabs(nextafter(*t, INFINITY) - *t);
-        if (!isfinite(*h_abs)) return GS_NOT_FINITE;
         double h = *h_abs < min_step ? min_step : *h_abs;
         int rejected = 0;
         for (;;) {
-            if (!(h >= min_step)) return GS_STEP_TOO_SMALL;
+            if (!(h >= min_step)) {
+                c->group_status = GS_STEP_TOO_SMALL;
+                return;
+            }
             double t_new = *t + h;
             int clipped = 0;
             if (t_new >= target) {
@@ -226,28 +518,19 @@ static int gs_adaptive_to(const gs_tableau *T, double *t, double *y, double *f, 
                 clipped = 1;
             }
             const double hh = t_new - *t;
-            gs_step(T, *t, y, f, hh, p, q, K, ynew);
-            *nfev += T->ns;
-            for (int i = 0; i < GS_NX; ++i) {
-                const double a = fabs(y[i]), b = fabs(ynew[i]);
-                scale[i] = atol + (a > b ? a : b) * rtol;
-            }
-            const double err = gs_error_norm(T, K, hh, scale);
+            gs_stages(c, *t, hh, *t + hh, n);
+            const double err = gs_error(c, g0, n, *t, hh);
             if (err < 1.0) {
                 double factor = err == 0.0 ? 10.0 : 0.9 * pow(err, exponent);
                 if (factor > 10.0) factor = 10.0;
                 if (rejected && factor > 1.0) factor = 1.0;
                 const double next = hh * factor;
-                /* keep the unclipped proposal after a step shortened to hit a sample */
+                /* keep the unclipped proposal after a step shortened to hit a stop */
                 *h_abs = clipped && !rejected && h > next ? h : next;
-                const int leave = gs_range_step(rg, j, *t, hh, y, ynew, f, K[T->ns], 1);
+                const int64_t from = *next_sample;
+                if (c->dense) gs_dense_samples(c, g0, n, *t, t_new, next_sample);
+                gs_accept(c, g0, n, *t, t_new, 1, in_window, from, *next_sample);
                 *t = t_new;
-                memcpy(y, ynew, sizeof(double) * GS_NX);
-                memcpy(f, K[T->ns], sizeof(double) * GS_NX);
-                if (leave) {
-                    *nsteps += 1;
-                    return GS_LEFT_RANGE;
-                }
                 break;
             }
             double factor = 0.9 * pow(err, exponent);
@@ -255,105 +538,288 @@ static int gs_adaptive_to(const gs_tableau *T, double *t, double *y, double *f, 
             h = hh * factor;
             rejected = 1;
         }
-        *nsteps += 1;
-        const int c = gs_check(y, bound);
-        if (c != GS_OK) return c;
-        if (*nsteps >= max_steps) return GS_TOO_MANY_STEPS;
     }
-    return GS_OK;
 }
 
-static void gs_rk4_step(double t, double *y, double h, const double *p, const double *q)
+/* Advance the group by fixed steps on the grid t0 + j T / steps_per_period up to step
+ * `upto`. */
+static void gs_fixed_to(gs_ctx *c, int64_t g0, int n, double *t, int64_t upto, int in_window)
 {
-    double k1[GS_NX], k2[GS_NX], k3[GS_NX], k4[GS_NX], yt[GS_NX];
-    gs_rhs(t, y, p, q, k1);
-    for (int i = 0; i < GS_NX; ++i) yt[i] = y[i] + 0.5 * h * k1[i];
-    gs_rhs(t + 0.5 * h, yt, p, q, k2);
-    for (int i = 0; i < GS_NX; ++i) yt[i] = y[i] + 0.5 * h * k2[i];
-    gs_rhs(t + 0.5 * h, yt, p, q, k3);
-    for (int i = 0; i < GS_NX; ++i) yt[i] = y[i] + h * k3[i];
-    gs_rhs(t + h, yt, p, q, k4);
-    for (int i = 0; i < GS_NX; ++i) y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+    const gs_job *J = c->job;
+    const double h = J->period / (double)J->steps_per_period;
+    for (; c->done < upto && c->group_status == GS_OK; ++c->done) {
+        const double ta = J->t0 + (double)c->done * h, tb = J->t0 + (double)(c->done + 1) * h;
+        gs_stages(c, ta, h, tb, n);
+        gs_accept(c, g0, n, ta, tb, 0, in_window, 0, 0);
+        *t = tb;
+    }
 }
 
-/* method: 0 = Dormand-Prince 5(4), 1 = DOP853, 2 = RK4 with rk4_steps steps per period.
- * P: npts x GS_NP, X0: npts x GS_NX, OUT: npts x (n_sample*spp + 1) x GS_NX.
- * Sample k of point i is at t0 + (n_transient + k/spp) period. */
-int gs_run(int method, int npts, const double *P, const double *X0, double t0, double period,
-           int n_transient, int n_sample, int spp, double rtol, double atol, int rk4_steps,
-           double bound, long long max_steps, double *OUT, long long *NFEV, long long *NSTEP,
-           int *STATUS, double *TFAIL, const double *RANGE, int stop_exit, double *EXIT)
+/* Benettin's renormalisation of point j's tangent vector (components GS_NSTATE ..
+ * GS_NX - 1): divided by its length g, returned (0: not a positive finite length).
+ * Benettin, Galgani, Giorgilli and Strelcyn 1980, Meccanica 15. */
+static double gs_benettin(double *Y, int n, int j)
 {
-    const gs_range_t rg = {RANGE, stop_exit, EXIT};
-    for (long k = 0; k < 3L * npts; ++k) EXIT[k] = NAN;
-    const gs_tableau *T = method == 0 ? &GS_RK45 : &GS_DOP853;
-    const int n_out = n_sample * spp + 1;
-    for (int i = 0; i < npts; ++i) {
-        const double *p = P + (long)i * GS_NP;
-        double q[GS_NQ], y[GS_NX], f[GS_NX];
-        double *out = OUT + (long)i * n_out * GS_NX;
-        long long nfev = 0, nsteps = 0;
-        int status = GS_OK;
-        double t = t0;
+    double g = 0.0;
+    for (int i = GS_NSTATE; i < GS_NX; ++i) g += Y[(long)i * n + j] * Y[(long)i * n + j];
+    g = sqrt(g);
+    if (!(g > 0.0) || !isfinite(g)) return 0.0;
+    for (int i = GS_NSTATE; i < GS_NX; ++i) Y[(long)i * n + j] /= g;
+    return g;
+}
+
+/* At stop ko (index m on the grid of 1 / samples_per_period periods from t0): the sample,
+ * the window's first extremes, and the exponent's renormalisation. */
+static void gs_at_stop(gs_ctx *c, int64_t g0, int n, int64_t ko, double t)
+{
+    const gs_job *J = c->job;
+    const int64_t spp = J->samples_per_period;
+    const int ok = c->group_status == GS_OK;
+    const int64_t k = ko - c->n_pre, m = k >= 0 ? J->transient * spp + k : ko * spp;
+    if (k >= 0 && J->x) gs_write_sample(c, g0, n, k, c->Y, ok);
+    if (k == 0 && c->extremes) gs_extremes(c, g0, n);
+    if (!c->tangent || !ok) return;
+    const int64_t n_lyap = J->lyapunov_periods, pk = m / spp;
+    for (int j = 0; j < n; ++j) {
+        if (!c->alive[j]) continue;
+        const double g = gs_benettin(c->Y, n, j);
+        if (g == 0.0) {
+            gs_stop_point(c, g0, n, j, GS_NOT_FINITE, t);
+            continue;
+        }
+        if (m <= c->lyap_from * spp) continue;
+        c->growth[j] += log(g);
+        if (m % spp == 0)
+            J->exponent[(g0 + j) * n_lyap + pk - c->lyap_from - 1] =
+                c->growth[j] / ((double)(pk - c->lyap_from) * J->period);
+    }
+    gs_rhs_group(c, t, n, c->Y, c->K); /* the first stage changed with the rescaling */
+    c->nfev += 1;
+}
+
+/* The group's points at t0: state (and tangent), checks, first step size. */
+static double gs_start(gs_ctx *c, int64_t g0, int n)
+{
+    const gs_job *J = c->job;
+    double h_abs = INFINITY;
+    const double t_end = gs_sample_time(c, J->periods * J->samples_per_period);
+    for (int j = 0; j < n; ++j) {
+        const double *p = J->P + (g0 + j) * GS_NP;
+        double q[GS_NQ > 0 ? GS_NQ : 1], f[GS_NX], y[GS_NX];
         gs_prep(p, q);
-        memcpy(y, X0 + (long)i * GS_NX, sizeof(double) * GS_NX);
-        double h_abs = 0.0;
-        const double t_end = t0 + (double)(n_transient + n_sample) * period;
-        status = gs_check(y, bound);
-        if (status == GS_OK && method != 2) {
-            gs_rhs(t, y, p, q, f);
-            nfev += 1;
-            status = gs_check(f, INFINITY);
-            h_abs = gs_initial_step(t, y, f, t_end - t0, T->error_order, rtol, atol, p, q,
-                                    &nfev);
-        }
-        int k = 0;
-        long long done = 0; /* RK4 steps taken */
-        const int bad_start = status != GS_OK;
-        for (; k < n_out && !bad_start; ++k) {
-            const double target =
-                t0 + ((double)n_transient * spp + k) * period / (double)spp;
-            if (method == 2) {
-                /* steps are laid on the global grid t0 + j period / rk4_steps */
-                const long long upto =
-                    ((long long)n_transient * spp + k) * (long long)rk4_steps / spp;
-                const double h = period / rk4_steps;
-                for (; done < upto; ++done) {
-                    double y_old[GS_NX];
-                    memcpy(y_old, y, sizeof(double) * GS_NX);
-                    gs_rk4_step(t0 + done * h, y, h, p, q);
-                    nfev += 4;
-                    nsteps += 1;
-                    status = gs_check(y, bound);
-                    if (status == GS_OK && gs_range_step(&rg, i, t0 + done * h, h, y_old, y, 0, 0, 1))
-                        status = GS_LEFT_RANGE;
-                    if (status != GS_OK) {
-                        t = t0 + (done + 1) * h;
-                        break;
-                    }
-                }
-                if (status == GS_OK) t = target;
-            } else {
-                status = gs_adaptive_to(T, &t, y, f, &h_abs, target, rtol, atol, p, q, bound,
-                                        max_steps, &nfev, &nsteps, &rg, i);
+        for (int k = 0; k < GS_NP; ++k) c->Pg[k * n + j] = p[k];
+        for (int k = 0; k < GS_NQ; ++k) c->Qg[k * n + j] = q[k];
+        for (int i = 0; i < GS_NSTATE; ++i) y[i] = J->X0[(g0 + j) * GS_NSTATE + i];
+        for (int i = GS_NSTATE; i < GS_NX; ++i) y[i] = J->tangent0[i - GS_NSTATE];
+        for (int i = 0; i < GS_NX; ++i) c->Y[i * n + j] = y[i];
+        gs_rhs(J->t0, y, p, q, f);
+        c->alive[j] = 1;
+        c->growth[j] = 0.0;
+        J->status[g0 + j] = GS_OK;
+        J->t_fail[g0 + j] = NAN;
+        if (c->extremes)
+            for (int i = 0; i < GS_NSTATE; ++i) {
+                J->xmin[(g0 + j) * GS_NSTATE + i] = INFINITY;
+                J->xmax[(g0 + j) * GS_NSTATE + i] = -INFINITY;
             }
-            if (status != GS_OK) break;
-            memcpy(out + (long)k * GS_NX, y, sizeof(double) * GS_NX);
+        int status = gs_check(y, GS_NSTATE, J->bound);
+        if (status == GS_OK) status = gs_check(f, 0, INFINITY);
+        if (status == GS_OK && gs_range_start(c, g0 + j, y)) status = GS_LEFT_RANGE;
+        if (status != GS_OK) {
+            gs_stop_point(c, g0, n, j, status, J->t0);
+            continue;
         }
-        for (; k < n_out; ++k)
-            for (int j = 0; j < GS_NX; ++j) out[(long)k * GS_NX + j] = NAN;
-        NFEV[i] = nfev;
-        NSTEP[i] = nsteps;
-        STATUS[i] = status;
-        TFAIL[i] = status == GS_OK ? NAN : status == GS_LEFT_RANGE ? EXIT[3 * (long)i] : t;
+        if (!c->T->error_order) continue;
+        /* in the phase a small first step; the control adapts it at once */
+        const double h0 = c->phase ? 1e-3 * J->period
+                                   : gs_initial_step(J->t0, y, f, t_end - J->t0,
+                                                     c->T->error_order, J->rtol, J->atol, p, q,
+                                                     &c->nfev);
+        if (h0 < h_abs) h_abs = h0;
+    }
+    if (!isfinite(h_abs)) h_abs = 1e-6 * J->period;
+    c->nfev = c->nfev / (n > 0 ? n : 1) + 1;
+    gs_rhs_group(c, J->t0, n, c->Y, c->K); /* K[0] = f(t0, y0) */
+    return h_abs;
+}
+
+/* One group of n points from g0: start, every stop, the statuses and counters. */
+static void gs_group(gs_ctx *c, int64_t g0, int n)
+{
+    const gs_job *J = c->job;
+    const int64_t spp = J->samples_per_period;
+    c->nfev = c->nsteps = 0;
+    c->done = 0;
+    c->group_status = GS_OK;
+    double h_abs = gs_start(c, g0, n), t = J->t0;
+    int64_t next = 0; /* dense: the next sample to write */
+    if (c->dense)
+        while (next < J->periods * spp + 1 && gs_sample_time(c, next) <= t)
+            gs_write_sample(c, g0, n, next++, c->Y, 1);
+    int64_t reached = c->n_stops; /* stops done */
+    for (int64_t ko = 0; ko < (c->dense ? 1 : c->n_stops); ++ko) {
+        int any = 0;
+        for (int j = 0; j < n; ++j) any |= c->alive[j];
+        const int64_t k = c->dense ? J->periods * spp : ko - c->n_pre;
+        const int64_t m = k >= 0 ? J->transient * spp + k : ko * spp;
+        const int in_window = c->extremes && k > 0;
+        if (!any) {
+            reached = ko;
+            break;
+        }
+        if (c->T->error_order)
+            gs_adaptive_to(c, g0, n, &t, &h_abs, gs_sample_time(c, k), in_window, &next);
+        else
+            gs_fixed_to(c, g0, n, &t, m * (J->steps_per_period / spp), in_window);
+        if (!c->dense) gs_at_stop(c, g0, n, ko, t);
+    }
+    /* samples not reached: a group whose points all stopped, dense output cut short */
+    for (int64_t k = c->dense ? next : reached - c->n_pre; J->x && k < J->periods * spp + 1; ++k)
+        if (k >= 0) gs_write_sample(c, g0, n, k, c->Y, 0);
+    for (int j = 0; j < n; ++j) {
+        const int64_t pt = g0 + j;
+        J->nfev[pt] = c->nfev;
+        J->nsteps[pt] = c->nsteps;
+        if (J->status[pt] == GS_OK && c->group_status != GS_OK) {
+            J->status[pt] = c->group_status;
+            J->t_fail[pt] = t;
+        }
+        if (c->tangent && J->status[pt] != GS_OK)
+            for (int64_t r = 0; r < J->lyapunov_periods; ++r)
+                J->exponent[pt * J->lyapunov_periods + r] = NAN;
+    }
+}
+
+static int gs_product(int64_t a, int64_t b, int64_t *out)
+{
+    return a < 0 || b < 0 || __builtin_mul_overflow(a, b, out);
+}
+
+/* An array of `len` elements where `want` (a product, checked) are needed; NULL allowed
+ * when `optional`. */
+static int gs_array_ok(const void *ptr, int64_t len, int64_t a, int64_t b, int optional)
+{
+    int64_t want;
+    if (!ptr) return optional;
+    return !gs_product(a, b, &want) && len == want;
+}
+
+/* Every size, option and array length of the job, before anything is written. */
+static int gs_check_job(const gs_job *J)
+{
+    int64_t n_samples, total, steps;
+    if (J->abi != GS_ABI_VERSION) return GS_E_ABI;
+    if (J->n_points < 0 || J->n_states != GS_NSTATE || J->n_params != GS_NP) return GS_E_SIZE;
+    if (J->group < 1 || J->group > GS_MOST_GROUP || J->transient < 0 || J->periods < 1 ||
+        J->samples_per_period < 1 || J->steps_per_period < 1 || J->max_steps < 1 ||
+        J->lyapunov_periods < 0)
+        return GS_E_OPTION;
+    if (gs_product(J->periods, J->samples_per_period, &n_samples) || n_samples >= GS_MOST_STOP ||
+        J->transient > GS_MOST_STOP || gs_product(J->transient + J->periods,
+                                                  J->samples_per_period, &total) ||
+        total >= GS_MOST_STOP)
+        return GS_E_SIZE;
+    if (J->method < 0 || J->method > 2 || J->time_mode < 0 || J->time_mode > 1 ||
+        J->valid_range < 0 || J->valid_range > 2 || (J->flags & ~7) ||
+        J->lyapunov_periods > J->transient + J->periods)
+        return GS_E_OPTION;
+    if (J->method == 2 && (J->time_mode == 1 || J->steps_per_period % J->samples_per_period ||
+                           gs_product(J->transient + J->periods, J->steps_per_period, &steps) ||
+                           steps >= GS_MOST_STOP))
+        return GS_E_OPTION;
+    if (!(J->rtol > 0 && J->atol > 0 && J->bound > 0 && J->period > 0 && isfinite(J->t0) &&
+          isfinite(J->period)))
+        return GS_E_OPTION;
+    const int64_t N = J->n_points, n = J->n_states, L = J->lyapunov_periods;
+    int64_t Nn;
+    if (gs_product(N, n, &Nn) || !gs_array_ok(J->P, J->P_len, N, GS_NP, 0) ||
+        !gs_array_ok(J->X0, J->X0_len, N, n, 0) ||
+        !gs_array_ok(J->x, J->x_len, Nn, n_samples + 1, 1) ||
+        !gs_array_ok(J->xmin, J->xmin_len, N, n, 1) || !gs_array_ok(J->xmax, J->xmax_len, N, n, 1) ||
+        !J->xmin != !J->xmax || !gs_array_ok(J->nfev, J->nfev_len, N, 1, 0) ||
+        !gs_array_ok(J->nsteps, J->nsteps_len, N, 1, 0) ||
+        !gs_array_ok(J->status, J->status_len, N, 1, 0) ||
+        !gs_array_ok(J->t_fail, J->t_fail_len, N, 1, 0))
+        return GS_E_SIZE;
+    const int check = J->valid_range != 2;
+    if (!gs_array_ok(J->bounds, J->bounds_len, n, 1, !check) ||
+        !gs_array_ok(J->exits, J->exits_len, N, 3, !check) || (!check && (J->bounds || J->exits)))
+        return GS_E_SIZE;
+    /* the exponent: the variational library, a tangent start, period stops */
+    if (!gs_array_ok(J->exponent, J->exponent_len, N, L, 1) || (!J->exponent) != (L == 0) ||
+        (J->exponent && (GS_NSTATE == GS_NX || !(J->flags & GS_PERIOD_STOPS))) ||
+        !gs_array_ok(J->tangent0, J->tangent0_len, GS_NX - GS_NSTATE, 1, GS_NSTATE == GS_NX))
+        return GS_E_SIZE;
+    if (J->time_mode == 1) {
+        if (J->omega_index < 0 || J->omega_index >= GS_NP) return GS_E_OPTION;
+        for (int64_t j = 0; j < N; ++j)
+            if (!(J->P[j * GS_NP + J->omega_index] > 0.0)) return GS_E_OMEGA;
     }
     return 0;
+}
+
+/* Integrate the job (abi.py fills it, engine.py reads it back).  Returns 0, or a
+ * GS_E_ code with nothing written. */
+int gs_integrate(const gs_job *J)
+{
+    if (!J) return GS_E_SIZE;
+    const int refused = gs_check_job(J);
+    if (refused) return refused;
+    const int64_t spp = J->samples_per_period;
+    gs_ctx c = {.job = J, .T = &GS_TABLEAUX[J->method]};
+    c.phase = J->time_mode == 1;
+    c.batched = (J->flags & GS_BATCHED) != 0;
+    c.tangent = J->exponent != 0;
+    c.extremes = J->xmin != 0;
+    c.dense = (J->flags & GS_DENSE) && J->method == 1 && J->x && !c.extremes && !c.tangent;
+    c.range = J->valid_range != 2;
+    c.stop = J->valid_range == 1;
+    c.n_pre = (J->flags & GS_PERIOD_STOPS) ? J->transient : 0;
+    c.n_stops = c.n_pre + J->periods * spp + 1;
+    c.lyap_from = J->transient + J->periods - J->lyapunov_periods;
+    const size_t G = (size_t)(J->group < J->n_points ? J->group : J->n_points > 0 ? J->n_points : 1);
+    int code = GS_E_NOMEM;
+    c.Pg = malloc(sizeof(double) * GS_NP * G);
+    c.Qg = malloc(sizeof(double) * (GS_NQ > 0 ? GS_NQ : 1) * G);
+    c.Y = malloc(sizeof(double) * GS_NX * G);
+    c.YT = malloc(sizeof(double) * GS_NX * G);
+    c.YN = malloc(sizeof(double) * GS_NX * G);
+    c.K = malloc(sizeof(double) * GS_KROWS * GS_NX * G);
+    c.F = c.dense ? malloc(sizeof(double) * 7 * GS_NX * G) : 0;
+    c.E5s = malloc(sizeof(double) * G);
+    c.E3s = malloc(sizeof(double) * G);
+    c.growth = malloc(sizeof(double) * G);
+    c.alive = malloc(sizeof(int) * G);
+    c.leave = malloc(sizeof(int) * G);
+    if (!c.Pg || !c.Qg || !c.Y || !c.YT || !c.YN || !c.K || (c.dense && !c.F) || !c.E5s ||
+        !c.E3s || !c.growth || !c.alive || !c.leave)
+        goto cleanup;
+    for (int64_t k = 0; c.range && k < 3 * J->n_points; ++k) J->exits[k] = NAN;
+    for (int64_t g0 = 0; g0 < J->n_points; g0 += (int64_t)G) {
+        const int64_t left = J->n_points - g0;
+        gs_group(&c, g0, (int)(left < (int64_t)G ? left : (int64_t)G));
+    }
+    code = 0;
+cleanup:
+    free(c.Pg);
+    free(c.Qg);
+    free(c.Y);
+    free(c.YT);
+    free(c.YN);
+    free(c.K);
+    free(c.F);
+    free(c.E5s);
+    free(c.E3s);
+    free(c.growth);
+    free(c.alive);
+    free(c.leave);
+    return code;
 }
 
 /* Right-hand-side evaluations only (for the throughput benchmark): n calls at one point. */
 double gs_rhs_loop(const double *p, const double *x0, long long n, double dt)
 {
-    double q[GS_NQ], x[GS_NX], dx[GS_NX], acc = 0.0;
+    double q[GS_NQ > 0 ? GS_NQ : 1], x[GS_NX], dx[GS_NX], acc = 0.0;
     gs_prep(p, q);
     memcpy(x, x0, sizeof(double) * GS_NX);
     for (long long k = 0; k < n; ++k) {
@@ -364,481 +830,10 @@ double gs_rhs_loop(const double *p, const double *x0, long long n, double dt)
     return acc;
 }
 
-/* ---- Lockstep integration: a group of points shares time and step size. ----
- * The excitation terms are computed once per stage for the group (gs_rhs_batch) and the
- * per-point arithmetic vectorises.  The error norm of the group is the largest of its
- * points' norms, so every point meets the tolerance.  A point that diverges or turns
- * non-finite is marked, frozen and left out of the error norm.
- *
- * One engine serves plain sampled runs (gs_run_lockstep) and maps (gs_map_lockstep): the
- * group stops at t0 + (first + k) period / spp, k = 0 .. n_stops - 1, and `gs_extras`
- * says what a map keeps at each stop and after each accepted step. */
-#include <stdlib.h>
-
-typedef struct {
-    int n_state;         /* components of the physical state (GS_NX / 2 with a tangent) */
-    int tangent;         /* 1: components n_state .. 2 n_state - 1 are a tangent vector */
-    int first_kept;      /* stop from which Poincare points and extremes are kept */
-    int lyap_from;       /* log growth of the tangent is summed over stops after this one */
-    const double *range; /* n_state bounds |x_i| <= range[i] (the force law's valid range) */
-    double *poinc;       /* npts x (n_stops - first_kept) x n_state */
-    double *xmin;        /* npts x n_state, over accepted steps and stops in the window */
-    double *xmax;
-    double *lyap;        /* npts x (n_stops - 1 - lyap_from): running exponent */
-} gs_extras;
-
-/* Status of point j (structure of arrays, n points) after a step: bound and valid range on
- * the physical state, finiteness on the rest. */
-static int gs_check_soa(const double *Y, int n, int j, double bound, const gs_extras *m)
-{
-    const int ns = m ? m->n_state : GS_NX;
-    for (int i = 0; i < GS_NX; ++i) {
-        const double y = Y[(long)i * n + j];
-        if (!isfinite(y)) return GS_NOT_FINITE;
-        if (i < ns && fabs(y) > bound) return GS_DIVERGENT;
-        if (i < ns && m && m->range && fabs(y) > m->range[i]) return GS_LEFT_RANGE;
-    }
-    return GS_OK;
-}
-
-static void gs_extremes(const double *Y, int n, int g0, const int *alive, const gs_extras *m)
-{
-    for (int j = 0; j < n; ++j) {
-        if (!alive[j]) continue;
-        double *lo = m->xmin + (long)(g0 + j) * m->n_state;
-        double *hi = m->xmax + (long)(g0 + j) * m->n_state;
-        for (int i = 0; i < m->n_state; ++i) {
-            const double y = Y[(long)i * n + j];
-            if (y < lo[i]) lo[i] = y;
-            if (y > hi[i]) hi[i] = y;
-        }
-    }
-}
-
-/* The group's right-hand side.  iw < 0: in tau, the excitation computed once for the group
- * (gs_rhs_batch).  iw >= 0: in the excitation phase s = omega tau, each point with its own
- * omega = P[iw]: dX/ds = f(s / omega, X) / omega, so points of different forcing frequency
- * share the time grid (frequency sweeps in lockstep). */
-static void gs_rhs_group(int iw, double t, int n, const double *Y, const double *Pg,
-                         const double *Qg, double *K)
-{
-    if (iw < 0) {
-        gs_rhs_batch(t, n, Y, Pg, Qg, K);
-        return;
-    }
-    for (int j = 0; j < n; ++j) {
-        double x[GS_NX], p[GS_NP], q[GS_NQ > 0 ? GS_NQ : 1], dx[GS_NX];
-        for (int i = 0; i < GS_NX; ++i) x[i] = Y[(long)i * n + j];
-        for (int k = 0; k < GS_NP; ++k) p[k] = Pg[(long)k * n + j];
-        for (int k = 0; k < GS_NQ; ++k) q[k] = Qg[(long)k * n + j];
-        const double w = p[iw];
-        gs_rhs(t / w, x, p, q, dx);
-        for (int i = 0; i < GS_NX; ++i) K[(long)i * n + j] = dx[i] / w;
-    }
-}
-
-/* DOP853's dense output over the accepted step [t, t + hh] of a group (SciPy's
- * Dop853DenseOutput): the three extra stages into K rows 13..15, the seven interpolant
- * coefficients into F (7 x S), then y(t + x hh) = Y + a Horner-like sum in x and 1 - x. */
-#define GS_KROWS 16
-static void gs_dense_coefficients(int iw, double t, double hh, int n, const double *Y,
-                                  const double *YN, double *K, double *YT, const double *Pg,
-                                  const double *Qg, double *F)
-{
-    const long S = (long)GS_NX * n;
-    for (int x = 0; x < 3; ++x) {
-        const int row = 13 + x;
-        for (long e = 0; e < S; ++e) {
-            double acc = 0.0;
-            for (int r = 0; r < row; ++r) acc += GS_DOP853_AX[x * GS_KROWS + r] * K[r * S + e];
-            YT[e] = Y[e] + hh * acc;
-        }
-        gs_rhs_group(iw, t + GS_DOP853_CX[x] * hh, n, YT, Pg, Qg, K + row * S);
-    }
-    for (long e = 0; e < S; ++e) {
-        const double dy = YN[e] - Y[e], f0 = K[e], f1 = K[12 * S + e];
-        F[e] = dy;
-        F[S + e] = hh * f0 - dy;
-        F[2 * S + e] = 2.0 * dy - hh * (f1 + f0);
-        for (int i = 0; i < 4; ++i) {
-            double acc = 0.0;
-            for (int r = 0; r < GS_KROWS; ++r) acc += GS_DOP853_D[i * GS_KROWS + r] * K[r * S + e];
-            F[(3 + i) * S + e] = hh * acc;
-        }
-    }
-}
-
-static double gs_dense_value(const double *F, long S, long e, double x, double y0)
-{
-    double y = 0.0;
-    for (int i = 0; i < 7; ++i) {
-        y += F[(6 - i) * S + e];
-        y *= (i % 2 == 0) ? x : 1.0 - x;
-    }
-    return y + y0;
-}
-
-/* Write sample k of the group's points (alive: from V, structure of arrays; else NaN). */
-static void gs_write_sample(double *OUT, int n_out, int g0, int n, int k, const double *V,
-                            const int *alive, int ok)
-{
-    for (int j = 0; j < n; ++j) {
-        double *out = OUT + ((long)(g0 + j) * n_out + k) * GS_NX;
-        for (int i = 0; i < GS_NX; ++i) out[i] = ok && alive[j] ? V[(long)i * n + j] : NAN;
-    }
-}
-
-static int gs_lockstep(int method, int npts, int group, const double *P, const double *X0,
-                       double t0, double period, int first, int n_stops, int spp, int dense,
-                       int iw, double rtol, double atol, double bound, long long max_steps,
-                       double *OUT, long long *NFEV, long long *NSTEP, int *STATUS,
-                       double *TFAIL, const gs_extras *m, const gs_range_t *rg)
-{
-    /* dense: plain sampled DOP853 runs take their natural steps and interpolate the
-     * samples (the 7th-order dense output) instead of shortening steps to land on them */
-    const int use_dense = dense && !m && OUT && method != 0;
-    const gs_tableau *T = method == 0 ? &GS_RK45 : &GS_DOP853;
-    const int ns = T->ns;
-    const double exponent = -1.0 / (T->error_order + 1);
-    if (group < 1) group = 1;
-    const int G = group;
-    const int n_kept = m ? n_stops - m->first_kept : 0;
-    const int n_lyap = m && m->tangent ? n_stops - 1 - m->lyap_from : 0;
-    double *Pg = malloc(sizeof(double) * GS_NP * G), *Qg = malloc(sizeof(double) * GS_NQ * G);
-    double *Y = malloc(sizeof(double) * GS_NX * G), *YT = malloc(sizeof(double) * GS_NX * G);
-    double *YN = malloc(sizeof(double) * GS_NX * G);
-    double *K = malloc(sizeof(double) * GS_KROWS * GS_NX * G);
-    double *F = use_dense ? malloc(sizeof(double) * 7 * GS_NX * G) : 0;
-    int *alive = malloc(sizeof(int) * G), *leave = malloc(sizeof(int) * G);
-    if (rg && rg->exit)
-        for (long k = 0; k < 3L * npts; ++k) rg->exit[k] = NAN;
-    double *E5s = malloc(sizeof(double) * G), *E3s = malloc(sizeof(double) * G);
-    double *growth = malloc(sizeof(double) * G);
-    if (!Pg || !Qg || !Y || !YT || !YN || !K || !alive || !leave || !E5s || !E3s || !growth ||
-        (use_dense && !F))
-        return -1;
-    for (int g0 = 0; g0 < npts; g0 += G) {
-        const int n = npts - g0 < G ? npts - g0 : G;
-        long long nfev = 0, nsteps = 0;
-        double h_abs = INFINITY, t = t0;
-        const double t_end = t0 + ((double)(first + n_stops - 1) / spp) * period;
-        for (int j = 0; j < n; ++j) {
-            const double *p = P + (long)(g0 + j) * GS_NP;
-            const double *x0 = X0 + (long)(g0 + j) * GS_NX;
-            double q[GS_NQ], f[GS_NX];
-            gs_prep(p, q);
-            for (int k = 0; k < GS_NP; ++k) Pg[k * n + j] = p[k];
-            for (int k = 0; k < GS_NQ; ++k) Qg[k * n + j] = q[k];
-            for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = x0[i];
-            gs_rhs(t0, x0, p, q, f);
-            alive[j] = 1;
-            leave[j] = 0;
-            growth[j] = 0.0;
-            STATUS[g0 + j] = GS_OK;
-            TFAIL[g0 + j] = NAN;
-            if (m) {
-                for (int i = 0; i < m->n_state; ++i) {
-                    m->xmin[(long)(g0 + j) * m->n_state + i] = INFINITY;
-                    m->xmax[(long)(g0 + j) * m->n_state + i] = -INFINITY;
-                }
-            }
-            int c = gs_check_soa(Y, n, j, bound, m);
-            if (c == GS_OK) c = gs_check(f, INFINITY);
-            if (c != GS_OK) {
-                alive[j] = 0;
-                STATUS[g0 + j] = c;
-                TFAIL[g0 + j] = t0;
-                for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = 0.0;
-                continue;
-            }
-            /* in the phase (iw >= 0) a small first step; the control adapts it at once */
-            const double h0 = iw >= 0 ? 1e-3 * period
-                                      : gs_initial_step(t0, x0, f, t_end - t0, T->error_order,
-                                                        rtol, atol, p, q, &nfev);
-            if (h0 < h_abs) h_abs = h0;
-        }
-        if (!isfinite(h_abs)) h_abs = 1e-6 * period;
-        nfev = nfev / (n > 0 ? n : 1) + 1;
-        gs_rhs_group(iw, t0, n, Y, Pg, Qg, K); /* K[0] = f(t0, y0) */
-        int group_status = GS_OK;
-        int next_out = 0; /* dense: the next sample to write */
-        const double t_last = t0 + (double)(first + n_stops - 1) * period / (double)spp;
-        if (use_dense) {
-            while (next_out < n_stops &&
-                   t0 + (double)(first + next_out) * period / (double)spp <= t)
-                gs_write_sample(OUT, n_stops, g0, n, next_out++, Y, alive, 1);
-        }
-        for (int ko = 0; ko < (use_dense ? 1 : n_stops); ++ko) {
-            const double target =
-                use_dense ? t_last : t0 + (double)(first + ko) * period / (double)spp;
-            const int in_window = m && ko > m->first_kept;
-            while (t < target && group_status == GS_OK) {
-                const double min_step = 10.0 * fabs(nextafter(t, INFINITY) - t);
-                double h = h_abs < min_step ? min_step : h_abs;
-                int rejected = 0;
-                const int step_first = next_out; /* dense: samples written by this step */
-                for (;;) {
-                    if (h < min_step) {
-                        group_status = GS_STEP_TOO_SMALL;
-                        break;
-                    }
-                    double t_new = t + h;
-                    int clipped = 0;
-                    if (t_new >= target) {
-                        t_new = target;
-                        clipped = 1;
-                    }
-                    const double hh = t_new - t;
-                    const long S = (long)GS_NX * n;
-                    for (int s = 1; s < ns; ++s) {
-                        for (long e = 0; e < S; ++e) {
-                            double acc = 0.0;
-                            for (int r = 0; r < s; ++r) acc += T->A[s * ns + r] * K[r * S + e];
-                            YT[e] = Y[e] + hh * acc;
-                        }
-                        gs_rhs_group(iw, t + T->C[s] * hh, n, YT, Pg, Qg, K + s * S);
-                    }
-                    for (long e = 0; e < S; ++e) {
-                        double acc = 0.0;
-                        for (int r = 0; r < ns; ++r) acc += T->B[r] * K[r * S + e];
-                        YN[e] = Y[e] + hh * acc;
-                    }
-                    gs_rhs_group(iw, t + hh, n, YN, Pg, Qg, K + ns * S);
-                    nfev += ns;
-                    /* per-point error norms, structure-of-arrays */
-                    for (int j = 0; j < n; ++j) E5s[j] = E3s[j] = 0.0;
-                    for (int i = 0; i < GS_NX; ++i) {
-                        const double *y0 = Y + (long)i * n, *y1 = YN + (long)i * n;
-                        for (int j = 0; j < n; ++j) {
-                            double a5 = 0.0, a3 = 0.0;
-                            const long e = (long)i * n + j;
-                            if (T->E) {
-                                for (int r = 0; r <= ns; ++r) a5 += T->E[r] * K[r * S + e];
-                                a5 *= hh;
-                            } else {
-                                for (int r = 0; r <= ns; ++r) {
-                                    a5 += T->E5[r] * K[r * S + e];
-                                    a3 += T->E3[r] * K[r * S + e];
-                                }
-                            }
-                            const double a = fabs(y0[j]), b = fabs(y1[j]);
-                            const double sc = atol + (a > b ? a : b) * rtol;
-                            a5 /= sc;
-                            a3 /= sc;
-                            E5s[j] += a5 * a5;
-                            E3s[j] += a3 * a3;
-                        }
-                    }
-                    double err = 0.0;
-                    for (int j = 0; j < n; ++j) {
-                        if (!alive[j]) continue;
-                        double ej;
-                        if (T->E) {
-                            ej = sqrt(E5s[j] / GS_NX);
-                        } else {
-                            ej = (E5s[j] == 0.0 && E3s[j] == 0.0)
-                                     ? 0.0
-                                     : fabs(hh) * E5s[j] / sqrt((E5s[j] + 0.01 * E3s[j]) * GS_NX);
-                        }
-                        if (!isfinite(ej)) {
-                            /* a non-finite point leaves the group instead of stalling it */
-                            alive[j] = 0;
-                            STATUS[g0 + j] = GS_NOT_FINITE;
-                            TFAIL[g0 + j] = t;
-                            for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = 0.0;
-                            continue;
-                        }
-                        if (ej > err) err = ej;
-                    }
-                    if (err < 1.0) {
-                        double factor = err == 0.0 ? 10.0 : 0.9 * pow(err, exponent);
-                        if (factor > 10.0) factor = 10.0;
-                        if (rejected && factor > 1.0) factor = 1.0;
-                        const double next = hh * factor;
-                        h_abs = clipped && !rejected && h > next ? h : next;
-                        if (use_dense) {
-                            int have_f = 0;
-                            for (;;) {
-                                if (next_out >= n_stops) break;
-                                const double ts =
-                                    t0 + (double)(first + next_out) * period / (double)spp;
-                                if (ts > t_new) break;
-                                if (ts == t_new) {
-                                    gs_write_sample(OUT, n_stops, g0, n, next_out++, YN, alive, 1);
-                                    continue;
-                                }
-                                if (!have_f) {
-                                    gs_dense_coefficients(iw, t, hh, n, Y, YN, K, YT, Pg, Qg,
-                                                          F);
-                                    nfev += 3;
-                                    have_f = 1;
-                                }
-                                const double x = (ts - t) / hh;
-                                for (int j = 0; j < n; ++j) {
-                                    double *out = OUT + ((long)(g0 + j) * n_stops + next_out) * GS_NX;
-                                    for (int i = 0; i < GS_NX; ++i) {
-                                        const long e = (long)i * n + j;
-                                        out[i] = alive[j] ? gs_dense_value(F, S, e, x, Y[e]) : NAN;
-                                    }
-                                }
-                                next_out++;
-                            }
-                        }
-                        if (rg && rg->range) {
-                            /* the valid range on the step, from its ends and slopes (the
-                             * excitation phase's time s = omega tau: Python converts) */
-                            for (int j = 0; j < n; ++j)
-                                if (alive[j])
-                                    leave[j] = gs_range_step(rg, g0 + j, t, hh, Y + j, YN + j,
-                                                             K + j, K + ns * S + j, n);
-                        }
-                        t = t_new;
-                        memcpy(Y, YN, sizeof(double) * S);
-                        memcpy(K, K + ns * S, sizeof(double) * S); /* FSAL */
-                        break;
-                    }
-                    double factor = 0.9 * pow(err, exponent);
-                    if (!(factor > 0.2)) factor = 0.2;
-                    h = hh * factor;
-                    rejected = 1;
-                }
-                nsteps += 1;
-                if (nsteps >= max_steps && group_status == GS_OK) group_status = GS_TOO_MANY_STEPS;
-                int dead = 0;
-                for (int j = 0; j < n; ++j) {
-                    if (!alive[j]) continue;
-                    int c = gs_check_soa(Y, n, j, bound, m);
-                    if (c == GS_OK && leave[j]) c = GS_LEFT_RANGE;
-                    if (c != GS_OK) {
-                        alive[j] = 0;
-                        STATUS[g0 + j] = c;
-                        TFAIL[g0 + j] = leave[j] ? rg->exit[3 * (long)(g0 + j)] : t;
-                        for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = 0.0;
-                        dead = 1;
-                        /* as without dense output: no samples from the failing step */
-                        for (int k = step_first; use_dense && k < next_out; ++k)
-                            for (int i = 0; i < GS_NX; ++i)
-                                OUT[((long)(g0 + j) * n_stops + k) * GS_NX + i] = NAN;
-                    }
-                }
-                if (dead) gs_rhs_group(iw, t, n, Y, Pg, Qg, K); /* refresh FSAL stage */
-                if (in_window) gs_extremes(Y, n, g0, alive, m);
-            }
-            const int group_ok = group_status == GS_OK;
-            if (use_dense) {
-                /* a failed group leaves the samples it did not reach undefined */
-                while (next_out < n_stops)
-                    gs_write_sample(OUT, n_stops, g0, n, next_out++, Y, alive, 0);
-                continue;
-            }
-            if (OUT) gs_write_sample(OUT, n_stops, g0, n, ko, Y, alive, group_ok);
-            if (!m) continue;
-            if (ko >= m->first_kept) {
-                if (ko == m->first_kept) gs_extremes(Y, n, g0, alive, m);
-                for (int j = 0; j < n; ++j) {
-                    double *out = m->poinc + ((long)(g0 + j) * n_kept + ko - m->first_kept) *
-                                                 m->n_state;
-                    const int ok = alive[j] && group_ok;
-                    for (int i = 0; i < m->n_state; ++i) out[i] = ok ? Y[i * n + j] : NAN;
-                }
-            }
-            if (m->tangent && group_ok) {
-                /* Benettin: renormalise the tangent vector every stop, sum log |w| after
-                 * lyap_from; the FSAL stage changes with the rescaling. */
-                for (int j = 0; j < n; ++j) {
-                    if (!alive[j]) continue;
-                    double g = 0.0;
-                    for (int i = m->n_state; i < GS_NX; ++i) g += Y[(long)i * n + j] * Y[(long)i * n + j];
-                    g = sqrt(g);
-                    if (!(g > 0.0) || !isfinite(g)) {
-                        alive[j] = 0;
-                        STATUS[g0 + j] = GS_NOT_FINITE;
-                        TFAIL[g0 + j] = t;
-                        for (int i = 0; i < GS_NX; ++i) Y[i * n + j] = 0.0;
-                        continue;
-                    }
-                    for (int i = m->n_state; i < GS_NX; ++i) Y[(long)i * n + j] /= g;
-                    if (ko > m->lyap_from) {
-                        growth[j] += log(g);
-                        m->lyap[(long)(g0 + j) * n_lyap + ko - m->lyap_from - 1] =
-                            growth[j] / ((double)(ko - m->lyap_from) * period / spp);
-                    }
-                }
-                gs_rhs_group(iw, t, n, Y, Pg, Qg, K);
-                nfev += 1;
-            }
-        }
-        for (int j = 0; j < n; ++j) {
-            NFEV[g0 + j] = nfev;
-            NSTEP[g0 + j] = nsteps;
-            if (STATUS[g0 + j] == GS_OK && group_status != GS_OK) {
-                STATUS[g0 + j] = group_status;
-                TFAIL[g0 + j] = t;
-            }
-            if (m && m->tangent && STATUS[g0 + j] != GS_OK)
-                for (int k = 0; k < n_lyap; ++k) m->lyap[(long)(g0 + j) * n_lyap + k] = NAN;
-        }
-    }
-    free(Pg); free(Qg); free(Y); free(YT); free(YN); free(K); free(alive); free(leave);
-    free(E5s); free(E3s); free(growth); free(F);
-    return 0;
-}
-
-/* Sampled runs: OUT npts x (n_sample spp + 1) x GS_NX at t0 + (n_transient + k / spp) T. */
-int gs_run_lockstep(int method, int npts, int group, const double *P, const double *X0,
-                    double t0, double period, int n_transient, int n_sample, int spp, int dense,
-                    double rtol, double atol, double bound, long long max_steps, double *OUT,
-                    long long *NFEV, long long *NSTEP, int *STATUS, double *TFAIL,
-                    const double *RANGE, int stop_exit, double *EXIT)
-{
-    const gs_range_t rg = {RANGE, stop_exit, EXIT};
-    return gs_lockstep(method, npts, group, P, X0, t0, period, n_transient * spp,
-                       n_sample * spp + 1, spp, dense, -1, rtol, atol, bound, max_steps, OUT,
-                       NFEV, NSTEP, STATUS, TFAIL, 0, &rg);
-}
-
-/* Sampled runs in the excitation phase s = omega tau (period 2 pi for every point): each
- * point its own forcing frequency P[iw], all in lockstep.  OUT as gs_run_lockstep's, at
- * s = s0 + 2 pi (n_transient + k / spp). */
-int gs_run_phase(int method, int npts, int group, const double *P, const double *X0, double s0,
-                 int iw, int n_transient, int n_sample, int spp, int dense, double rtol,
-                 double atol, double bound, long long max_steps, double *OUT, long long *NFEV,
-                 long long *NSTEP, int *STATUS, double *TFAIL, const double *RANGE,
-                 int stop_exit, double *EXIT)
-{
-    if (iw < 0 || iw >= GS_NP) return -2;
-    for (int j = 0; j < npts; ++j)
-        if (!(P[(long)j * GS_NP + iw] > 0.0)) return -3;
-    const gs_range_t rg = {RANGE, stop_exit, EXIT};
-    return gs_lockstep(method, npts, group, P, X0, s0, 2.0 * M_PI, n_transient * spp,
-                       n_sample * spp + 1, spp, dense, iw, rtol, atol, bound, max_steps, OUT,
-                       NFEV, NSTEP, STATUS, TFAIL, 0, &rg);
-}
-
-/* Maps: stops at every period t0 + k T, k = 0 .. n_transient + n_sample.  Keeps the
- * Poincare points of the last n_sample + 1 stops (POINC), the extremes of the physical
- * state over the sampled window at every accepted step (XMIN, XMAX), the valid range
- * (RANGE, or NULL) as a status, and with tangent = 1 (the variational library: X0 holds
- * x and a tangent vector) the running largest Lyapunov exponent over the last n_lyap
- * periods (LYAP npts x n_lyap). */
-int gs_map_lockstep(int method, int npts, int group, const double *P, const double *X0,
-                    double t0, double period, int n_transient, int n_sample, int tangent,
-                    int n_lyap, const double *RANGE, double rtol, double atol, double bound,
-                    long long max_steps, double *POINC, double *XMIN, double *XMAX,
-                    double *LYAP, long long *NFEV, long long *NSTEP, int *STATUS, double *TFAIL)
-{
-    const int n_stops = n_transient + n_sample + 1;
-    if (tangent && (n_lyap < 1 || n_lyap > n_stops - 1)) return -2;
-    gs_extras m = {tangent ? GS_NX / 2 : GS_NX, tangent, n_transient,
-                   tangent ? n_stops - 1 - n_lyap : 0, RANGE, POINC, XMIN, XMAX, LYAP};
-    return gs_lockstep(method, npts, group, P, X0, t0, period, 0, n_stops, 1, 0, -1, rtol, atol,
-                       bound, max_steps, 0, NFEV, NSTEP, STATUS, TFAIL, &m, 0);
-}
-
 /* One right-hand-side evaluation (tests compare it with the NumPy code). */
 void gs_eval(double tau, const double *x, const double *p, double *dx)
 {
-    double q[GS_NQ];
+    double q[GS_NQ > 0 ? GS_NQ : 1];
     gs_prep(p, q);
     gs_rhs(tau, x, p, q, dx);
 }
@@ -846,8 +841,8 @@ void gs_eval(double tau, const double *x, const double *p, double *dx)
 /* The batched form on n points (structure of arrays; tests compare it too). */
 void gs_eval_batch(double tau, int n, const double *X, const double *P, double *DX)
 {
-    double *Q = malloc(sizeof(double) * GS_NQ * (n > 0 ? n : 1));
-    double p[GS_NP], q[GS_NQ];
+    double *Q = malloc(sizeof(double) * (GS_NQ > 0 ? GS_NQ : 1) * (n > 0 ? n : 1));
+    double p[GS_NP], q[GS_NQ > 0 ? GS_NQ : 1];
     if (!Q) return;
     for (int j = 0; j < n; ++j) {
         for (int k = 0; k < GS_NP; ++k) p[k] = P[k * n + j];
@@ -857,50 +852,3 @@ void gs_eval_batch(double tau, int n, const double *X, const double *P, double *
     gs_rhs_batch(tau, n, X, P, Q, DX);
     free(Q);
 }
-
-#ifdef GS_VARIATIONAL
-/* Benettin's largest Lyapunov exponent: the state x (first half) and a tangent vector w
- * (second half) integrated together period by period; w renormalised after each period and
- * log |w| accumulated.  running[k] = estimate after k + 1 periods.  Returns a GS_ status. */
-int gs_benettin(const double *p, const double *z0, double t0, double period, int periods,
-                double rtol, double atol, double bound, long long max_steps, double *running,
-                long long *NFEV)
-{
-    const int n = GS_NX / 2;
-    double q[GS_NQ], z[GS_NX], f[GS_NX];
-    long long nfev = 0, nsteps = 0;
-    gs_prep(p, q);
-    memcpy(z, z0, sizeof(double) * GS_NX);
-    double t = t0, total = 0.0;
-    gs_rhs(t, z, p, q, f);
-    nfev += 1;
-    if (gs_check(z, bound) != GS_OK || gs_check(f, INFINITY) != GS_OK) {
-        *NFEV = nfev;
-        return GS_NOT_FINITE;
-    }
-    double h_abs = gs_initial_step(t, z, f, period, 7, rtol, atol, p, q, &nfev);
-    for (int k = 0; k < periods; ++k) {
-        const int status = gs_adaptive_to(&GS_DOP853, &t, z, f, &h_abs, t0 + (k + 1) * period,
-                                          rtol, atol, p, q, bound, max_steps, &nfev, &nsteps,
-                                          0, 0);
-        if (status != GS_OK) {
-            *NFEV = nfev;
-            return status;
-        }
-        double g = 0.0;
-        for (int i = n; i < GS_NX; ++i) g += z[i] * z[i];
-        g = sqrt(g);
-        if (!(g > 0.0) || !isfinite(g)) {
-            *NFEV = nfev;
-            return GS_NOT_FINITE;
-        }
-        total += log(g);
-        for (int i = n; i < GS_NX; ++i) z[i] /= g;
-        gs_rhs(t, z, p, q, f); /* the tangent part of f changed with the rescaling */
-        nfev += 1;
-        running[k] = total / ((k + 1) * period);
-    }
-    *NFEV = nfev;
-    return GS_OK;
-}
-#endif

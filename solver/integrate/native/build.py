@@ -27,7 +27,8 @@ from pathlib import Path
 import numpy as np
 
 from ...cache import cache_root
-from ..tableau import c_tables
+from ..tableau import RK4, c_tables
+from . import abi
 
 __all__ = ["NativeUnavailable", "cache_dir", "compiler", "library", "source"]
 
@@ -42,13 +43,6 @@ _FLAGS = (
 _loaded: dict[str, ctypes.CDLL] = {}
 _paths: dict[tuple, Path] = {}  # (module file, inputs hash, variational, compiler) -> library
 _failed: dict[str, str] = {}  # cache key -> why it could not be built (once per session)
-
-
-class NativeFallback(UserWarning):
-    """A run goes without the compiled library (no compiler, or a build that failed).
-
-    Worker processes ignore it (``sweep/executor.py``): the parent process decides once
-    and says it once (``maps.map_backend``, ``sweep._decide_native``)."""
 
 
 class NativeUnavailable(RuntimeError):
@@ -89,9 +83,21 @@ def cache_dir() -> Path:
     return cache_root() / "native"
 
 
+def _rk4_tables() -> str:
+    """The RK4 record of ``tableau.py`` as C arrays (the format of ``c_tables``)."""
+
+    def arr(name, values):
+        flat = np.asarray(values, dtype=float).ravel()
+        return (
+            f"static const double {name}[{flat.size}] = {{{', '.join(map(repr, flat.tolist()))}}};"
+        )
+
+    return "\n".join([arr("GS_RK4_A", RK4.A), arr("GS_RK4_B", RK4.b), arr("GS_RK4_C", RK4.c)])
+
+
 def source(module, variational: bool = False) -> str:
     """Full C text of the library for a generated module (``variational``: the state
-    extended by a tangent vector, with ``gs_benettin``)."""
+    extended by a tangent vector, for the Lyapunov exponent)."""
     attr = "C_SOURCE_VARIATIONAL" if variational else "C_SOURCE"
     if not hasattr(module, attr):
         raise NativeUnavailable(
@@ -99,7 +105,9 @@ def source(module, variational: bool = False) -> str:
         )
     body = (Path(__file__).with_name("_native.c")).read_text(encoding="utf-8")
     head = ["#define GS_VARIATIONAL 1"] if variational else []
-    return "\n".join([*head, "#include <math.h>", getattr(module, attr), c_tables(), body])
+    return "\n".join(
+        [*head, "#include <math.h>", getattr(module, attr), c_tables(), _rk4_tables(), body]
+    )
 
 
 def _key_text(module, variational: bool) -> str:
@@ -111,8 +119,8 @@ def _key_text(module, variational: bool) -> str:
     if not hasattr(module, attr):
         source(module, variational)  # raises NativeUnavailable with the reason
     engine = (Path(__file__).with_name("_native.c")).read_text(encoding="utf-8")
-    return "\n".join([f"variational={variational}", getattr(module, attr), engine,
-                      f"scipy {version('scipy')}"])  # fmt: skip
+    tables = [f"scipy {version('scipy')}", _rk4_tables()]
+    return "\n".join([f"variational={variational}", getattr(module, attr), engine, *tables])
 
 
 @functools.lru_cache(maxsize=8)
@@ -175,19 +183,36 @@ def _verified(path: Path) -> bool:
         return False
 
 
-def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
+def _shared_flags(module, shared) -> list[str]:
+    """``-DGS_SHARED_<k>=1`` for each parameter index ``k`` equal across a batch."""
+    n_p = len(module.CONTRACT["parameters"]) if hasattr(module, "CONTRACT") else None
+    ks = sorted({int(k) for k in shared})
+    if ks and (ks[0] < 0 or (n_p is not None and ks[-1] >= n_p)):
+        raise ValueError(f"shared parameter indices {ks} must lie in [0, {n_p})")
+    return [f"-DGS_SHARED_{k}=1" for k in ks]
+
+
+def library(module, variational: bool = False, shared=()) -> tuple[ctypes.CDLL, dict]:
     """Compile (or load from the cache) the native library of ``module``.
 
+    ``shared``: indices of the parameters equal across the whole batch, compiled in as
+    ``-DGS_SHARED_<k>=1`` so that the generated C may hoist what depends only on them (and
+    tau) out of the point loop; the default (none) is the library for any batch.
     Returns the library and facts: ``path``, ``compiled`` (bool: built now), ``seconds``.
-    Raises :class:`NativeUnavailable` without a working compiler.
+    Raises :class:`NativeUnavailable` without a working compiler, or when the library's
+    job layout differs from ``abi.py``'s.
     """
     cc = compiler()
     if cc is None:
         raise NativeUnavailable(_no_compiler())
+    # only a model whose C reads GS_SHARED_<k> gets them (else one library serves all)
+    text = getattr(module, "C_SOURCE_VARIATIONAL" if variational else "C_SOURCE", "")
+    defines = _shared_flags(module, shared) if "GS_SHARED_" in text else []
     memo = (
         getattr(module, "__file__", module.NAME),
         getattr(module, "INPUTS_SHA256", ""),
         variational,
+        tuple(defines),
         cc,
         str(cache_dir()),
     )
@@ -200,7 +225,9 @@ def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
     # tableaux are SciPy's coefficient arrays, so SciPy's version stands for them (and
     # SciPy itself is not imported for a library that is already compiled).
     key = hashlib.sha256(
-        "\n".join([_key_text(module, variational), _compiler_id(cc), " ".join(_FLAGS)]).encode()
+        "\n".join(
+            [_key_text(module, variational), _compiler_id(cc), " ".join([*_FLAGS, *defines])]
+        ).encode()
     ).hexdigest()[:20]
     if key in _failed:
         raise NativeUnavailable(_failed[key])
@@ -226,7 +253,7 @@ def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
             so = Path(tmp) / "lib.so"
             try:
                 done = subprocess.run(
-                    [cc, *_FLAGS, "-o", str(so), str(c_file), "-lm"],
+                    [cc, *_FLAGS, *defines, "-o", str(so), str(c_file), "-lm"],
                     capture_output=True,
                     text=True,
                     timeout=300,
@@ -252,66 +279,10 @@ def library(module, variational: bool = False) -> tuple[ctypes.CDLL, dict]:
         path.unlink(missing_ok=True)
         _failed[key] = f"the compiled library {path} could not be loaded ({err})"
         raise NativeUnavailable(_failed[key]) from None
-    d, i, ll = ctypes.c_double, ctypes.c_int, ctypes.c_longlong
-    ptr = np.ctypeslib.ndpointer
-    lib.gs_run.restype = i
-    lib.gs_run.argtypes = [
-        i, i,
-        ptr(np.float64, flags="C"), ptr(np.float64, flags="C"),
-        d, d, i, i, i, d, d, i, d, ll,
-        ptr(np.float64, flags="C"), ptr(np.int64, flags="C"), ptr(np.int64, flags="C"),
-        ptr(np.int32, flags="C"), ptr(np.float64, flags="C"),
-        ptr(np.float64, flags="C"), i, ptr(np.float64, flags="C"),
-    ]  # fmt: skip
-    lib.gs_run_lockstep.restype = i
-    lib.gs_run_lockstep.argtypes = [
-        i, i, i,
-        ptr(np.float64, flags="C"), ptr(np.float64, flags="C"),
-        d, d, i, i, i, i, d, d, d, ll,
-        ptr(np.float64, flags="C"), ptr(np.int64, flags="C"), ptr(np.int64, flags="C"),
-        ptr(np.int32, flags="C"), ptr(np.float64, flags="C"),
-        ptr(np.float64, flags="C"), i, ptr(np.float64, flags="C"),
-    ]  # fmt: skip
-    lib.gs_run_phase.restype = i
-    lib.gs_run_phase.argtypes = [
-        i, i, i,
-        ptr(np.float64, flags="C"), ptr(np.float64, flags="C"),
-        d, i, i, i, i, i, d, d, d, ll,
-        ptr(np.float64, flags="C"), ptr(np.int64, flags="C"), ptr(np.int64, flags="C"),
-        ptr(np.int32, flags="C"), ptr(np.float64, flags="C"),
-        ptr(np.float64, flags="C"), i, ptr(np.float64, flags="C"),
-    ]  # fmt: skip
-    lib.gs_map_lockstep.restype = i
-    lib.gs_map_lockstep.argtypes = [
-        i, i, i,
-        ptr(np.float64, flags="C"), ptr(np.float64, flags="C"),
-        d, d, i, i, i, i, ctypes.c_void_p, d, d, d, ll,
-        ptr(np.float64, flags="C"), ptr(np.float64, flags="C"), ptr(np.float64, flags="C"),
-        ctypes.c_void_p, ptr(np.int64, flags="C"), ptr(np.int64, flags="C"),
-        ptr(np.int32, flags="C"), ptr(np.float64, flags="C"),
-    ]  # fmt: skip
-    lib.gs_eval.restype = None
-    lib.gs_eval.argtypes = [
-        d,
-        ptr(np.float64, flags="C"),
-        ptr(np.float64, flags="C"),
-        ptr(np.float64, flags="C"),
-    ]
-    lib.gs_eval_batch.restype = None
-    lib.gs_eval_batch.argtypes = [
-        d,
-        i,
-        ptr(np.float64, flags="C"),
-        ptr(np.float64, flags="C"),
-        ptr(np.float64, flags="C"),
-    ]
-    lib.gs_rhs_loop.restype = d
-    lib.gs_rhs_loop.argtypes = [ptr(np.float64, flags="C"), ptr(np.float64, flags="C"), ll, d]
-    if variational:
-        lib.gs_benettin.restype = i
-        lib.gs_benettin.argtypes = [
-            ptr(np.float64, flags="C"), ptr(np.float64, flags="C"), d, d, i, d, d, d, ll,
-            ptr(np.float64, flags="C"), ptr(np.int64, flags="C"),
-        ]  # fmt: skip
+    try:
+        abi.bind(lib, str(path))
+    except abi.LayoutMismatch as err:
+        _failed[key] = str(err)
+        raise NativeUnavailable(_failed[key]) from None
     _loaded[str(path)] = lib
     return lib, facts

@@ -1,0 +1,247 @@
+"""The front door of batched runs: ``integrate(target, x0, spec) -> RunResult``.
+
+One point (a :class:`~..system.System`) or many (a :class:`Batch`: one generated model,
+a parameter matrix) are integrated as one :class:`~.spec.RunSpec` says, by the compiled
+engine (``native/``) or, without a compiler, by its one NumPy/SciPy fallback
+(``native/fallback.py``). Which one runs is decided once, in the calling process, with one
+warning line; ``workers > 1`` splits the points over as many processes through the one
+executor (``solver/executor.py``), each task a frozen, picklable :class:`_Task`.
+
+Inputs are checked here once (shapes, finite values, the forcing frequency); the options
+were checked by the spec's constructor, so nothing below checks them again.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import ModuleType
+
+import numpy as np
+
+from ..contract import Contract, load_generated
+from ..system import System
+from .spec import RunResult, RunSpec
+
+__all__ = ["BACKENDS", "Batch", "decide_backend", "integrate"]
+
+BACKENDS = ("auto", "native", "numpy")
+
+
+@dataclass(frozen=True, eq=False)
+class Batch:
+    """Many parameter points of one generated model, picklable for worker processes.
+
+    Attributes
+    ----------
+    source : str
+        Path of the generated module's file.
+    digest : str
+        sha256 of the file's bytes as this process read them; a worker loads exactly
+        those bytes (``contract.load_generated``) or refuses.
+    P : ndarray, shape (N, P)
+        Parameter vectors in the module's order (``module.parameters(...)``).
+    """
+
+    source: str
+    digest: str
+    P: np.ndarray
+    _module: ModuleType | None = field(default=None, repr=False)
+
+    @classmethod
+    def of(cls, module: ModuleType, P) -> Batch:
+        """The batch of ``module`` (a generated module) at the rows of ``P``, shape (N, P)."""
+        source = str(module.__file__)
+        digest = hashlib.sha256(Path(source).read_bytes()).hexdigest()
+        P = np.ascontiguousarray(np.atleast_2d(np.asarray(P, dtype=float)))
+        return cls(source, digest, P, module)
+
+    @property
+    def module(self) -> ModuleType:
+        """The generated module (loaded from the verified bytes in a worker)."""
+        if self._module is None:
+            data = Path(self.source).read_bytes()
+            if hashlib.sha256(data).hexdigest() != self.digest:
+                raise ValueError(f"{self.source} changed while a run was under way; run it again")
+            object.__setattr__(self, "_module", load_generated(self.source, source=data))
+        return self._module
+
+    def __getitem__(self, rows) -> Batch:
+        return Batch(self.source, self.digest, self.P[rows], self._module)
+
+    def __getstate__(self) -> dict:
+        # the module does not pickle: a worker loads it again from the verified file
+        return {"source": self.source, "digest": self.digest, "P": self.P, "_module": None}
+
+
+@dataclass(frozen=True, eq=False)
+class _Task:
+    """One worker's share: a slice of the batch, its initial states, the spec and the
+    backend the parent decided."""
+
+    batch: Batch
+    X0: np.ndarray
+    spec: RunSpec
+    backend: str
+
+
+def decide_backend(module: ModuleType, spec: RunSpec, backend: str = "auto") -> str:
+    """``"native"`` when the compiled library of ``module`` builds or is cached (with the
+    variational system when the spec collects the exponent), else ``"numpy"`` after the
+    one warning line (``backend="auto"``); ``"native"`` raises
+    :class:`~.native.build.NativeUnavailable` instead, ``"numpy"`` is taken as given."""
+    from .native.build import NativeUnavailable, library
+    from .native.fallback import fallback_warning
+
+    if backend not in BACKENDS:
+        raise ValueError(f"backend {backend!r} is unknown; backends: {', '.join(BACKENDS)}")
+    if backend == "numpy":
+        return backend
+    try:
+        library(module, variational="exponent" in spec.collect)
+    except NativeUnavailable as err:
+        if backend == "native":
+            raise
+        fallback_warning(err)
+        return "numpy"
+    return "native"
+
+
+def integrate(
+    target: System | Batch,
+    x0,
+    spec: RunSpec,
+    *,
+    backend: str = "auto",
+    workers: int = 1,
+) -> RunResult:
+    """Integrate one point or a batch of points as ``spec`` says.
+
+    Parameters
+    ----------
+    target : System or Batch
+        One parameter point (``N = 1``) or ``N`` points of one model.
+    x0 : array_like, shape (n,) or (N, n)
+        Initial states (one for every point, or one per point).
+    spec : RunSpec
+        The run's options, checked by its constructor.
+    backend : {"auto", "native", "numpy"}
+        The compiled engine, its fallback, or ``auto``: native when it builds (decided
+        here once, one warning line otherwise).
+    workers : int
+        Processes to split the points over (``1``: this process).
+
+    Returns
+    -------
+    RunResult
+        Per point (in the order of ``target``'s rows): samples, extremes, exponent, work,
+        status; ``label`` says which engine and method ran.
+    """
+    if not isinstance(spec, RunSpec):
+        raise TypeError(f"spec must be a RunSpec, got {type(spec).__name__}")
+    if isinstance(target, System):
+        module, P, batch = target.module, target.p[None, :], None
+    elif isinstance(target, Batch):
+        module, P, batch = target.module, target.P, target
+    else:
+        raise TypeError(f"target must be a System or a Batch, got {type(target).__name__}")
+    if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1:
+        raise ValueError(f"workers must be a whole number >= 1, got {workers!r}")
+    P = np.ascontiguousarray(np.asarray(P, dtype=float))
+    X0 = _check_inputs(Contract.of(module), P, x0, spec)
+    started = time.perf_counter()
+    backend = decide_backend(module, spec, backend)
+    N = P.shape[0]
+    if workers > 1 and N > 1:
+        from ..executor import map_tasks
+
+        batch = batch or Batch.of(module, P)
+        chunks = [c for c in np.array_split(np.arange(N), workers) if c.size]
+        tasks = [_Task(batch[c], X0[c], spec, backend) for c in chunks]
+        parts = map_tasks(_run_task, tasks, executor="processes", workers=len(chunks))
+        return _join(parts, time.perf_counter() - started)
+    return _run(module, P, X0, spec, backend)
+
+
+def _check_inputs(contract: Contract, P: np.ndarray, x0, spec: RunSpec) -> np.ndarray:
+    """``X0`` (N, n) from ``x0``, after checking ``P`` and ``x0`` once."""
+    n, n_p = len(contract.states), len(contract.parameters)
+    if P.ndim != 2 or P.shape[0] < 1 or P.shape[1] != n_p:
+        raise ValueError(f"P must have shape (N, {n_p}) with N >= 1, got {P.shape}")
+    N = P.shape[0]
+    X0 = np.asarray(x0, dtype=float)
+    if X0.shape == (n,):
+        X0 = np.repeat(X0[None, :], N, axis=0)
+    if X0.shape != (N, n):
+        raise ValueError(f"x0 must have shape ({n},) or ({N}, {n}), got {X0.shape}")
+    for name, a in (("P", P), ("x0", X0)):
+        if not np.all(np.isfinite(a)):
+            raise ValueError(
+                f"{name} holds a NaN or infinite value; every parameter and initial "
+                "state must be a finite number"
+            )
+    w_name = contract.forcing_frequency
+    omega = P[:, contract.parameters.index(w_name)]
+    if not np.all(omega > 0):
+        raise ValueError(f"{w_name} (the forcing frequency) must be > 0 at every point")
+    if spec.time == "tau" and np.ptp(omega) != 0.0:
+        raise ValueError(
+            f"{w_name} must be the same for every point in time 'tau'; give time='phase' "
+            "to run several forcing frequencies together"
+        )
+    return np.ascontiguousarray(X0)
+
+
+def _run_task(task: _Task) -> RunResult:
+    return _run(task.batch.module, task.batch.P, task.X0, task.spec, task.backend)
+
+
+def _run(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec, backend: str) -> RunResult:
+    if backend == "numpy":
+        from .native.fallback import run_fallback
+
+        return run_fallback(module, P, X0, spec)
+    return _compiled(module, P, X0, spec)
+
+
+def _compiled(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec) -> RunResult:
+    """The compiled engine (``native/engine.py``), with how points share steps: a
+    piecewise force law (the dead zone) would shrink a whole group's step at each point's
+    kinks, so its sampled runs go point by point and its maps in groups of one; RK4 and a
+    single point always take their own steps."""
+    from .native.engine import run_compiled
+
+    piecewise = Contract.of(module).piecewise
+    if "extremes" in spec.collect or "exponent" in spec.collect:
+        return run_compiled(module, P, X0, spec.with_(group=1) if piecewise else spec)
+    if spec.time == "phase":
+        return run_compiled(module, P, X0, spec)
+    lockstep = spec.lockstep and not piecewise and spec.method != "rk4" and P.shape[0] > 1
+    return run_compiled(module, P, X0, spec.with_(lockstep=lockstep))
+
+
+def _join(parts: list[RunResult], wall_time: float) -> RunResult:
+    """One result from the workers' parts, in task order."""
+
+    def cat(name):
+        first = getattr(parts[0], name)
+        return None if first is None else np.concatenate([getattr(r, name) for r in parts])
+
+    return RunResult(
+        t=parts[0].t,
+        x=cat("x"),
+        nfev=cat("nfev"),
+        nsteps=cat("nsteps"),
+        status=tuple(s for r in parts for s in r.status),
+        t_fail=cat("t_fail"),
+        method=parts[0].method,
+        backend=parts[0].backend,
+        xmin=cat("xmin"),
+        xmax=cat("xmax"),
+        exponent=cat("exponent"),
+        exits=cat("exits"),
+        wall_time=wall_time,
+        compile_seconds=max(r.compile_seconds for r in parts),
+    )

@@ -1,0 +1,102 @@
+"""What a frequency response gives: one :class:`Curve` per method, gathered in a
+:class:`FrequencyResponse` (``frequency.py`` computes them)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..system import System
+
+__all__ = ["Curve", "FrequencyResponse"]
+
+
+@dataclass(frozen=True)
+class Curve:
+    """One method's solution curve: per point the parameter value, stability and, per
+    coordinate, mean, amplitude and RMS; the located events."""
+
+    method: str
+    parameter: str
+    values: np.ndarray
+    stable: np.ndarray
+    stats: dict  # coordinate -> {"mean", "amplitude", "rms", "max", "min",
+    # "dynamic_factor"}: arrays
+    events: tuple = ()  # the Bifurcation records located on the branch (records.py)
+    wall_time: float = 0.0
+    details: dict = field(default_factory=dict)
+    # the state at tau = 0 (mod n T) of each point (harmonic balance, shooting), kept for
+    # checks and restarts; not written to the result files
+    states: tuple = ()
+
+    def records(self) -> list[dict]:
+        out = []
+        for k, v in enumerate(self.values):
+            rec = {"method": self.method, self.parameter: float(v), "stable": bool(self.stable[k])}
+            if "direction" in self.details:
+                rec["direction"] = self.details["direction"]
+            for c, s in self.stats.items():
+                rec[c] = {q: float(s[q][k]) for q in ("mean", "amplitude", "rms")}
+                if "dynamic_factor" in s:
+                    rec[c]["dynamic_factor"] = float(s["dynamic_factor"][k])
+            out.append(rec)
+        return out
+
+
+@dataclass(frozen=True)
+class FrequencyResponse:
+    system: System
+    parameter: str
+    start: float
+    stop: float
+    curves: tuple[Curve, ...]
+
+    def records(self) -> list[dict]:
+        return [r for c in self.curves for r in c.records()]
+
+    def to_dict(self) -> dict:
+        d = self.system.describe()
+        return {
+            "model": d["model"],
+            "model_hash": d["model_hash"],
+            "values": {k: float(v) for k, v in self.system.values.items()},
+            "scales": self.system.scales(),
+            "parameter": self.parameter,
+            "range": [self.start, self.stop],
+            "curves": [
+                {
+                    "method": c.method,
+                    "points": len(c.values),
+                    "wall_time_s": c.wall_time,
+                    "events": [e.to_dict() for e in c.events],
+                    **c.details,
+                }
+                for c in self.curves
+            ],
+            "records": self.records(),
+        }
+
+    def to_table(self) -> tuple[list, list]:
+        coords = self.system.coordinates
+        columns = ["method", self.parameter, "stable"] + [
+            f"{c}_{q}" for c in coords for q in ("mean", "amplitude", "rms", "dynamic_factor")
+        ]
+        rows = []
+        for r in self.records():
+            method = r["method"] + (f" {r['direction']}" if "direction" in r else "")
+            rows.append(
+                [method, r[self.parameter], r["stable"]]
+                + [
+                    r[c].get(q, float("nan"))
+                    for c in coords
+                    for q in ("mean", "amplitude", "rms", "dynamic_factor")
+                ]
+            )
+        return columns, rows
+
+    def save(self, path):
+        """Write to ``path``: ``.json``, ``.csv`` or ``.mat`` (see ``solver/export.py``)."""
+        from ..export import save
+
+        return save(self, path)
