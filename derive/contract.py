@@ -11,10 +11,20 @@ import sympy as sp
 
 from .mesh.backlash import DEAD_ZONE_EDGES
 
-__all__ = ["CONTRACT_FORMAT", "model_contract"]
+__all__ = ["CONTRACT_FORMAT", "FUNCTIONS", "model_contract"]
 
 # Version of the contract's layout; a solver refuses a format it does not read.
 CONTRACT_FORMAT = 1
+# What every emitted module defines (``emit/python.py``): the parameter vector, the
+# right-hand side and its Jacobian, the CasADi builders, each mesh's dynamic and static force.
+FUNCTIONS = (
+    "parameters",
+    "rhs",
+    "jacobian",
+    "casadi_functions",
+    "mesh_force",
+    "static_mesh_force",
+)
 
 
 def model_contract(model) -> dict:
@@ -45,6 +55,9 @@ def model_contract(model) -> dict:
     ``valid_range``
         coordinate -> bound ``a``, the force law holding for ``|u| <= a`` only (a
         polynomial fit of the dead zone); None when valid everywhere.
+    ``functions``
+        The functions the module defines for a solver (:data:`FUNCTIONS`): a solver asks
+        this, not the module's attributes, whether it may compute mesh forces.
     """
     index = {s: k for k, s in enumerate(model.state_symbols)}
     velocities = {}
@@ -81,4 +94,5 @@ def model_contract(model) -> dict:
         "piecewise": bool(pieces),
         "switching_surfaces": surfaces,
         "valid_range": None if valid is None else {c: float(valid) for c in model.coordinates},
+        "functions": FUNCTIONS,
     }

@@ -274,6 +274,7 @@ CONTRACT = {
     'piecewise': False,
     'switching_surfaces': (),
     'valid_range': {'u': 3.0, 'v': 3.0},
+    'functions': ('parameters', 'rhs', 'jacobian', 'casadi_functions', 'mesh_force', 'static_mesh_force'),
 }
 
 # The linear, time-averaged model in physical coordinates, for the modal analysis

@@ -116,6 +116,7 @@ CONTRACT = {
     'piecewise': True,
     'switching_surfaces': ((0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0)),
     'valid_range': None,
+    'functions': ('parameters', 'rhs', 'jacobian', 'casadi_functions', 'mesh_force', 'static_mesh_force'),
 }
 
 # The linear, time-averaged model in physical coordinates, for the modal analysis

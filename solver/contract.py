@@ -44,6 +44,9 @@ class Contract:
         ``(i, c)``: the kink ``x[i] = c``.
     valid_range : dict or None
         coordinate -> bound ``a``: the force law holds for ``|x| <= a`` only.
+    functions : tuple of str
+        The functions the module defines for a solver (``rhs``, ``jacobian``, ...,
+        ``mesh_force``, ``static_mesh_force``); each is checked to be there.
     """
 
     states: tuple[str, ...]
@@ -56,6 +59,7 @@ class Contract:
     piecewise: bool
     switching_surfaces: tuple
     valid_range: dict | None
+    functions: tuple[str, ...] = ("parameters", "rhs", "jacobian", "casadi_functions")
 
     @classmethod
     def of(cls, module: ModuleType) -> Contract:
@@ -95,8 +99,15 @@ class Contract:
             valid_range=None
             if data["valid_range"] is None
             else {k: float(v) for k, v in dict(data["valid_range"]).items()},
+            functions=tuple(str(f) for f in data.get("functions", cls.functions)),
         )
         c._check(name)
+        absent = [f for f in c.functions if not callable(getattr(module, f, None))]
+        if absent:
+            raise ValueError(
+                f"model '{name}': CONTRACT lists {', '.join(absent)}, which the module does "
+                "not define; regenerate it with `gearsym derive`"
+            )
         return c
 
     def _check(self, name: str) -> None:
@@ -131,6 +142,10 @@ class Contract:
             raise ValueError(f"model '{name}': inconsistent CONTRACT ({'; '.join(problems)})")
 
     # -- questions the solver asks ----------------------------------------------------
+    def provides(self, *functions: str) -> bool:
+        """True when the module defines every one of ``functions`` (its contract says so)."""
+        return all(f in self.functions for f in functions)
+
     def index(self, state: str) -> int:
         try:
             return self.states.index(state)

@@ -48,7 +48,7 @@ def dynamic_factor(system: System, tau, x, p) -> dict:
     (nan where the model does not emit its mesh forces or a mesh carries no static load)."""
     mod = system.module
     coords = system.coordinates
-    if not (hasattr(mod, "mesh_force") and hasattr(mod, "static_mesh_force")):
+    if not system.contract.provides("mesh_force", "static_mesh_force"):
         return {c: float("nan") for c in coords}
     F = np.asarray(mod.mesh_force(np.asarray(tau, float), np.asarray(x, float), p))
     F = F.reshape(len(coords), -1)
@@ -66,7 +66,7 @@ def _hb_factors(system, parameter, br, n, samples: int = 512) -> dict:
     coords = system.coordinates
     npts = len(br.points)
     mod = system.module
-    if not npts or not (hasattr(mod, "mesh_force") and hasattr(mod, "static_mesh_force")):
+    if not npts or not system.contract.provides("mesh_force", "static_mesh_force"):
         return {c: np.full(npts, np.nan) for c in coords}
     prob = br.harmonic_balance
     phases = 2 * np.pi * np.arange(samples) / samples

@@ -6,6 +6,7 @@ range), the first-order form of the equations, or the emitted module itself.
 
 import ast
 import importlib
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -27,6 +28,7 @@ KEYS = (
     "piecewise",
     "switching_surfaces",
     "valid_range",
+    "functions",
 )
 
 
@@ -179,3 +181,22 @@ def test_backlash_kinks_are_the_edges_of_its_piecewise_expression(model):
         assert model.kinks == (1.0, -1.0)
     else:
         assert model.kinks == ()
+
+
+def test_the_contract_names_the_functions_the_module_defines(tmp_path):
+    # Reference: emit/python.py writes these six functions into every module; a solver
+    # asks the contract (Contract.provides), and a contract that lists a function the
+    # module lacks is refused in one line.
+    from gearsym.solver.contract import Contract, load_generated
+
+    module = load_generated("reference_light")
+    contract = Contract.of(module)
+    assert contract.provides("mesh_force", "static_mesh_force")
+    assert not contract.provides("no_such_function")
+    for name in contract.functions:
+        assert callable(getattr(module, name))
+    path = tmp_path / "lacking.py"
+    text = Path(module.__file__).read_text().replace("def mesh_force(", "def _gone(")
+    path.write_text(text)
+    with pytest.raises(ValueError, match="lists mesh_force, which the module does not define"):
+        Contract.of(load_generated(path))
