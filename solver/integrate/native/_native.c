@@ -124,7 +124,7 @@ typedef struct {
     const gs_tableau *T;
     int phase, batched, dense, tangent, extremes, range, stop;
     int64_t n_pre, n_stops, lyap_from, done; /* done: fixed steps taken by the group */
-    double *Pg, *Qg, *Y, *YT, *YN, *K, *F, *E5s, *E3s, *growth;
+    double *Pg, *Qg, *Y, *YT, *YN, *W, *K, *F, *E5s, *E3s, *growth;
     int *alive, *leave;
     long long nfev, nsteps;
     int group_status;
@@ -265,6 +265,10 @@ static void gs_rhs_group(const gs_ctx *c, double t, int n, const double *Y, doub
         gs_rhs_batch(t, n, Y, c->Pg, c->Qg, K);
         return;
     }
+    if (n == 1 && !c->phase) { /* a point on its own: the group's arrays are its vectors */
+        gs_rhs(t, Y, c->Pg, c->Qg, K);
+        return;
+    }
     for (int j = 0; j < n; ++j) {
         double x[GS_NX], p[GS_NP], q[GS_NQ > 0 ? GS_NQ : 1], dx[GS_NX];
         for (int i = 0; i < GS_NX; ++i) x[i] = Y[(long)i * n + j];
@@ -281,6 +285,39 @@ static void gs_rhs_group(const gs_ctx *c, double t, int n, const double *Y, doub
     }
 }
 
+/* out = w_0 K_0 + ... + w_{m-1} K_{m-1} on S elements (K_r at K + r S), each sum fused in
+ * order of r.  The loops run along the contiguous elements, so they vectorise (a sum
+ * along r for each element would gather K with stride S). */
+static inline __attribute__((always_inline)) void
+gs_weighted_any(double *restrict out, const double *restrict K, const double *restrict w,
+                int m, long S)
+{
+    const double w0 = w[0];
+    for (long e = 0; e < S; ++e) out[e] = w0 * K[e];
+    for (int r = 1; r < m; ++r) {
+        const double wr = w[r];
+        const double *restrict Kr = K + r * S;
+        for (long e = 0; e < S; ++e) out[e] = fma(wr, Kr[e], out[e]);
+    }
+}
+
+/* A point on its own steps (S = GS_NX, known here) keeps out in registers. */
+static void gs_weighted(double *restrict out, const double *restrict K,
+                        const double *restrict w, int m, long S)
+{
+    if (S == GS_NX) gs_weighted_any(out, K, w, m, GS_NX);
+    else gs_weighted_any(out, K, w, m, S);
+}
+
+/* out = y + hh (w_0 K_0 + ... + w_{m-1} K_{m-1}): a stage's state or the new state. */
+static void gs_combine(double *restrict out, const double *restrict y,
+                       const double *restrict K, const double *restrict w, int m, double hh,
+                       long S)
+{
+    gs_weighted(out, K, w, m, S);
+    for (long e = 0; e < S; ++e) out[e] = fma(hh, out[e], y[e]);
+}
+
 /* The explicit step of the tableau from (t, Y) with K[0] = f(t, Y): stages into K, the
  * new state into YN and its slope at t_new (first same as last) into K[ns]. */
 static void gs_stages(gs_ctx *c, double t, double hh, double t_new, int n)
@@ -288,21 +325,13 @@ static void gs_stages(gs_ctx *c, double t, double hh, double t_new, int n)
     const gs_tableau *T = c->T;
     const int ns = T->ns;
     const long S = (long)GS_NX * n;
-    double *K = c->K, *Y = c->Y, *YT = c->YT, *YN = c->YN;
+    const double *K = c->K;
     for (int s = 1; s < ns; ++s) {
-        for (long e = 0; e < S; ++e) {
-            double acc = 0.0;
-            for (int r = 0; r < s; ++r) acc += T->A[s * ns + r] * K[r * S + e];
-            YT[e] = Y[e] + hh * acc;
-        }
-        gs_rhs_group(c, t + T->C[s] * hh, n, YT, K + s * S);
+        gs_combine(c->YT, c->Y, K, T->A + s * ns, s, hh, S);
+        gs_rhs_group(c, t + T->C[s] * hh, n, c->YT, c->K + s * S);
     }
-    for (long e = 0; e < S; ++e) {
-        double acc = 0.0;
-        for (int r = 0; r < ns; ++r) acc += T->B[r] * K[r * S + e];
-        YN[e] = Y[e] + hh * acc;
-    }
-    gs_rhs_group(c, t_new, n, YN, K + ns * S);
+    gs_combine(c->YN, c->Y, K, T->B, ns, hh, S);
+    gs_rhs_group(c, t_new, n, c->YN, c->K + ns * S);
     c->nfev += ns;
 }
 
@@ -324,27 +353,22 @@ static double gs_error(gs_ctx *c, int64_t g0, int n, double t, double hh)
     const int ns = T->ns;
     const long S = (long)GS_NX * n;
     const double rtol = c->job->rtol, atol = c->job->atol;
-    const double *restrict K = c->K;
     double *restrict E5s = c->E5s, *restrict E3s = c->E3s;
+    /* the error estimates into the free work rows: YT (the stages are done) and W */
+    double *restrict A5 = c->YT, *restrict A3 = c->W;
+    gs_weighted(A5, c->K, T->E ? T->E : T->E5, ns + 1, S);
+    if (T->E)
+        for (long e = 0; e < S; ++e) A5[e] *= hh;
+    else
+        gs_weighted(A3, c->K, T->E3, ns + 1, S);
     for (int j = 0; j < n; ++j) E5s[j] = E3s[j] = 0.0;
     for (int i = 0; i < GS_NX; ++i) {
         const double *y0 = c->Y + (long)i * n, *y1 = c->YN + (long)i * n;
         for (int j = 0; j < n; ++j) {
-            double a5 = 0.0, a3 = 0.0;
             const long e = (long)i * n + j;
-            if (T->E) {
-                for (int r = 0; r <= ns; ++r) a5 += T->E[r] * K[r * S + e];
-                a5 *= hh;
-            } else {
-                for (int r = 0; r <= ns; ++r) {
-                    a5 += T->E5[r] * K[r * S + e];
-                    a3 += T->E3[r] * K[r * S + e];
-                }
-            }
             const double a = fabs(y0[j]), b = fabs(y1[j]);
             const double sc = atol + (a > b ? a : b) * rtol;
-            a5 /= sc;
-            a3 /= sc;
+            const double a5 = A5[e] / sc, a3 = T->E ? 0.0 : A3[e] / sc;
             E5s[j] += a5 * a5;
             E3s[j] += a3 * a3;
         }
@@ -395,11 +419,7 @@ static void gs_dense_coefficients(gs_ctx *c, double t, double hh, int n)
     double *K = c->K, *F = c->F;
     for (int x = 0; x < 3; ++x) {
         const int row = 13 + x;
-        for (long e = 0; e < S; ++e) {
-            double acc = 0.0;
-            for (int r = 0; r < row; ++r) acc += GS_DOP853_AX[x * GS_KROWS + r] * K[r * S + e];
-            c->YT[e] = c->Y[e] + hh * acc;
-        }
+        gs_combine(c->YT, c->Y, K, GS_DOP853_AX + x * GS_KROWS, row, hh, S);
         gs_rhs_group(c, t + GS_DOP853_CX[x] * hh, n, c->YT, K + row * S);
     }
     for (long e = 0; e < S; ++e) {
@@ -407,11 +427,11 @@ static void gs_dense_coefficients(gs_ctx *c, double t, double hh, int n)
         F[e] = dy;
         F[S + e] = hh * f0 - dy;
         F[2 * S + e] = 2.0 * dy - hh * (f1 + f0);
-        for (int i = 0; i < 4; ++i) {
-            double acc = 0.0;
-            for (int r = 0; r < GS_KROWS; ++r) acc += GS_DOP853_D[i * GS_KROWS + r] * K[r * S + e];
-            F[(3 + i) * S + e] = hh * acc;
-        }
+    }
+    for (int i = 0; i < 4; ++i) {
+        double *Fi = F + (3 + i) * S;
+        gs_weighted(Fi, K, GS_DOP853_D + i * GS_KROWS, GS_KROWS, S);
+        for (long e = 0; e < S; ++e) Fi[e] *= hh;
     }
     c->nfev += 3;
 }
@@ -784,6 +804,7 @@ int gs_integrate(const gs_job *J)
     c.Y = malloc(sizeof(double) * GS_NX * G);
     c.YT = malloc(sizeof(double) * GS_NX * G);
     c.YN = malloc(sizeof(double) * GS_NX * G);
+    c.W = malloc(sizeof(double) * GS_NX * G);
     c.K = malloc(sizeof(double) * GS_KROWS * GS_NX * G);
     c.F = c.dense ? malloc(sizeof(double) * 7 * GS_NX * G) : 0;
     c.E5s = malloc(sizeof(double) * G);
@@ -791,7 +812,7 @@ int gs_integrate(const gs_job *J)
     c.growth = malloc(sizeof(double) * G);
     c.alive = malloc(sizeof(int) * G);
     c.leave = malloc(sizeof(int) * G);
-    if (!c.Pg || !c.Qg || !c.Y || !c.YT || !c.YN || !c.K || (c.dense && !c.F) || !c.E5s ||
+    if (!c.Pg || !c.Qg || !c.Y || !c.YT || !c.YN || !c.W || !c.K || (c.dense && !c.F) || !c.E5s ||
         !c.E3s || !c.growth || !c.alive || !c.leave)
         goto cleanup;
     for (int64_t k = 0; c.range && k < 3 * J->n_points; ++k) J->exits[k] = NAN;
@@ -806,6 +827,7 @@ cleanup:
     free(c.Y);
     free(c.YT);
     free(c.YN);
+    free(c.W);
     free(c.K);
     free(c.F);
     free(c.E5s);
