@@ -34,7 +34,7 @@ import numpy as np
 N_POINTS = 400
 _HARNESS = r"""
 #include <stdlib.h>
-/* Q of every point by gs_prep, as the engine does once per run (_native.c). */
+/* Q of every point by gs_prep, as the engine does once per run (native_*.c). */
 double *rc_prep(int n, const double *P)
 {
     double *Q = malloc(sizeof(double) * GS_NQ * (n > 0 ? n : 1)), p[GS_NP], q[GS_NQ];

@@ -12,7 +12,7 @@ a scene or gear name, a description) may become code there.  Every emitter (``em
 * :func:`markdown` -- the same for Markdown prose and code spans of the audit pages;
 * :func:`code_name` -- the identifier a model symbol takes in generated Python and C:
   ``m_<name>``, a namespace that no name of the generated code or of the C host file
-  (``solver/integrate/native/_native.c``, ``math.h``) uses, so that any name a topology
+  (``solver/integrate/native/native_*.c``, ``math.h``) uses, so that any name a topology
   accepts (``int``, ``q``, ``NAN``, ``restrict``, ``np``, ``th0``) compiles in both;
 * :func:`is_identifier` -- the check of a user's name: the *whole* string matches (a
   trailing newline does not pass, as it would with ``re.match`` and ``$``).

@@ -86,9 +86,11 @@ def test_no_import_circles(folder):
 
 @pytest.mark.parametrize("folder", ["derive", "solver", "app"])
 def test_modules_are_short_enough_to_read_in_one_sitting(folder):
+    # Python modules, and the C engine's parts (solver/integrate/native/native_*.c)
+    files = [*(ROOT / folder).rglob("*.py"), *(ROOT / folder).rglob("*.c")]
     long = {
         str(p.relative_to(ROOT)): n
-        for p in (ROOT / folder).rglob("*.py")
+        for p in files
         if (n := len(p.read_text(encoding="utf-8").splitlines())) > 400
     }
     assert not long, long
@@ -204,7 +206,7 @@ def test_the_c_interface_is_declared_once():
         if ".argtypes" in text:
             bindings.add(rel)
     assert structures == bindings == {"solver/integrate/native/abi.py"}, (structures, bindings)
-    c = (native / "_native.c").read_text(encoding="utf-8")
+    c = "".join(p.read_text(encoding="utf-8") for p in sorted(native.glob("native_*.c")))
     exported = set(re.findall(r"^(?!static)[A-Za-z][\w \*]*?\b(gs_\w+)\s*\(", c, re.M))
     entries = {e for e in exported if e not in {"gs_job_fields", "gs_job_layout"}}
     integrators = entries - {"gs_eval", "gs_eval_batch", "gs_rhs_loop"}

@@ -1,7 +1,7 @@
 """Explicit Runge-Kutta methods as data: frozen Butcher tableaux that check themselves.
 
 One generic step (:func:`rk_step`) does the work in NumPy; the compiled integrators
-(``native/_native.c``) read the same tableaux, printed as C arrays by
+(``native/native_*.c``) read the same tableaux, printed as C arrays by
 :func:`c_tables`.  The Dormand-Prince coefficients are SciPy's own
 (``scipy.integrate._ivp``), so that the compiled step control is SciPy's (Hairer, Norsett
 and Wanner 1993, "Solving Ordinary Differential Equations I", II.4-II.5).

@@ -7,7 +7,7 @@
 * ``maps.py`` -- the same engine for maps: Poincare points, extremes at every step, the
   valid range and the exponent's tangent vector, with no Python step per point;
 * ``fallback.py`` -- the one NumPy/SciPy fallback without a compiler, for every spec;
-* ``_native.c`` -- the integrators (DOPRI5, DOP853, RK4), whose tableaux come from
+* ``native_*.c`` -- the integrators (DOPRI5, DOP853, RK4), whose tableaux come from
   ``../tableau.py``.
 
 :func:`run` is the ``simulate`` back end of the ``native`` family: one point.

@@ -1,6 +1,6 @@
 """The one call into the compiled library: ``int gs_integrate(const gs_job *job)``.
 
-:class:`Job` is the C struct ``gs_job`` of ``_native.c``, declared here once.  The C
+:class:`Job` is the C struct ``gs_job`` of ``native_*.c``, declared here once.  The C
 exports its layout (``gs_job_fields``: each field's name and kind in order;
 ``gs_job_layout``: the ABI version, ``sizeof(gs_job)`` and each field's ``offsetof``);
 :func:`bind` compares them with this declaration when a library is loaded and refuses a
@@ -22,7 +22,7 @@ __all__ = ["ABI_VERSION", "ERRORS", "FLAGS", "Job", "LayoutMismatch", "bind", "c
 
 ABI_VERSION = 1
 INT64_MIN, INT64_MAX = -(2**63), 2**63 - 1
-# gs_integrate's refusals (``GS_E_*`` of _native.c); Python's checks come first, so one of
+# gs_integrate's refusals (``GS_E_*`` of native_*.c); Python's checks come first, so one of
 # these means the two sides disagree (a bug), except memory.
 ERRORS = {
     -1: "the library's job layout version differs from abi.py's",
@@ -64,7 +64,7 @@ class LayoutMismatch(RuntimeError):
 
 
 class Job(ctypes.Structure):
-    """``gs_job`` of ``_native.c``: int64 sizes and options, doubles, and each array as a
+    """``gs_job`` of ``native_*.c``: int64 sizes and options, doubles, and each array as a
     pointer with its length in elements (NULL: not given / not collected)."""
 
     _fields_ = [
@@ -116,7 +116,7 @@ def bind(lib: ctypes.CDLL, path: str) -> None:
         where = _difference(theirs.split(), names.split(), got, offsets)
         raise LayoutMismatch(
             f"the compiled library {path} lays out gs_job differently from abi.py ({where}); "
-            "rebuild it (delete the cached library) or update abi.py with _native.c"
+            "rebuild it (delete the cached library) or update abi.py with native_*.c"
         )
     lib.gs_integrate.restype = ctypes.c_int
     lib.gs_integrate.argtypes = [ctypes.POINTER(Job)]

@@ -3,7 +3,7 @@
 ``run_batch(module, P, X0, ...)`` integrates many parameter points of one generated model:
 Dormand-Prince 5(4) (``dopri5``), DOP853 (``dop853``) or classic RK4 (``rk4``), with the
 step control of SciPy's RK45/DOP853, sampled ``samples_per_period`` times per forcing
-period after a transient (``_native.c``). It is a spec constructor over the front door,
+period after a transient (``native_*.c``). It is a spec constructor over the front door,
 ``integrate()`` (``../run.py``), which checks the inputs once, decides once between the
 compiled engine and the NumPy/SciPy fallback (``fallback.py``) and splits the points over
 worker processes.

@@ -4,7 +4,7 @@ The generated module carries its right-hand side as C (``C_SOURCE``, printed by
 ``derive/emit/c.py`` from the same SymPy expressions as the NumPy and CasADi code, with
 the excitation's harmonics reduced to one ``sincos`` per step stage).  It is compiled with
 the system C compiler (``cc``, or ``$GEARSYM_CC``) together with the integrators of
-``_native.c`` and the checked tableaux of ``../tableau.py`` into a shared library, loaded
+``native_*.c`` and the checked tableaux of ``../tableau.py`` into a shared library, loaded
 with ``ctypes`` and cached under ``<cache root>/native`` (``solver/cache.py``) keyed by
 the sha256 of its full source, the compiler and the CPU, so that a second run pays no
 compile time.
@@ -103,11 +103,22 @@ def source(module, variational: bool = False) -> str:
         raise NativeUnavailable(
             f"generated module '{module.NAME}' has no {attr}; regenerate it with `gearsym derive`"
         )
-    body = (Path(__file__).with_name("_native.c")).read_text(encoding="utf-8")
+    body = engine_text()
     head = ["#define GS_VARIATIONAL 1"] if variational else []
     return "\n".join(
         [*head, "#include <math.h>", getattr(module, attr), c_tables(), _rk4_tables(), body]
     )
+
+
+# The C engine, in the order its parts are joined: the job and the shared utilities, the
+# step arithmetic (stages, error, samples, valid range), the step loop and the one entry.
+ENGINE_PARTS = ("native_1_job.c", "native_2_step.c", "native_3_loop.c")
+
+
+def engine_text() -> str:
+    """The C engine's text: its parts joined in order (one translation unit)."""
+    here = Path(__file__).parent
+    return "".join((here / name).read_text(encoding="utf-8") for name in ENGINE_PARTS)
 
 
 def _key_text(module, variational: bool) -> str:
@@ -118,7 +129,7 @@ def _key_text(module, variational: bool) -> str:
     attr = "C_SOURCE_VARIATIONAL" if variational else "C_SOURCE"
     if not hasattr(module, attr):
         source(module, variational)  # raises NativeUnavailable with the reason
-    engine = (Path(__file__).with_name("_native.c")).read_text(encoding="utf-8")
+    engine = engine_text()
     tables = [f"scipy {version('scipy')}", _rk4_tables()]
     return "\n".join([f"variational={variational}", getattr(module, attr), engine, *tables])
 

@@ -2,7 +2,7 @@
 
 Every compiled run -- one point on its own steps, lockstep groups, the excitation phase,
 a map with its extremes and Lyapunov exponent -- is one call of the one C entry
-(``_native.c``) with a :class:`~.abi.Job` built from a :class:`~..spec.RunSpec`; what
+(``native_*.c``) with a :class:`~.abi.Job` built from a :class:`~..spec.RunSpec`; what
 differs between them is data in the job:
 
 * ``group`` and ``batched``: ``spec.lockstep`` groups of ``spec.group`` points sharing

@@ -5,7 +5,7 @@ returns the same :class:`~..spec.RunResult`, every field with the same meaning, 
 point on the generated NumPy code:
 
 * ``dopri5`` and ``dop853``: SciPy's ``RK45`` and ``DOP853`` steppers (the step control
-  the C engine follows, ``_native.c``), stopped on every sample time
+  the C engine follows, ``native_*.c``), stopped on every sample time
   ``t0 + (j / samples_per_period) T``, the step size carried over from one stop to the
   next; ``rk4``: the classic tableau (``tableau.py``) on the fixed grid
   ``t0 + j T / steps_per_period``, as the C engine steps it;

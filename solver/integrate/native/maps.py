@@ -1,7 +1,7 @@
 """The compiled map engine: many points, stroboscopic samples, extremes and the exponent.
 
 A :class:`~..spec.RunSpec` that collects the extremes or the exponent runs in lockstep
-groups (``engine.run_compiled``, ``gs_integrate`` in ``_native.c``) and keeps, without a
+groups (``engine.run_compiled``, ``gs_integrate`` in ``native_*.c``) and keeps, without a
 Python step per point:
 
 * the Poincare points ``x(t0 + k T)`` of the last ``periods + 1`` periods;
