@@ -67,7 +67,7 @@ def outcome(
     atol,
     values: dict | None = None,
     x0=None,
-    engine: str = "compiled DOP853 (map)",
+    engine: str,
 ) -> RunRecord:
     """The record of one run of a map: ``poincare`` (K, n) its Poincare points,
     ``xmin``/``xmax`` (n,) its extremes, ``running`` its running exponent (or None);
