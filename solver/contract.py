@@ -171,6 +171,11 @@ class Contract:
         return [(self.states.index(c), a) for c, a in self.valid_range.items()]
 
 
+# Modules run from a file, by (path, sha256 of the bytes run): a worker that meets the same
+# verified bytes again (a map's next column) takes the module it made, not a new one.
+_LOADED: dict[tuple[str, str], ModuleType] = {}
+
+
 def load_generated(name_or_path: str | Path, source: bytes | None = None) -> ModuleType:
     """Import ``generated/<name>.py`` by model name, or a generated file by path.
 
@@ -193,9 +198,14 @@ def load_generated(name_or_path: str | Path, source: bytes | None = None) -> Mod
                     f"{path} does not match the digest beside it ({stated.name}); derive "
                     "it again (`gearsym derive` on its scene)"
                 )
-        module = ModuleType(f"gearsym_generated_{path.stem}")
-        module.__file__ = str(path)
-        exec(compile(data, str(path), "exec", dont_inherit=True), module.__dict__)
+        key = (str(path.resolve()), hashlib.sha256(data).hexdigest())
+        module = _LOADED.get(key)
+        if module is None:
+            module = ModuleType(f"gearsym_generated_{path.stem}")
+            module.__file__ = str(path)
+            exec(compile(data, str(path), "exec", dont_inherit=True), module.__dict__)
+            if not [k for k in _REQUIRED if not hasattr(module, k)]:
+                _LOADED[key] = module
     else:
         try:
             # Built-in names may be written with hyphens, as the scene files are.

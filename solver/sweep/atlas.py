@@ -33,7 +33,7 @@ import numpy as np
 
 from .._json import dumps
 from ..analysis.record import RunRecord
-from ..contract import load_generated
+from ..contract import Contract, load_generated
 from ..executor import map_tasks
 from ..integrate.run import Batch, decide_backend, integrate
 from ..integrate.simulate import default_initial_state
@@ -82,17 +82,17 @@ def _run_column(col: _Column, X0: np.ndarray, opts: dict) -> list[RunRecord]:
     out: list[RunRecord | None] = [None] * len(col.files)
     modules = {f: load_generated(f) for f in set(col.files)}
     by_model: dict = {}
+    contracts = {f: Contract.of(m) for f, m in modules.items()}
     for i, f in enumerate(col.files):
-        c = modules[f].CONTRACT
-        w = col.P[i][list(c["parameters"]).index(c["forcing_frequency"])]
+        c = contracts[f]
+        w = col.P[i][c.parameters.index(c.forcing_frequency)]
         by_model.setdefault((f, float(w)), []).append(i)
     for (f, _), idx in by_model.items():
         module = modules[f]
         batch = Batch.of(module, np.array([col.P[i] for i in idx]))
         res = integrate(batch, X0[idx], opts["spec"], backend=opts["backends"][f])
-        base = System(module, col.P[idx[0]])
         for r, i in enumerate(idx):
-            system = System(module, col.P[i], {}, base.contract)
+            system = System(module, col.P[i], {}, contracts[f])
             out[i] = outcome(
                 system,
                 col.starts[i],
@@ -111,11 +111,31 @@ def _run_column(col: _Column, X0: np.ndarray, opts: dict) -> list[RunRecord]:
     return out  # type: ignore[return-value]
 
 
-def _task(task) -> list[tuple[str, int, list[RunRecord]]]:
+@dataclass(frozen=True, eq=False)
+class _Task:
+    """One worker's share of a map: a chain of columns (each from the previous one's end
+    states; ``first_x0`` the first column's starts) or one column of independent starts;
+    the runs the store already holds of them (``stored``, by key) and the store to add
+    to."""
+
+    columns: tuple[_Column, ...]
+    first_x0: np.ndarray | None
+    opts: dict
+    store: RunStore | None
+    stored: dict
+
+
+def _task(task: _Task) -> list[tuple[str, int, list[RunRecord]]]:
     """One task: a chain of columns (each from the previous one's end states) or one
     column of independent starts.  Finished columns go to the store at once; columns
     the store holds (``stored``, by key) are not run again."""
-    columns, first_x0, opts, store, stored = task
+    columns, first_x0, opts, store, stored = (
+        task.columns,
+        task.first_x0,
+        task.opts,
+        task.store,
+        task.stored,
+    )
     done = []
     x0 = first_x0
     for col in columns:
@@ -255,7 +275,7 @@ def regime_map(
             first = None if cells is None else np.array([default_initial_state(g) for g in cells])
             keys = {k for col in columns for k in range(col.key, col.key + len(col.files))}
             held = {k: r for k, r in stored.items() if k in keys}
-            tasks.append((columns, first, run_opts, opened, held))
+            tasks.append(_Task(tuple(columns), first, run_opts, opened, held))
         bar = Progress(len(tasks), "map", enabled=progress)
         results = map_tasks(
             _task,
