@@ -269,6 +269,7 @@ def _summary(m) -> None:
     print(
         f"{m.model}: {len(m.x_values)} x {len(m.y_values)} grid ({m.x} x {m.y}), "
         f"{m.settings['initial_states']} initial states each, {m.wall_time:.1f} s"
+        + (f" ({m.settings['engine']})" if m.settings.get("engine") else "")
     )
     for c in m.coordinates:
         counts = Counter(m.grid("motion", c).ravel())

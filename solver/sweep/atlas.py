@@ -250,6 +250,8 @@ def regime_map(
     # the compiled library of every model, built once here (or the fallback, warned once)
     models = {g.module.__file__: g.module for col in grid for g in col}
     backends = {f: decide_backend(m, spec) for f, m in models.items()}
+    where = {"native": "compiled", "numpy": "NumPy fallback"}
+    engine = ", ".join(sorted({f"{where[b]} {method.upper()}" for b in backends.values()}))
     run_opts = {**opts, "spec": spec, "backends": backends}
     chains = {"forward": range(nx), "backward": range(nx - 1, -1, -1)}
     planned = [
@@ -312,7 +314,7 @@ def regime_map(
         states=tuple(states),
         coordinates=tuple(system.coordinates),
         values={k: float(v) for k, v in system.values.items()},
-        settings={**opts, "initial_states": initial_states, "box": box},
+        settings={**opts, "initial_states": initial_states, "box": box, "engine": engine},
         cells=cells,
         wall_time=time.perf_counter() - started,
         digest=hashlib.sha256(dumps([hashes, xv.tolist(), yv.tolist()]).encode()).hexdigest(),
