@@ -25,6 +25,7 @@ import time
 from pathlib import Path
 
 import pytest
+from gearsym.solver.sweep.store import stored_count
 
 pytestmark = pytest.mark.skipif(
     not hasattr(signal, "SIGPIPE") or sys.platform == "win32", reason="POSIX signals"
@@ -164,14 +165,16 @@ def test_ctrl_c_on_a_map_with_worker_processes_keeps_its_columns_and_resumes(tmp
         f"--out={out}",
         "--quiet",
     ]
-    store = out / "store" / "columns"
+    store = out / "store" / "points"  # one store layout for sweeps and maps
     code, err, stored = _interrupt_when_stored(argv, store, tmp_path)
     _assert_one_quiet_line(code, err)
-    assert 1 <= len(stored) < 8  # two chains of 4 columns each
+    assert 1 <= len(stored) < 8  # two chains of 4 columns each, a file per column
+    runs = stored_count(out / "store")  # a column holds one run per y value
+    assert runs == 2 * len(stored)
     again = subprocess.run(_gearsym(*argv), capture_output=True, text=True, cwd=tmp_path)
     assert again.returncode == 0, again.stderr
     assert again.stdout.splitlines()[0] == (
-        f"resumed: {len(stored)} finished columns came from {out / 'store'}"
+        f"resumed: {runs} finished runs came from {out / 'store'}"
     )
     _assert_kept(store, stored)
     assert len(list(store.glob("*.json"))) == 8
