@@ -31,7 +31,6 @@ import pytest
 from gearsym.solver.integrate import native
 from gearsym.solver.integrate.run import Batch, integrate
 from gearsym.solver.integrate.spec import RunSpec
-from gearsym.solver.sweep.atlas import regime_map
 from gearsym.solver.system import System
 
 RTOL = 1e-8
@@ -123,31 +122,6 @@ def test_fallback_stops_a_failing_point_as_the_compiled_engine(
     assert abs(got.t_fail[1] - ref.t_fail[1]) < s.period / 10
 
 
-@pytest.mark.slow  # some 30 s: the fallback steps every point in Python
-def test_a_map_without_a_compiler_gives_the_compiled_verdicts(no_compiler, monkeypatch):
-    s = System.load("reference_light")
-    kw = dict(initial_states=2, transient=60, periods=20, lyapunov_periods=40)
-    kw.update(rtol=RTOL, executor="serial")
-    axes = (("lambda", np.linspace(0, 1, 3)), ("f1", np.array([0.1, 0.2])))
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        got = regime_map(s, *axes, **kw)
-    assert [str(w.message) for w in caught if "NumPy instead" in str(w.message)] == [
-        "GEARSYM_CC='none' turns the C compiler off; integrating with NumPy instead (slower)"
-    ]
-    monkeypatch.delenv("GEARSYM_CC")
-    ref = _compiled(lambda: regime_map(s, *axes, **kw))
-    for row_got, row_ref in zip(got.cells, ref.cells, strict=True):
-        for a, b in zip(row_got, row_ref, strict=True):
-            assert len(a.attractors) == len(b.attractors)
-            for ga, gb in zip(a.attractors, b.attractors, strict=True):
-                da, db = ga.to_dict(s.states), gb.to_dict(s.states)
-                assert _verdict(da) == _verdict(db)
-                end_a, end_b = np.array(da["state"]), np.array(db["state"])
-                assert np.max(np.abs(end_a - end_b)) <= 10 * RTOL * np.max(np.abs(end_b))
-                assert abs(da["lyapunov"] - db["lyapunov"]) <= 10 * RTOL / s.period
-
-
 def _verdict(attractor: dict) -> tuple:
     """What a map says of an attractor: which starts reach it, its status, motion, period
     and meshing regime per coordinate."""
@@ -186,6 +160,8 @@ def test_gearsym_map_without_a_compiler_gives_the_compiled_verdicts(tmp_path):
         where = ("lambda", "f1", "attractor", "attractors", "share")
         assert [a[k] for k in where] == [b[k] for k in where]
         assert _verdict(a) == _verdict(b)
+        end_a, end_b = np.array(a["state"]), np.array(b["state"])
+        assert np.max(np.abs(end_a - end_b)) <= 10 * RTOL * np.max(np.abs(end_b))
         assert abs(a["lyapunov"] - b["lyapunov"]) <= 10 * RTOL / period
 
 
