@@ -22,6 +22,7 @@ from gearsym.benchmarks.baseline import (
     _reference_library,
     baseline_point,
     reference_run,
+    tight_reference,
 )
 
 
@@ -34,25 +35,7 @@ def headline(quick: bool) -> dict:
     reps = 3
     # independent reference for the accuracy comparison: CVODES (BDF) at rtol 1e-13
     subset = np.linspace(0, len(lam) - 1, 2 if quick else 6).round().astype(int)
-    from gearsym.solver.integrate import simulate
-    from gearsym.solver.system import System
-
-    tight = []
-    for i in subset:
-        s = System(module, P[i])
-        tight.append(
-            simulate(
-                s,
-                X0[i],
-                method="cvodes",
-                rtol=1e-13,
-                atol=1e-15,
-                transient=tr,
-                periods=per,
-                samples_per_period=1,
-            ).x.T
-        )
-    tight = np.array(tight)
+    tight = tight_reference(module, P, X0, subset, tr, per)
     baselines = {}
     for method in ("RK45", "DOP853"):
         times, errs, nfevs = [], [], []

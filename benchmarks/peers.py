@@ -52,23 +52,7 @@ TRANSIENT, PERIODS, RTOL, ATOL = 300, 100, 1e-8, 1e-10
 
 def tight_reference(module, P, X0, subset) -> np.ndarray:
     """Poincaré points (len(subset), PERIODS, 4) by CVODES at rtol 1e-13, atol 1e-15."""
-    from gearsym.solver.integrate import simulate
-    from gearsym.solver.system import System
-
-    runs = [
-        simulate(
-            System(module, P[i]),
-            X0[i],
-            method="cvodes",
-            rtol=1e-13,
-            atol=1e-15,
-            transient=TRANSIENT,
-            periods=PERIODS,
-            samples_per_period=1,
-        ).x.T
-        for i in subset
-    ]
-    return np.array(runs)
+    return baseline.tight_reference(module, P, X0, subset, TRANSIENT, PERIODS)
 
 
 class WrappedBuild:
