@@ -122,14 +122,10 @@ def _cmd_simulate(args) -> int:
     )
     if start.x0 is not None:
         print(f"  started from {start.source}: " + ", ".join(f"{v:.6g}" for v in start.x0))
-    if result.lyapunov is not None:
-        ly = result.lyapunov
-        print(
-            f"  largest Lyapunov exponent {ly.exponent:.5f} ± {ly.uncertainty:.1e} per unit tau "
-            f"(over {ly.periods} periods)"
-        )
     if tr.status != "ok":
         print(f"  {tr.message}")
+    for line in verdict_lines(result.verdict):
+        print(line)
 
     def num(v, fmt=".4f"):
         return "n/a" if v is None else format(v, fmt)
@@ -140,20 +136,17 @@ def _cmd_simulate(args) -> int:
         u = u[np.isfinite(u)]
         low, high = (float(u.min()), float(u.max())) if u.size else (None, None)
         peaks = ", ".join(f"{p['frequency']:.3g}" for p in result._spectrum(c).peaks()[:4])
-        line = f"  {c}: {k.motion:<15} range [{num(low)}, {num(high)}]  peaks at {peaks or 'n/a'}"
+        line = f"  {c}: range [{num(low)}, {num(high)}]  peaks at {peaks or 'n/a'}"
         if c in shares:
             f, s, b = (num(shares[c][key], ".2f") for key in ("forward", "separated", "backward"))
             line += f"  forward/separated/backward {f}/{s}/{b}"
         print(line)
-        ev = k.evidence
-        if k.period is None and "poincare_extent" in ev:
-            ext = ev["poincare_extent"]
-            dim = ev.get("correlation_dimension")
+        sp = k.evidence.get("spread")
+        if sp and k.period is None:
             print(
-                f"      Poincaré cloud of {ev['poincare_points']} points: extent "
-                f"{num(ext['displacement'], '.2e')} in {c}, {num(ext['velocity'], '.2e')} in "
-                f"its velocity; correlation dimension {num(dim, '.2f')}"
-                + (f"; {ev['why']}" if "why" in ev else "")
+                f"      Poincaré cloud: extent {num(sp['displacement'], '.2e')} in {c}, "
+                f"{num(sp['velocity'], '.2e')} in its velocity, {num(sp['share'], '.2f')} of "
+                "the widest coordinate's"
             )
     if tr.left_valid_range is not None:
         t, c, v = tr.left_valid_range
@@ -256,3 +249,34 @@ def _cmd_sweep(args) -> int:
             + " (exit status 3)"
         )
     return 3 if failed else 0
+
+
+def verdict_lines(v) -> list[str]:
+    """The attractor's verdict and the evidence it rests on, as the CLI prints it."""
+    if v is None:
+        return []
+    ev = v.evidence
+    lines = [f"  attractor: {v.motion} (verdict after {v.periods_run} periods)"]
+    if "orbit" in ev:
+        o = ev["orbit"]
+        lines.append(
+            f"      shooting check: period-{o['minimal_period']} orbit, residual "
+            f"{o['residual']:.1e}, largest multiplier {o['largest_multiplier']:.4f}"
+            + ("; the run was still converging to it" if ev.get("converging") else "")
+        )
+    if "transient_chaos" in ev:
+        lines.append("      " + ev["transient_chaos"]["text"])
+    for w in (ev.get("windows") or [])[-2:]:
+        parts = [f"periods {w['window'][0]}-{w['window'][1]}: {w['label']}"]
+        if "exponent" in w:
+            e = w["exponent"]
+            lo, hi = e["interval"]
+            parts.append(f"exponent {e['exponent']:.5f} per tau in [{lo:.5f}, {hi:.5f}]")
+        if "zero_one" in w:
+            parts.append(f"0-1 test K = {w['zero_one']['K']:.2f}")
+        if "rotation_number" in w:
+            parts.append(f"rotation number {w['rotation_number']:.5f}")
+        lines.append("      " + ", ".join(parts))
+    if "why" in ev:
+        lines.append(f"      why undetermined: {ev['why']}")
+    return lines

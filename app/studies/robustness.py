@@ -52,14 +52,14 @@ CASES = (
 
 # The study is about how each integration ends, not about the motion: no exponent, and no
 # extension of the 2-period window to the 400 Poincare points a non-periodic verdict
-# would otherwise ask for (that made Radau on the undamped case run for minutes).
+# would otherwise ask for (that made Radau on the undamped case run for minutes): budget 0.
 BASE = dict(
     transient=6,
     periods=2,
     samples_per_period=16,
     lyapunov_periods=0,
     steps_per_period=256,
-    dimension_points=0,
+    budget=0,
 )
 
 

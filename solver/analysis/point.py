@@ -1,15 +1,14 @@
-"""Everything about one operating point: response, spectra, exponent and verdicts.
+"""Everything about one operating point: response, spectra, exponent and the verdict.
 
-``analyse_point`` is the convenience call on top of :func:`simulate`,
-:func:`largest_lyapunov` and :func:`classify_points`; sweeps call it once per point.
+``analyse_point`` is the convenience call on top of :func:`simulate` and :func:`settle`;
+sweeps call it (or :func:`analyse_trajectory` on a batch's trajectories) once per point.
 
-Adaptive Poincare sample: a coordinate whose verdict from the sampled window is not
-period-n (chaotic, quasi-periodic or undetermined) is classified again on at least
-``dimension_points`` (default 400) Poincare points, the run being continued from its end
-state for the missing periods: the correlation dimension that tells a torus section from
-a strange attractor is unreliable on 100 points.  The evidence records the count
-(``poincare_points``, ``extended_from``); ``dimension_points=0`` keeps the window's
-points and the evidence states the limit instead (``sample_limit``).
+The verdict belongs to the attractor (``verdict.py``): a period-n label rests on the
+shooting check from the run's end state, a chaotic or quasi-periodic one on two
+successive windows of the run continued from where it ended (``settle.py``), each with
+its exponent and the 0-1 test; anything else is ``undetermined`` with its reason.  Each
+mesh coordinate's :class:`Classification` carries the attractor's label and its own
+spread (the extent of its Poincare cloud and its share of the widest).
 """
 
 from __future__ import annotations
@@ -20,10 +19,12 @@ import numpy as np
 
 from ..integrate import Trajectory, get_method, simulate
 from ..system import System
-from .classify import DIMENSION_POINTS, Classification, classify_points
-from .lyapunov import LyapunovEstimate, largest_lyapunov
+from .classify import Classification
+from .lyapunov import LyapunovEstimate
 from .record import Extremes, RunRecord
+from .settle import BUDGET, FIRST_WINDOW, Settled, per_coordinate, settle
 from .spectra import extremes, meshing_states, spectrum
+from .verdict import Verdict
 
 __all__ = ["PointResult", "analyse_point", "analyse_trajectory", "classification_tolerance"]
 
@@ -33,14 +34,19 @@ class PointResult:
     """One operating point analysed, with its time series: the live object behind the
     :class:`~.record.RunRecord` that sweeps and stores keep (:meth:`record`).
 
-    ``lyapunov`` is the estimate with its running history (or None); ``spectra`` the
-    spectra the verdicts were drawn from, per coordinate (None: computed on demand).
+    ``lyapunov`` is the last window's estimate with its running history (None for a
+    periodic verdict: its exponent comes from the orbit's multipliers); ``verdict`` the
+    attractor's; ``settled`` what the continued run gave (end state, last window's
+    Poincare points, the exponent's summary); ``spectra`` per coordinate (None: computed
+    on demand).
     """
 
     trajectory: Trajectory
     lyapunov: LyapunovEstimate | None
     classification: dict[str, Classification]
     spectra: dict | None = None
+    verdict: Verdict | None = None
+    settled: Settled | None = None
 
     def record(self, values: dict | None = None, *, start: str = "default", x0=None):
         """The :class:`~.record.RunRecord` of this point: its verdicts, extremes, Poincare
@@ -49,21 +55,39 @@ class PointResult:
         ``values`` names the parameter values the caller varied (a sweep's one);
         ``start`` and ``x0`` say where the run started (None: the default state).
         """
-        tr = self.trajectory
+        tr, st = self.trajectory, self.settled
+        states = tr.system.states
+        if st is not None:
+            poincare = {s: st.points[k].copy() for k, s in enumerate(states)}
+            x_final, lyap = st.x_final.copy(), st.lyapunov
+        else:
+            poincare = {s: tr.poincare[k].copy() for k, s in enumerate(states)}
+            x_final, lyap = tr.x_final.copy(), None
         return RunRecord(
             values={k: float(v) for k, v in (values or {}).items()},
             status=tr.status,
             classification=dict(self.classification),
-            extremes={s: Extremes(e["max"], e["min"]) for s, e in extremes(tr).items()},
+            extremes=self._extremes(),
             start=start,
             x0=None if x0 is None else np.array(x0, dtype=float),
             meshing_states=meshing_states(tr),
-            lyapunov=None if self.lyapunov is None else self.lyapunov.describe(),
+            lyapunov=lyap,
             spectra={c: self._spectrum(c).describe() for c in tr.system.coordinates},
-            poincare={s: tr.poincare[k].copy() for k, s in enumerate(tr.system.states)},
-            x_final=tr.x_final.copy(),
+            poincare=poincare,
+            x_final=x_final,
             integration=tr.describe(),
+            verdict=None if self.verdict is None else self.verdict.describe(),
         )
+
+    def _extremes(self) -> dict:
+        """Per state: over the last continued window when the run was continued (the
+        attractor it settled on), else over the sampled window."""
+        st = self.settled
+        if st is not None and st.extremes is not None:
+            lo, hi = st.extremes
+            states = self.trajectory.system.states
+            return {s: Extremes(float(hi[k]), float(lo[k])) for k, s in enumerate(states)}
+        return {s: Extremes(e["max"], e["min"]) for s, e in extremes(self.trajectory).items()}
 
     def describe(self, poincare: bool = True) -> dict:
         """The point's summary (its :meth:`record`) with the system's description."""
@@ -76,6 +100,7 @@ class PointResult:
             "meshing_states": rec.meshing_states,
             "spectra": rec.spectra,
             "lyapunov": rec.lyapunov,
+            "verdict": rec.verdict,
         }
         if poincare:
             out["poincare"] = {s: v.tolist() for s, v in rec.poincare.items()}
@@ -120,16 +145,17 @@ def analyse_point(
     transient: int = 300,
     periods: int = 100,
     samples_per_period: int = 64,
-    lyapunov_periods: int = 200,
+    lyapunov_periods: int = FIRST_WINDOW,
     steps_per_period: int = 512,
     on_invalid: str = "warn",
-    dimension_points: int = DIMENSION_POINTS,
+    budget: int = BUDGET,
 ) -> PointResult:
-    """Simulate, estimate the largest exponent from the end state, classify each mesh.
+    """Simulate, then judge the attractor (see the module text).
 
     ``method`` defaults to the fastest that meets ``rtol`` (see :func:`simulate`).
-    ``dimension_points``: Poincare points a non-periodic verdict is decided on (the run
-    is extended when the window has fewer; 0: never extend, see the module docstring).
+    ``lyapunov_periods``: the first continued window, over which the exponent runs (each
+    next window twice as long; 0: no exponent, so only periodic verdicts can settle).
+    ``budget``: periods the verdict may take in all, counted from the run's start.
     """
     tr = simulate(
         system,
@@ -150,7 +176,7 @@ def analyse_point(
         lyapunov_periods=lyapunov_periods,
         steps_per_period=steps_per_period,
         on_invalid=on_invalid,
-        dimension_points=dimension_points,
+        budget=budget,
     )
 
 
@@ -159,76 +185,43 @@ def analyse_trajectory(
     *,
     rtol: float = 1e-8,
     atol: float = 1e-10,
-    lyapunov_periods: int = 200,
+    lyapunov_periods: int = FIRST_WINDOW,
     steps_per_period: int = 512,
     on_invalid: str = "warn",
-    dimension_points: int = DIMENSION_POINTS,
+    budget: int = BUDGET,
 ) -> PointResult:
     """The analysis of :func:`analyse_point` on a simulated trajectory (from
-    ``simulate`` or ``simulate_many``): the exponent from its end state, then the
-    verdict per mesh, with the sample extended for a non-periodic one."""
+    ``simulate`` or ``simulate_many``): the attractor's verdict from the run's end on,
+    and each coordinate's spread."""
     system = tr.system
-    lyap = None
-    if tr.status == "ok" and lyapunov_periods > 0:
-        # The variational equations at the run's own tolerances (compiled DOP853, or
-        # CVODES without a compiler: see lyapunov.py).
-        try:
-            lyap = largest_lyapunov(
-                system,
-                tr.x_final,
-                t0=tr.t_final,
-                periods=lyapunov_periods,
-                rtol=max(rtol, 1e-13),
-                atol=max(atol, 1e-15),
-            )
-        except (FloatingPointError, RuntimeError):
-            lyap = None
-    tol = classification_tolerance(tr.method, rtol)
-    verdicts = {}
-    if tr.status == "invalid":
-        why = {"why": tr.message}
+    coords = system.coordinates
+    if tr.status != "ok":
+        motion = "divergent" if tr.status == "divergent" else "undetermined"
+        why = {"why": tr.message} if motion == "undetermined" else {}
+        verdict = Verdict(motion, None, tr.transient + tr.periods, why)
         return PointResult(
-            tr, None, {c: Classification("undetermined", None, why) for c in system.coordinates}
+            tr, None, {c: Classification(motion, None, why) for c in coords}, None, verdict
         )
-    spectra = {c: spectrum(tr, c) for c in system.coordinates} if tr.status == "ok" else None
-    for c in system.coordinates:
-        i, j = system.index(c), system.velocity_index(c)
-        points = tr.poincare[[i, j]]
-        verdicts[c] = classify_points(
-            points,
-            tol=tol,
-            lyapunov=lyap,
-            divergent=tr.status == "divergent",
-            period=system.period,
-            spectrum_peaks=spectra[c].peaks() if spectra else None,
-        )
-    unsettled = [c for c, k in verdicts.items() if k.period is None and k.motion != "divergent"]
-    more = dimension_points - tr.poincare.shape[1]
-    if unsettled and more > 0 and tr.status == "ok":
-        ext = simulate(
-            system,
-            tr.x_final,
-            method=tr.method,
-            rtol=rtol,
-            atol=atol,
-            t0=tr.t_final,
-            transient=0,
-            periods=more,
-            samples_per_period=1,
-            steps_per_period=steps_per_period,
-            on_invalid=on_invalid,
-        )
-        if ext.status == "ok":
-            poincare = np.concatenate([tr.poincare, ext.poincare], axis=1)
-            for c in unsettled:
-                i, j = system.index(c), system.velocity_index(c)
-                k = classify_points(
-                    poincare[[i, j]],
-                    tol=tol,
-                    lyapunov=lyap,
-                    period=system.period,
-                    spectrum_peaks=verdicts[c].evidence.get("spectrum_peaks"),
-                )
-                k.evidence["extended_from"] = int(tr.poincare.shape[1])
-                verdicts[c] = k
-    return PointResult(tr, lyap, verdicts, spectra)
+    del on_invalid  # the continued windows record a valid-range exit as the first run did
+    cloud = max(float(np.ptp(tr.poincare, axis=1).max()), 1.0)
+    st = settle(
+        system,
+        tr.poincare,
+        tr.x_final,
+        tr.t_final,
+        periods_run=tr.transient + tr.periods,
+        tol=classification_tolerance(tr.method, rtol) * cloud,
+        method=tr.method,
+        rtol=rtol,
+        atol=atol,
+        steps_per_period=steps_per_period,
+        budget=max(budget, tr.transient + tr.periods),
+        first_window=max(lyapunov_periods, 100),
+        exponent=lyapunov_periods > 0,
+    )
+    v = st.verdict
+    spectra = {c: spectrum(tr, c) for c in coords}
+    verdicts = per_coordinate(
+        system, v, {c: {"spectrum_peaks": spectra[c].peaks()} for c in coords}
+    )
+    return PointResult(tr, st.estimate, verdicts, spectra, v, st)

@@ -51,7 +51,12 @@ class RunRecord:
     status : str
         ``ok``, ``divergent``, ``invalid`` or ``failed`` (then ``error`` says why).
     classification : dict
-        coordinate -> :class:`Classification` (motion, period, evidence).
+        coordinate -> :class:`Classification`: the attractor's motion and period, and the
+        coordinate's own spread as evidence.
+    verdict : dict or None
+        The attractor's verdict with all its evidence (``verdict.Verdict.describe``:
+        motion, period, periods run, the shooting check or each window's exponent and
+        0-1 test); None for runs classified before verdicts were per attractor.
     extremes : dict
         state -> :class:`Extremes` over the sampled window.
     poincare : dict
@@ -88,6 +93,7 @@ class RunRecord:
     integration: dict = field(default_factory=dict)
     error: str | None = None
     attempts: int | None = None
+    verdict: dict | None = None
 
     @classmethod
     def failed(cls, system, values: dict, error: Exception, attempts: int, **start) -> RunRecord:
@@ -180,6 +186,8 @@ class RunRecord:
         out["integration"] = self.integration
         if self.attempts is not None:
             out["attempts"] = self.attempts
+        if self.verdict is not None:
+            out["verdict"] = self.verdict
         return out
 
     @classmethod
@@ -204,4 +212,5 @@ class RunRecord:
             integration=d.get("integration", {}),
             error=d.get("error"),
             attempts=d.get("attempts"),
+            verdict=d.get("verdict"),
         )

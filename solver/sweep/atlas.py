@@ -33,6 +33,7 @@ import numpy as np
 
 from .._json import dumps
 from ..analysis.record import RunRecord
+from ..analysis.settle import BUDGET
 from ..contract import Contract, load_generated
 from ..executor import map_tasks
 from ..integrate.run import Batch, decide_backend, integrate
@@ -40,6 +41,7 @@ from ..integrate.simulate import default_initial_state
 from ..integrate.spec import RunSpec
 from ..system import System
 from .attractors import group_runs, outcome
+from .borders import BORDER_BUDGET, map_looks, run_look
 from .maps_result import Cell, RegimeMap
 from .progress import Progress
 from .store import RunStore
@@ -107,6 +109,9 @@ def _run_column(col: _Column, X0: np.ndarray, opts: dict) -> list[RunRecord]:
                 atol=opts["atol"],
                 values=col.values[i],
                 x0=X0[i],
+                t_end=opts["spec"].t0 + (opts["transient"] + opts["periods"]) * system.period,
+                method=opts["method"],
+                budget=opts["budget"],
             )
     return out  # type: ignore[return-value]
 
@@ -149,7 +154,7 @@ def _task(task: _Task) -> list[tuple[str, int, list[RunRecord]]]:
         done.append((col.kind, col.ix, runs))
         # the next column of a chain starts where this one ended (or, after a failure,
         # from the column's own start)
-        ends = [r.tail[-1] if r.status == "ok" else None for r in runs]
+        ends = [r.x_final if r.status == "ok" else None for r in runs]
         start = col.X0 if col.X0 is not None else x0
         x0 = np.array([e if e is not None else start[k] for k, e in enumerate(ends)])
     return done
@@ -175,6 +180,7 @@ def regime_map(
     store: str | Path | None = None,
     progress: bool = False,
     resolve=None,
+    budget: int = BUDGET,
 ) -> RegimeMap:
     """Map the attractors of ``system`` over ``x = (name, values)`` by ``y``.
 
@@ -221,6 +227,7 @@ def regime_map(
         lyapunov_periods=lyapunov_periods,
         seed=seed,
         tol=classification_tolerance(method, rtol),
+        budget=budget,
     )
     hashes = sorted({g.model_hash for col in grid for g in col})
     nx, ny = len(xv), len(yv)
@@ -297,10 +304,15 @@ def regime_map(
             per = 1 if kind != "random" else n_random
             for k, r in enumerate(column_runs):
                 runs.setdefault((ix, k // per), []).append(r)
+    runs = {cell: _ordered(rs) for cell, rs in runs.items()}
+    looks = map_looks(runs, grid, (nx, ny), _look_options(opts))
+    if looks:
+        looked = map_tasks(run_look, [lk for _, _, lk in looks], executor=executor, workers=workers)
+        for (cell, k, _), r in zip(looks, looked, strict=True):
+            runs[cell][k] = r
     cells = tuple(
         tuple(
-            Cell(float(a), float(b), tuple(group_runs(_ordered(runs[(ix, iy)]))))
-            for iy, b in enumerate(yv)
+            Cell(float(a), float(b), tuple(group_runs(runs[(ix, iy)]))) for iy, b in enumerate(yv)
         )
         for ix, a in enumerate(xv)
     )
@@ -320,6 +332,13 @@ def regime_map(
         digest=hashlib.sha256(dumps([hashes, xv.tolist(), yv.tolist()]).encode()).hexdigest(),
         resumed=len(stored),
     )
+
+
+def _look_options(opts: dict) -> dict:
+    """What a border run's re-examination needs of the map's options."""
+    keys = ("tol", "method", "rtol", "atol")
+    budget = max(BORDER_BUDGET, opts["budget"])
+    return {k: opts[k] for k in keys} | {"budget": budget}
 
 
 def _ordered(runs: list[RunRecord]) -> list[RunRecord]:

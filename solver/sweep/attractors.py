@@ -28,9 +28,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..analysis.classify import Classification, classify_points
+from ..analysis.classify import Classification
 from ..analysis.lyapunov import LyapunovEstimate
 from ..analysis.record import Extremes, RunRecord
+from ..analysis.settle import BUDGET, FIRST_WINDOW, per_coordinate, settle
 
 __all__ = ["Attractor", "group_runs", "meshing_regime", "outcome"]
 
@@ -68,16 +69,36 @@ def outcome(
     values: dict | None = None,
     x0=None,
     engine: str,
+    t_end: float = 0.0,
+    method: str = "dop853",
+    budget: int = BUDGET,
+    first_window: int = FIRST_WINDOW,
 ) -> RunRecord:
-    """The record of one run of a map: ``poincare`` (K, n) its Poincare points,
-    ``xmin``/``xmax`` (n,) its extremes, ``running`` its running exponent (or None);
-    ``values`` the grid point's named values, ``x0`` (n,) where it started; ``engine``
-    names what integrated it (the exponent's record says so).  The record keeps the last
-    64 Poincare points, the whole window's spread per coordinate, and of the evidence
-    the reason of an undetermined verdict (``why``)."""
+    """The record of one run of a map: ``poincare`` (K + 1, n) its Poincare points and
+    end state, ``xmin``/``xmax`` (n,) its extremes, ``running`` its running exponent over
+    the last periods (or None); ``values`` the grid point's named values, ``x0`` (n,)
+    where it started, ``t_end`` where it ended (tau); ``engine`` names what integrated it.
+    The run is judged and continued as ``analysis.settle`` says (``budget`` periods in
+    all).  The record keeps the last 64 Poincare points, the spread per coordinate, and
+    the verdict's summary (``Verdict.summary``)."""
     c = system.contract
+    if status != "ok":
+        motion = "divergent" if status == "divergent" else "undetermined"
+        return RunRecord(
+            values=dict(values or {}),
+            status=status,
+            classification={k: Classification(motion, None, {}) for k in system.coordinates},
+            extremes={
+                s: Extremes(float(xmax[k]), float(xmin[k])) for k, s in enumerate(system.states)
+            },
+            start=start,
+            x0=None if x0 is None else np.array(x0, dtype=float),
+            meshing_regime={k: "undetermined" for k in c.contact},
+            poincare={s: np.asarray(poincare[-64:, k], float) for k, s in enumerate(system.states)},
+            verdict={"motion": motion, "period": None, "periods_run": None},
+        )
     lyap = None
-    if running is not None and status == "ok" and np.all(np.isfinite(running)):
+    if running is not None and np.all(np.isfinite(running)):
         half = running[len(running) // 2 :]
         lyap = LyapunovEstimate(
             float(running[-1]),
@@ -89,26 +110,35 @@ def outcome(
             engine,
             system.period,
         )
-    verdicts, spread = {}, {}
-    for coord in system.coordinates:
-        i, j = c.index(coord), c.velocity(coord)
-        pts = poincare[:, [i, j]].T
-        spread[coord] = float(np.ptp(pts[0])) if np.all(np.isfinite(pts)) else None
-        if status == "ok":
-            v = classify_points(pts, tol=tol, lyapunov=lyap, period=system.period)
-            why = {"why": v.evidence["why"]} if "why" in v.evidence else {}
-            verdicts[coord] = Classification(v.motion, v.period, why)
-        else:
-            motion = "divergent" if status == "divergent" else "undetermined"
-            verdicts[coord] = Classification(motion, None, {})
-    meshing = {}
-    for coord, (lower, upper) in c.contact.items():
-        k = c.index(coord)
-        meshing[coord] = (
-            meshing_regime(xmin[k], xmax[k], lower, upper) if status == "ok" else "undetermined"
-        )
-    tail = np.asarray(poincare[-min(len(poincare), 2 * 32) :], float)
-    summary = None if lyap is None else {"exponent": lyap.exponent, "uncertainty": lyap.uncertainty}
+    K = poincare.shape[0] - 1
+    st = settle(
+        system,
+        np.asarray(poincare[:-1], float).T,
+        poincare[-1],
+        t_end,
+        periods_run=int(round(t_end / system.period)),
+        tol=tol * max(float(np.ptp(poincare, axis=0).max()), 1.0),
+        method=method,
+        rtol=rtol,
+        atol=atol,
+        budget=budget,
+        first_window=first_window,
+        exponent=running is not None,
+        lyapunov=lyap if lyap is not None and len(running) >= K else None,
+    )
+    v = st.verdict
+    if st.extremes is not None:
+        xmin, xmax = st.extremes
+    spreads = v.evidence.get("spread", {})
+    verdicts = per_coordinate(system, v)
+    meshing = {
+        k: meshing_regime(xmin[c.index(k)], xmax[c.index(k)], lower, upper)
+        for k, (lower, upper) in c.contact.items()
+    }
+    tail = np.asarray(st.points[:, -64:], float)
+    summary = st.lyapunov
+    if summary is not None:
+        summary = {"exponent": summary["exponent"], "uncertainty": summary["uncertainty"]}
     return RunRecord(
         values=dict(values or {}),
         status=status,
@@ -118,8 +148,10 @@ def outcome(
         x0=None if x0 is None else np.array(x0, dtype=float),
         meshing_regime=meshing,
         lyapunov=summary,
-        poincare={s: tail[:, k].copy() for k, s in enumerate(system.states)},
-        spread=spread,
+        poincare={s: tail[k].copy() for k, s in enumerate(system.states)},
+        spread={k: e["displacement"] for k, e in spreads.items()},
+        x_final=st.x_final.copy(),
+        verdict=v.summary(),
     )
 
 

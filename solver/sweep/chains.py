@@ -36,7 +36,7 @@ _SIMULATE = (
     *("steps_per_period", "on_invalid"),
 )
 _ANALYSE = ("rtol", "atol", "lyapunov_periods", "steps_per_period", "on_invalid")
-_ANALYSE += ("dimension_points",)
+_ANALYSE += ("budget",)
 
 
 @dataclass(frozen=True)

@@ -41,7 +41,7 @@ __all__ = [
     "write_atomic",
 ]
 
-STORE_FORMAT = 2
+STORE_FORMAT = 3  # 3: one verdict per attractor, with its evidence (issue 27)
 _MANIFEST = "manifest.json"
 _RUNS = "points"  # the runs' files: <first key>-<count>.json
 

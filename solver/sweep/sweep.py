@@ -27,6 +27,7 @@ from .._json import dumps
 from ..analysis.record import RunRecord
 from ..executor import EXECUTORS, map_tasks
 from ..system import System
+from .borders import reexamine_sweep
 from .chains import Chain, ChainDone, checked_values, module_ref, plan, run_chain
 from .progress import Progress
 from .result import SweepResult
@@ -225,6 +226,9 @@ class _Planned:
         order = order[::-1] if self.backward else order
         points = [found[i] for i in order]
         stored = [texts.get(i) for i in order]
+        looked = reexamine_sweep(self.system, self.parameter, points, self.settings)
+        if any(a is not b for a, b in zip(looked, points, strict=True)):
+            points, stored = looked, [None]  # re-examined points: their stored text is old
         settings = dict(self.settings, x0=self.x0)
         direction = _direction(self.continuation, self.backward)
         result = _result(self.system, self.parameter, self.values, direction, settings, points)

@@ -29,13 +29,17 @@ def test_simulate_json_has_the_verdicts_and_their_evidence(capsys):
     assert set(data["poincare"]) == {"u", "v", "du", "dv"} and len(data["poincare"]["u"]) == 32
     for c in ("u", "v"):
         verdict = data["classification"][c]
-        assert verdict["motion"] == "period-1" and "lyapunov" in verdict["evidence"]
+        assert verdict["motion"] == "period-1" and "spread" in verdict["evidence"]
         assert data["extremes"][c]["max"] > data["extremes"][c]["min"]
         shares = data["meshing_states"][c]
         assert sum(shares.values()) == pytest.approx(1.0)
         assert data["spectra"][c]["peaks"][0]["frequency"] == pytest.approx(0.5, abs=0.01)
     assert data["integration"]["method"] == "cvodes"
     assert data["system"]["values"] == {"lambda": 0.8}
+    # one verdict for the attractor, on the shooting check's evidence
+    orbit = data["verdict"]["evidence"]["orbit"]
+    assert data["verdict"]["motion"] == "period-1" and orbit["attracting"]
+    assert data["lyapunov"]["exponent"] < 0 and "multipliers" in data["lyapunov"]["method"]
 
 
 def test_simulate_rejects_unknown_parameters_in_one_line(capsys):

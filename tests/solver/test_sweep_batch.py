@@ -85,7 +85,8 @@ def test_batched_sweep_equals_point_by_point(light, batched):
             assert point.max(s) == pytest.approx(tr.x[k].max(), abs=1e-6)
             assert point.min(s) == pytest.approx(tr.x[k].min(), abs=1e-6)
             assert np.allclose(point.poincare[s], tr.poincare[k], rtol=0, atol=1e-6)
-        assert point.lyapunov is None
+        # no tangent vector run: a periodic verdict's exponent is its orbit's, log|mu|/nT
+        assert "multipliers" in point.lyapunov["method"] and point.lyapunov["exponent"] < 0
     assert [p.motion("u") for p in batched.points][1:4] == ["period-3", "period-1", "period-12"]
 
 
@@ -129,7 +130,8 @@ def test_cli_sweep_of_independent_points(tmp_path, capsys):
     assert main(args) == 0
     data = json.loads((out / "sweep.json").read_text())
     assert data["direction"] == "independent" and len(data["points"]) == 8
-    assert all(p["status"] == "ok" and p["lyapunov"] is None for p in data["points"])
+    assert all(p["status"] == "ok" for p in data["points"])
+    assert all("multipliers" in p["lyapunov"]["method"] for p in data["points"])
     assert (out / "bifurcation.png").stat().st_size > 0
     assert "u: period-1 on [0, 1]" in capsys.readouterr().out
 

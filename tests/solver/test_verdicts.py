@@ -1,6 +1,6 @@
 """Verdicts a user can trust (issue 12, point 5): minimal period, neutral Floquet
 multipliers, an honest Lyapunov uncertainty, the Poincare cloud's extent, the adaptive
-sample for the correlation dimension."""
+sample for the correlation dimension (now: test_verdict_evidence.py)."""
 
 import numpy as np
 import pytest
@@ -144,19 +144,3 @@ def test_a_small_cloud_is_reported_with_its_extent():
     ev = classify_points(cloud, tol=1e-6).evidence
     assert ev["poincare_extent"]["displacement"] == pytest.approx(np.ptp(cloud[0]))
     assert ev["poincare_extent"]["velocity"] == pytest.approx(np.ptp(cloud[1]))
-
-
-def test_chaos_is_decided_on_an_extended_poincare_sample(duffing):
-    # Ueda's oscillator (chaotic, Ueda 1979): 100 sampled periods are extended to 400
-    # before the correlation dimension is taken; with the extension off the limit is
-    # stated in the evidence.
-    r = analyse_point(duffing, np.array([2.5, 0.0]), transient=100, lyapunov_periods=100)
-    ev = r.classification["x"].evidence
-    assert r.classification["x"].motion == "chaotic"
-    assert ev["poincare_points"] == 400 and ev["extended_from"] == 100
-    assert "sample_limit" not in ev and ev["correlation_dimension"] > 1.15
-    short = analyse_point(
-        duffing, np.array([2.5, 0.0]), transient=100, lyapunov_periods=0, dimension_points=0
-    )
-    ev = short.classification["x"].evidence
-    assert ev["poincare_points"] == 100 and "sample_limit" in ev

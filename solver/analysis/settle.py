@@ -1,0 +1,253 @@
+"""Run on until the verdict is settled or the budget is spent.
+
+``settle`` takes a run where it stands -- its Poincare points so far, its end state and
+time -- and judges it (``verdict.py``).  A period-n verdict needs no more than the
+shooting check; anything else is continued **from the run's end state** in windows of
+``first_window``, then twice, four times ... as many periods, each run with the tangent
+vector (the exponent over the window) and judged on its own, until the last two windows
+agree (chaotic, or a torus) or ``budget`` periods (counted from the run's start) are spent.
+The verdict records the periods it took and every window's evidence; a periodic verdict
+after chaotic windows records the chaotic transient and bounds its length.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..integrate import get_method, simulate
+from ..integrate.run import integrate
+from ..integrate.spec import RunSpec
+from ..system import System
+from .classify import Classification
+from .lyapunov import LyapunovEstimate, largest_lyapunov
+from .orbit_check import OrbitCheck, check_orbit
+from .verdict import Verdict, Window, candidates, judge, settled, spread
+
+__all__ = ["BUDGET", "FIRST_WINDOW", "Settled", "per_coordinate", "settle"]
+
+BUDGET = 3000  # periods a verdict may take, counted from the run's start
+FIRST_WINDOW = 400  # the first continued window; each next one is twice as long
+KEEP = 1000  # Poincare points of the last window a record keeps
+
+
+@dataclass(frozen=True)
+class Settled:
+    """The verdict, the last window's Poincare points (n, K <= KEEP), where the run ended,
+    the exponent's summary (a dict, or None), the orbit of a periodic verdict, and the
+    last window's exponent estimate with its running history (or None), and the state
+    extremes ``(xmin, xmax)`` over the last continued window (None: not continued)."""
+
+    verdict: Verdict
+    points: np.ndarray
+    x_final: np.ndarray
+    t_final: float
+    lyapunov: dict | None
+    orbit: OrbitCheck | None
+    estimate: LyapunovEstimate | None = None
+    extremes: tuple | None = None
+
+
+def _periodic(system: System, w: Window, x_end, t_end, tol: float) -> OrbitCheck | None:
+    """The attracting orbit the window's run is on or converging to, or None."""
+    strict, near = candidates(w.points, tol)
+    tried = set()
+    for n in [m for m in (strict, *near) if m is not None]:
+        check = check_orbit(system, x_end, n, t0=t_end)
+        tried.add(n)
+        m = check.minimal_period
+        if check.converged and m is not None and m < n and m not in tried:
+            check = check_orbit(system, check.x, m, t0=t_end)
+            tried.add(m)
+        if check.attracting:
+            return check
+    return None
+
+
+def _extend(system, x, t, periods: int, run: dict, exponent: bool):
+    """``periods`` more periods from state ``x`` at time ``t``: Poincare points (n, L),
+    end state, status, the exponent over them (or None), extremes (xmin, xmax)."""
+    if get_method(run["method"]).family == "native":
+        spec = RunSpec(
+            method=run["method"],
+            rtol=run["rtol"],
+            atol=run["atol"],
+            t0=t,
+            transient=0,
+            periods=periods,
+            steps_per_period=run["steps_per_period"],
+            collect=("samples", "extremes", "exponent") if exponent else ("samples", "extremes"),
+            lyapunov_periods=periods if exponent else 0,
+        )
+        res = integrate(system, x, spec)
+        status, X = res.status[0], res.x[0]
+        lyap = None
+        if exponent and status == "ok":
+            running = res.exponent[0]
+            half = running[periods // 2 :]
+            lyap = LyapunovEstimate(
+                float(running[-1]),
+                running,
+                periods,
+                float(np.ptp(half)),
+                run["rtol"],
+                run["atol"],
+                res.label,
+                system.period,
+            )
+        return X[:periods].T, X[-1].copy(), status, lyap, (res.xmin[0], res.xmax[0])
+    tr = simulate(
+        system,
+        x,
+        method=run["method"],
+        rtol=run["rtol"],
+        atol=run["atol"],
+        t0=t,
+        transient=0,
+        periods=periods,
+        samples_per_period=1,
+        steps_per_period=run["steps_per_period"],
+    )
+    lyap = None
+    if exponent and tr.status == "ok":
+        try:
+            lyap = largest_lyapunov(system, x, t0=t, periods=periods, rtol=run["rtol"])
+        except (FloatingPointError, RuntimeError):
+            lyap = None
+    return tr.poincare, tr.x_final.copy(), tr.status, lyap, (tr.x.min(axis=1), tr.x.max(axis=1))
+
+
+def settle(
+    system: System,
+    points: np.ndarray,
+    x_end,
+    t_end: float,
+    *,
+    periods_run: int,
+    tol: float,
+    method: str = "dop853",
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    steps_per_period: int = 512,
+    budget: int = BUDGET,
+    first_window: int = FIRST_WINDOW,
+    exponent: bool = True,
+    lyapunov: LyapunovEstimate | None = None,
+    min_periods: int = 0,
+) -> Settled:
+    """Judge a run that has gone ``periods_run`` periods, ending with the Poincare points
+    ``points`` (n, K), at state ``x_end`` and time ``t_end``; continue it as the module
+    text says.  ``tol``: how close Poincare points repeat (absolute, half backlashes);
+    ``lyapunov``: the exponent over the same periods as ``points``, if the run had one;
+    ``min_periods``: a chaotic or quasi-periodic verdict is not settled before the run has
+    gone this far (the long budget of a border point: a chaotic transient has time to end).
+    """
+    run = {"method": method, "rtol": rtol, "atol": atol, "steps_per_period": steps_per_period}
+    x_end = np.asarray(x_end, dtype=float)
+    w = Window(periods_run - points.shape[1], points, lyapunov)
+    judged: list[dict] = []
+    length, ext = first_window, None
+    while True:
+        done = _verdict(
+            system, w, x_end, t_end, judged, periods_run, tol, budget, exponent, min_periods
+        )
+        if done is not None:
+            return replace(done, extremes=ext)
+        L = min(length, budget - periods_run)
+        length *= 2
+        pts, x_new, status, lyap, ext = _extend(system, x_end, t_end, L, run, exponent)
+        periods_run += L
+        if status != "ok":
+            motion = "divergent" if status == "divergent" else "undetermined"
+            why = {"why": f"the continued run stopped: {status}"}
+            v = Verdict(motion, None, periods_run, {"windows": judged} | why)
+            return Settled(v, w.points[:, -KEEP:], x_end, t_end, None, None)
+        w = Window(w.end, pts, lyap)
+        x_end, t_end = x_new, t_end + L * system.period
+
+
+def _verdict(system, w, x_end, t_end, judged, periods_run, tol, budget, exponent, min_periods):
+    """The settled verdict after window ``w`` (appending its judgement), or None: go on."""
+    orbit = _periodic(system, w, x_end, t_end, tol)
+    if orbit is not None:
+        return _settled_periodic(system, w, x_end, t_end, orbit, judged, periods_run, tol)
+    if w.lyapunov is not None:
+        judged.append(judge(system, w, tol))
+        label = settled(judged)
+        if label is not None and (periods_run >= min_periods or budget - periods_run < 100):
+            motion = "chaotic" if label == "chaotic" else "quasi-periodic"
+            return _done(system, w, x_end, t_end, motion, judged, periods_run)
+    if budget - periods_run < 100:
+        return _undetermined(system, w, x_end, t_end, judged, periods_run, exponent)
+    return None
+
+
+def _settled_periodic(system, w, x_end, t_end, orbit, judged, periods_run, tol) -> Settled:
+    n = orbit.n
+    gaps = np.max(np.abs(w.points[:, n:] - w.points[:, :-n]), axis=0)
+    evidence = {
+        "orbit": orbit.describe(),
+        "repeat_tolerance": tol,
+        "last_gap": float(gaps[-1]) if gaps.size else None,
+        "converging": bool(gaps.size and gaps.max() > tol),
+        "spread": spread(system, w.points),
+        "windows": judged,
+    }
+    chaotic = [j for j in judged if j["label"] == "chaotic"]
+    if chaotic:
+        evidence["transient_chaos"] = {
+            "chaotic_until_at_least": chaotic[-1]["window"][1],
+            "periodic_by": periods_run,
+            "text": (
+                f"chaotic transient: chaotic up to period {chaotic[-1]['window'][1]}, on the "
+                f"period-{n} orbit by period {periods_run}"
+            ),
+        }
+    lyap = {
+        "exponent": orbit.exponent(system.period),
+        "uncertainty": 0.0,
+        "method": "log max|mu| / (n T) of the shooting check's multipliers",
+        "units": "per unit tau",
+    }
+    v = Verdict(f"period-{n}", n, periods_run, evidence)
+    return Settled(v, w.points[:, -KEEP:], x_end, t_end, lyap, orbit)
+
+
+def _lyap_summary(w: Window) -> dict | None:
+    return None if w.lyapunov is None else w.lyapunov.describe()
+
+
+def _done(system, w, x_end, t_end, motion, judged, periods_run) -> Settled:
+    evidence = {"spread": spread(system, w.points), "windows": judged}
+    v = Verdict(motion, None, periods_run, evidence)
+    return Settled(v, w.points[:, -KEEP:], x_end, t_end, _lyap_summary(w), None, w.lyapunov)
+
+
+def _undetermined(system, w, x_end, t_end, judged, periods_run, exponent) -> Settled:
+    if not exponent:
+        why = "no attracting periodic orbit found, and the exponent was not computed"
+    elif judged:
+        why = judged[-1].get("why") or (
+            f"the last window reads {judged[-1]['label']}, the one before does not agree"
+        )
+    else:
+        why = "no attracting periodic orbit found, and no window was judged"
+    evidence = {"why": f"{why} (after {periods_run} periods)", "windows": judged}
+    evidence["spread"] = spread(system, w.points)
+    v = Verdict("undetermined", None, periods_run, evidence)
+    return Settled(v, w.points[:, -KEEP:], x_end, t_end, _lyap_summary(w), None, w.lyapunov)
+
+
+def per_coordinate(system: System, v: Verdict, extra: dict | None = None) -> dict:
+    """coordinate -> :class:`Classification`: the attractor's motion and period, with the
+    coordinate's spread (and the reason of an undetermined verdict) as its evidence;
+    ``extra`` maps coordinates to more evidence (spectral peaks, say)."""
+    spreads = v.evidence.get("spread", {})
+    out = {}
+    for c in system.coordinates:
+        ev = {"spread": spreads.get(c), **((extra or {}).get(c) or {})}
+        if "why" in v.evidence:
+            ev["why"] = v.evidence["why"]
+        out[c] = Classification(v.motion, v.period, ev)
+    return out

@@ -1,0 +1,182 @@
+"""Sweeps and maps look again where neighbours disagree.
+
+A verdict settles on the evidence of its last windows; near a bifurcation (a border
+between two kinds of motion) that evidence is weakest and a chaotic transient longest.
+So after a sweep or a map, every run whose motion differs from a neighbour's (the next
+value of a sweep; the four grid neighbours of a map) and whose verdict is not a
+confirmed periodic orbit is continued **from where it ended** with the long budget
+``BORDER_BUDGET``, a chaotic or quasi-periodic label needing that many periods
+(``settle(min_periods=...)``), and the shooting check at every window.  A run already on an
+attracting periodic orbit (the shooting check's multipliers inside the unit circle) is
+not run again: a longer run cannot leave it.  Re-examined runs say so in their verdict
+(``reexamined``: the periods before and the budget).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..analysis.record import Extremes, RunRecord
+from ..analysis.settle import BUDGET, per_coordinate, settle
+from ..contract import load_generated
+from ..system import System
+
+__all__ = [
+    "BORDER_BUDGET",
+    "Look",
+    "border_cells",
+    "border_indices",
+    "map_looks",
+    "reexamine",
+    "reexamine_sweep",
+]
+
+BORDER_BUDGET = 8000  # periods a border run's verdict may take, from the run's start
+
+
+def _kind(r: RunRecord) -> str:
+    first = next(iter(r.classification.values()), None)
+    return r.status if first is None or r.status != "ok" else first.motion
+
+
+def border_indices(runs: list[RunRecord]) -> list[int]:
+    """Indices of a sweep's runs whose motion differs from the next or previous run's."""
+    kinds = [_kind(r) for r in runs]
+    out = set()
+    for i in range(len(kinds) - 1):
+        if kinds[i] != kinds[i + 1]:
+            out.update((i, i + 1))
+    return sorted(out)
+
+
+def border_cells(kinds: np.ndarray) -> list[tuple[int, int]]:
+    """Cells (i, j) of a grid of motion labels that differ from a 4-neighbour."""
+    nx, ny = kinds.shape
+    out = set()
+    for i in range(nx):
+        for j in range(ny):
+            for a, b in ((i + 1, j), (i, j + 1)):
+                if a < nx and b < ny and kinds[i, j] != kinds[a, b]:
+                    out.update(((i, j), (a, b)))
+    return sorted(out)
+
+
+def needs_look(r: RunRecord) -> bool:
+    """A border run is continued unless it failed or sits on a confirmed orbit."""
+    return r.ok and r.verdict is not None and r.verdict.get("period") is None
+
+
+def reexamine(
+    system: System,
+    r: RunRecord,
+    *,
+    tol: float,
+    method: str = "dop853",
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    budget: int = BORDER_BUDGET,
+) -> RunRecord:
+    """``r`` continued from its end state with the long budget (see the module text);
+    ``system`` is the model at ``r``'s values, ``tol`` the repeat tolerance relative to
+    the Poincare cloud (``point.classification_tolerance``)."""
+    if not needs_look(r) or r.x_final is None:
+        return r
+    before = int(r.verdict.get("periods_run") or 0)
+    points = r.tail.T
+    cloud = max(float(np.ptp(points, axis=1).max()), 1.0) if points.size else 1.0
+    st = settle(
+        system,
+        points,
+        r.x_final,
+        0.0,  # the run ended on a whole number of forcing periods: the phase is 0
+        periods_run=before,
+        tol=tol * cloud,
+        method=method,
+        rtol=rtol,
+        atol=atol,
+        budget=max(budget, before),
+        min_periods=budget,
+    )
+    v = st.verdict
+    summary = v.summary() | {"reexamined": {"periods_before": before, "budget": budget}}
+    keep = r.tail.shape[0]
+    lyap = st.lyapunov
+    if lyap is not None:
+        lyap = {"exponent": lyap["exponent"], "uncertainty": lyap["uncertainty"]}
+    changes = dict(
+        classification=per_coordinate(system, v),
+        verdict=summary,
+        lyapunov=lyap,
+        poincare={s: st.points[k, -keep:].copy() for k, s in enumerate(system.states)},
+        x_final=st.x_final.copy(),
+    )
+    if st.extremes is not None:
+        lo, hi = st.extremes
+        changes["extremes"] = {
+            s: Extremes(float(hi[k]), float(lo[k])) for k, s in enumerate(system.states)
+        }
+    return replace(r, **changes)
+
+
+def reexamine_sweep(
+    system: System, parameter: str, runs: list[RunRecord], settings: dict
+) -> list[RunRecord]:
+    """A sweep's runs with its border runs re-examined (none when the sweep's ``budget``
+    setting is 0: no run may be continued)."""
+    from ..analysis.point import classification_tolerance
+    from ..integrate import fastest_method
+
+    if settings.get("budget", BUDGET) == 0:
+        return runs
+    rtol = settings.get("rtol", 1e-8)
+    method = settings.get("method") or fastest_method(rtol)
+    tol = classification_tolerance(method, rtol)
+    out = list(runs)
+    for i in border_indices(runs):
+        if needs_look(runs[i]):
+            at = system.with_values(**{parameter: runs[i].values[parameter]})
+            out[i] = reexamine(
+                at,
+                runs[i],
+                tol=tol,
+                method=method,
+                rtol=rtol,
+                atol=settings.get("atol", 1e-10),
+                budget=max(BORDER_BUDGET, settings.get("budget", BUDGET)),
+            )
+    return out
+
+
+@dataclass(frozen=True)
+class Look:
+    """One map run to re-examine, picklable for a worker: the model's file and parameter
+    vector, the run, and the options of :func:`reexamine`."""
+
+    source: str
+    p: tuple
+    record: RunRecord
+    options: dict
+
+
+def run_look(look: Look) -> RunRecord:
+    system = System(load_generated(look.source), np.asarray(look.p, float), {})
+    return reexamine(system, look.record, **look.options)
+
+
+def map_looks(runs: dict, systems, shape, options: dict) -> list[tuple[tuple, int, Look]]:
+    """The re-examinations a map needs: ``runs`` maps a cell (ix, iy) to its runs (the
+    first is the forward start's), ``systems[ix][iy]`` is the cell's model; returns
+    (cell, run index, :class:`Look`) for every run that needs a look at a border cell."""
+    kinds = np.empty(shape, dtype=object)
+    for (ix, iy), rs in runs.items():
+        kinds[ix, iy] = _kind(rs[0])
+    out = []
+    for cell in border_cells(kinds):
+        s = systems[cell[0]][cell[1]]
+        for k, r in enumerate(runs[cell]):
+            if needs_look(r):
+                look = Look(str(s.module.__file__), tuple(map(float, s.p)), r, options)
+                out.append((cell, k, look))
+    return out
