@@ -14,7 +14,8 @@ from .mesh.backlash import DEAD_ZONE_EDGES
 __all__ = ["CONTRACT_FORMAT", "FUNCTIONS", "model_contract"]
 
 # Version of the contract's layout; a solver refuses a format it does not read.
-CONTRACT_FORMAT = 1
+# 2: ``force_sign`` (where each mesh's force is zero and its sign elsewhere).
+CONTRACT_FORMAT = 2
 # What every emitted module defines (``emit/python.py``): the parameter vector, the
 # right-hand side and its Jacobian, the CasADi builders, each mesh's dynamic and static force.
 FUNCTIONS = (
@@ -43,9 +44,17 @@ def model_contract(model) -> dict:
     ``loads``
         coordinate -> its static-load parameter (coordinates that have one).
     ``contact``
-        coordinate -> ``(lower, upper)`` edges of the backlash, ``(-1.0, 1.0)`` in half
-        backlashes: forward contact for ``u > upper``, separated for
-        ``lower <= u <= upper``, backward contact for ``u < lower``.
+        coordinate -> ``(lower, upper)`` edges of the backlash gap, ``(-1.0, 1.0)`` in half
+        backlashes: the geometry (where the flanks are), whatever the force law.
+    ``force_sign``
+        coordinate -> the sign of its backlash force ``g(u)``
+        (:class:`~.mesh.force_sign.ForceSign`): ``edges`` ``(lower, upper)``, the outer
+        zeros of ``g`` (forward contact, ``g > 0``, for ``u > upper``; backward, ``g < 0``,
+        for ``u < lower``); ``zero_between``, True when ``g`` vanishes on all of
+        ``[lower, upper]`` (the teeth apart: a dead zone), False when it only crosses zero
+        there (the polynomial fit: zeros at ``0, +-0.7701``, loaded inside the gap);
+        ``zeros``, every zero of ``g`` in the valid range, sorted; ``signs``, the sign of
+        ``g`` on each interval between them (``len(zeros) + 1`` entries).
     ``piecewise``
         True when the right-hand side contains a ``Piecewise`` (it has kinks).
     ``switching_surfaces``
@@ -82,6 +91,7 @@ def model_contract(model) -> dict:
         )
     names = model.parameter_names
     valid = backlash.valid_range
+    sign = backlash.force_sign().to_contract()
     return {
         "format": CONTRACT_FORMAT,
         "states": tuple(model.states),
@@ -91,6 +101,7 @@ def model_contract(model) -> dict:
         "forcing_frequency": model.forcing_frequency,
         "loads": {c: f for c, f in model.load_parameters.items() if f in names},
         "contact": {c: tuple(float(e) for e in DEAD_ZONE_EDGES) for c in model.coordinates},
+        "force_sign": {c: dict(sign) for c in model.coordinates},
         "piecewise": bool(pieces),
         "switching_surfaces": surfaces,
         "valid_range": None if valid is None else {c: float(valid) for c in model.coordinates},

@@ -163,7 +163,7 @@ OPERATIONS = {'rhs': 119, 'rhs_and_jacobian': 200}
 # What a solver needs to know about this model, as plain data (Model.contract in
 # derive/model.py); solvers read this, never the source or the names.
 CONTRACT = {
-    'format': 1,
+    'format': 2,
     'states': ('u', 'xp', 'yp', 'zp', 'xg', 'yg', 'zg', 'du', 'dxp', 'dyp', 'dzp', 'dxg', 'dyg', 'dzg'),
     'coordinates': ('u',),
     'velocities': {'u': 7},
@@ -171,6 +171,7 @@ CONTRACT = {
     'forcing_frequency': 'omega',
     'loads': {'u': 'f_u'},
     'contact': {'u': (-1.0, 1.0)},
+    'force_sign': {'u': {'edges': (-0.7701168086601865, 0.7701168086601865), 'zero_between': False, 'zeros': (-0.7701168086601865, 0.0, 0.7701168086601865), 'signs': (-1, 1, -1, 1)}},
     'piecewise': False,
     'switching_surfaces': (),
     'valid_range': {'u': 3.0},

@@ -105,7 +105,7 @@ OPERATIONS = {'rhs': 83, 'rhs_and_jacobian': 107}
 # What a solver needs to know about this model, as plain data (Model.contract in
 # derive/model.py); solvers read this, never the source or the names.
 CONTRACT = {
-    'format': 1,
+    'format': 2,
     'states': ('u', 'v', 'du', 'dv'),
     'coordinates': ('u', 'v'),
     'velocities': {'u': 2, 'v': 3},
@@ -113,6 +113,7 @@ CONTRACT = {
     'forcing_frequency': 'omega',
     'loads': {'u': 'f_u', 'v': 'f_v'},
     'contact': {'u': (-1.0, 1.0), 'v': (-1.0, 1.0)},
+    'force_sign': {'u': {'edges': (-1.0, 1.0), 'zero_between': True, 'zeros': (-1.0, 1.0), 'signs': (-1, 0, 1)}, 'v': {'edges': (-1.0, 1.0), 'zero_between': True, 'zeros': (-1.0, 1.0), 'signs': (-1, 0, 1)}},
     'piecewise': True,
     'switching_surfaces': ((0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0)),
     'valid_range': None,

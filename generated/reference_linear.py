@@ -67,7 +67,7 @@ OPERATIONS = {'rhs': 14, 'rhs_and_jacobian': 20}
 # What a solver needs to know about this model, as plain data (Model.contract in
 # derive/model.py); solvers read this, never the source or the names.
 CONTRACT = {
-    'format': 1,
+    'format': 2,
     'states': ('u', 'v', 'du', 'dv'),
     'coordinates': ('u', 'v'),
     'velocities': {'u': 2, 'v': 3},
@@ -75,6 +75,7 @@ CONTRACT = {
     'forcing_frequency': 'omega',
     'loads': {'u': 'f_u', 'v': 'f_v'},
     'contact': {'u': (-1.0, 1.0), 'v': (-1.0, 1.0)},
+    'force_sign': {'u': {'edges': (0.0, 0.0), 'zero_between': False, 'zeros': (0.0,), 'signs': (-1, 1)}, 'v': {'edges': (0.0, 0.0), 'zero_between': False, 'zeros': (0.0,), 'signs': (-1, 1)}},
     'piecewise': False,
     'switching_surfaces': (),
     'valid_range': None,

@@ -79,7 +79,7 @@ OPERATIONS = {'rhs': 41, 'rhs_and_jacobian': 55}
 # What a solver needs to know about this model, as plain data (Model.contract in
 # derive/model.py); solvers read this, never the source or the names.
 CONTRACT = {
-    'format': 1,
+    'format': 2,
     'states': ('u', 'du'),
     'coordinates': ('u',),
     'velocities': {'u': 1},
@@ -87,6 +87,7 @@ CONTRACT = {
     'forcing_frequency': 'omega',
     'loads': {'u': 'f_u'},
     'contact': {'u': (-1.0, 1.0)},
+    'force_sign': {'u': {'edges': (-0.7701168086601865, 0.7701168086601865), 'zero_between': False, 'zeros': (-0.7701168086601865, 0.0, 0.7701168086601865), 'signs': (-1, 1, -1, 1)}},
     'piecewise': False,
     'switching_surfaces': (),
     'valid_range': {'u': 3.0},

@@ -155,7 +155,7 @@ OPERATIONS = {'rhs': 149, 'rhs_and_jacobian': 228}
 # What a solver needs to know about this model, as plain data (Model.contract in
 # derive/model.py); solvers read this, never the source or the names.
 CONTRACT = {
-    'format': 1,
+    'format': 2,
     'states': ('u', 'v', 'w', 'du', 'dv', 'dw'),
     'coordinates': ('u', 'v', 'w'),
     'velocities': {'u': 3, 'v': 4, 'w': 5},
@@ -163,6 +163,7 @@ CONTRACT = {
     'forcing_frequency': 'omega',
     'loads': {'u': 'f_u', 'v': 'f_v', 'w': 'f_w'},
     'contact': {'u': (-1.0, 1.0), 'v': (-1.0, 1.0), 'w': (-1.0, 1.0)},
+    'force_sign': {'u': {'edges': (-0.7701168086601865, 0.7701168086601865), 'zero_between': False, 'zeros': (-0.7701168086601865, 0.0, 0.7701168086601865), 'signs': (-1, 1, -1, 1)}, 'v': {'edges': (-0.7701168086601865, 0.7701168086601865), 'zero_between': False, 'zeros': (-0.7701168086601865, 0.0, 0.7701168086601865), 'signs': (-1, 1, -1, 1)}, 'w': {'edges': (-0.7701168086601865, 0.7701168086601865), 'zero_between': False, 'zeros': (-0.7701168086601865, 0.0, 0.7701168086601865), 'signs': (-1, 1, -1, 1)}},
     'piecewise': False,
     'switching_surfaces': (),
     'valid_range': {'u': 3.0, 'v': 3.0, 'w': 3.0},

@@ -291,7 +291,7 @@ OPERATIONS = {'rhs': 258, 'rhs_and_jacobian': 439}
 # What a solver needs to know about this model, as plain data (Model.contract in
 # derive/model.py); solvers read this, never the source or the names.
 CONTRACT = {
-    'format': 1,
+    'format': 2,
     'states': ('v', 'u', 'w', 'xa', 'ya', 'za', 'xb', 'yb', 'zb', 'xc', 'yc', 'zc', 'xd', 'yd', 'zd', 'dv', 'du', 'dw', 'dxa', 'dya', 'dza', 'dxb', 'dyb', 'dzb', 'dxc', 'dyc', 'dzc', 'dxd', 'dyd', 'dzd'),
     'coordinates': ('v', 'u'),
     'velocities': {'v': 15, 'u': 16},
@@ -299,6 +299,7 @@ CONTRACT = {
     'forcing_frequency': 'omega',
     'loads': {'v': 'f_v', 'u': 'f_u'},
     'contact': {'v': (-1.0, 1.0), 'u': (-1.0, 1.0)},
+    'force_sign': {'v': {'edges': (-0.7701168086601865, 0.7701168086601865), 'zero_between': False, 'zeros': (-0.7701168086601865, 0.0, 0.7701168086601865), 'signs': (-1, 1, -1, 1)}, 'u': {'edges': (-0.7701168086601865, 0.7701168086601865), 'zero_between': False, 'zeros': (-0.7701168086601865, 0.0, 0.7701168086601865), 'signs': (-1, 1, -1, 1)}},
     'piecewise': False,
     'switching_surfaces': (),
     'valid_range': {'v': 3.0, 'u': 3.0},

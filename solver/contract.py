@@ -3,22 +3,81 @@
 A generated module states as data everything the solver needs (``derive/model.py`` builds
 it, ``derive/emit/python.py`` prints it): the state and parameter order, where each coordinate's
 velocity is, which parameter sets the excitation period, which parameters are static
-loads, the contact edges of each mesh coordinate, the switching surfaces (kinks) of a
-piecewise force law and the range where the force law is valid.  The solver reads only
-this; it never parses generated source or guesses from names.
+loads, the contact edges of each mesh coordinate, where each mesh's force is zero and its
+sign elsewhere (format 2), the switching surfaces (kinks) of a piecewise force law and the
+range where the force law is valid.  The solver reads only this; it never parses
+generated source or guesses from names.
+
+Formats read: 1 (before ``force_sign``: its ``contact`` edges were stated as the dead
+zone's, force zero between them, so that is how a format-1 contract is read) and 2.
 """
 
 from __future__ import annotations
 
 import hashlib
 import importlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
 
-__all__ = ["CONTRACT_FORMAT", "Contract", "load_generated"]
+import numpy as np
 
-CONTRACT_FORMAT = 1
+__all__ = ["CONTRACT_FORMAT", "READ_FORMATS", "Contract", "ForceSign", "load_generated"]
+
+# The format this solver's derivations write (and the derivation cache's file names carry);
+# it reads every format in READ_FORMATS.
+CONTRACT_FORMAT = 2
+READ_FORMATS = (1, 2)
+
+
+@dataclass(frozen=True)
+class ForceSign:
+    """Where a mesh's backlash force ``g(u)`` is zero and its sign elsewhere.
+
+    Attributes
+    ----------
+    zeros : tuple of float
+        Sorted, distinct ``u`` (half backlashes) with ``g(u) = 0``.
+    signs : tuple of int
+        Sign (-1, 0, 1) of ``g`` on ``(-inf, zeros[0]), ..., (zeros[-1], inf)``.
+    """
+
+    zeros: tuple[float, ...]
+    signs: tuple[int, ...]
+
+    @classmethod
+    def dead_zone(cls, lower: float, upper: float) -> ForceSign:
+        """Zero on ``[lower, upper]``, the sign of ``u`` outside (format 1's reading)."""
+        return cls((lower,), (-1, 1)) if lower == upper else cls((lower, upper), (-1, 0, 1))
+
+    @property
+    def edges(self) -> tuple[float, float]:
+        """The outer zeros ``(lower, upper)``: ``g > 0`` beyond ``upper``, ``< 0`` below."""
+        return (self.zeros[0], self.zeros[-1])
+
+    @property
+    def zero_between(self) -> bool:
+        """``g`` vanishes on all of ``[lower, upper]`` (the teeth apart there)."""
+        return len(self.zeros) > 1 and all(s == 0 for s in self.signs[1:-1])
+
+    def sign(self, u) -> np.ndarray:
+        """``sign(g(u))`` elementwise (int8, same shape as ``u``); 0 at each zero."""
+        u = np.asarray(u, dtype=float)
+        z = np.asarray(self.zeros)
+        k = np.searchsorted(z, u, side="left")  # z[k-1] < u <= z[k]
+        at_zero = (k < z.size) & (z[np.minimum(k, z.size - 1)] == u)
+        return np.where(at_zero, 0, np.asarray(self.signs, dtype=np.int8)[k]).astype(np.int8)
+
+    def problems(self) -> list[str]:
+        """What is inconsistent in the table (empty when it is sound)."""
+        out = []
+        if not self.zeros or list(self.zeros) != sorted(set(self.zeros)):
+            out.append("force zeros that are not sorted and distinct")
+        if len(self.signs) != len(self.zeros) + 1 or not set(self.signs) <= {-1, 0, 1}:
+            out.append("not one sign (-1, 0, 1) per interval between the force zeros")
+        return out
+
+
 _REQUIRED = ("NAME", "CONTRACT", "parameters", "rhs", "jacobian", "casadi_functions")
 
 
@@ -37,7 +96,8 @@ class Contract:
     loads : dict
         coordinate -> name of its static-load parameter (coordinates without one absent).
     contact : dict
-        coordinate -> (lower, upper) edges of the backlash, in coordinate units.
+        coordinate -> (lower, upper) edges of the backlash gap, in coordinate units (the
+        geometry; where the force is zero is ``force_sign``).
     piecewise : bool
         The right-hand side has kinks (``switching_surfaces``) that integrators locate.
     switching_surfaces : tuple of (int, float)
@@ -47,6 +107,9 @@ class Contract:
     functions : tuple of str
         The functions the module defines for a solver (``rhs``, ``jacobian``, ...,
         ``mesh_force``, ``static_mesh_force``); each is checked to be there.
+    force_sign : dict
+        coordinate -> :class:`ForceSign` of its backlash force; a format-1 contract, or a
+        contract built without it, reads its ``contact`` edges as a dead zone.
     """
 
     states: tuple[str, ...]
@@ -60,16 +123,23 @@ class Contract:
     switching_surfaces: tuple
     valid_range: dict | None
     functions: tuple[str, ...] = ("parameters", "rhs", "jacobian", "casadi_functions")
+    force_sign: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        if not self.force_sign:
+            dead = {c: ForceSign.dead_zone(lo, hi) for c, (lo, hi) in self.contact.items()}
+            object.__setattr__(self, "force_sign", dead)
 
     @classmethod
     def of(cls, module: ModuleType) -> Contract:
         """The checked contract of a generated module (``ValueError`` names what is wrong)."""
         data = dict(module.CONTRACT)
         name = getattr(module, "NAME", module.__name__)
-        if data.get("format") != CONTRACT_FORMAT:
+        fmt = data.get("format")
+        if fmt not in READ_FORMATS:
             raise ValueError(
-                f"model '{name}' states contract format {data.get('format')!r}, this solver "
-                f"reads format {CONTRACT_FORMAT}; regenerate it with `gearsym derive`"
+                f"model '{name}' states contract format {fmt!r}, this solver reads formats "
+                f"{', '.join(map(str, READ_FORMATS))}; regenerate it with `gearsym derive`"
             )
         fields = (
             "states",
@@ -82,6 +152,7 @@ class Contract:
             "piecewise",
             "switching_surfaces",
             "valid_range",
+            *(("force_sign",) if fmt >= 2 else ()),
         )
         missing = [k for k in fields if k not in data]
         if missing:
@@ -100,6 +171,7 @@ class Contract:
             if data["valid_range"] is None
             else {k: float(v) for k, v in dict(data["valid_range"]).items()},
             functions=tuple(str(f) for f in data.get("functions", cls.functions)),
+            force_sign=_force_signs(data.get("force_sign", {}), name),
         )
         c._check(name)
         absent = [f for f in c.functions if not callable(getattr(module, f, None))]
@@ -128,6 +200,10 @@ class Contract:
                 problems.append(f"{key} names something that is not a coordinate")
         if any(not lower <= upper for lower, upper in self.contact.values()):
             problems.append("contact edges with lower > upper")
+        if not set(self.force_sign) <= coords:
+            problems.append("force_sign names something that is not a coordinate")
+        for coord, sign in self.force_sign.items():
+            problems.extend(f"{coord}: {p}" for p in sign.problems())
         if any(not a > 0 for a in (self.valid_range or {}).values()):
             problems.append("a valid range that is not > 0")
         if self.forcing_frequency not in self.parameters:
@@ -169,6 +245,32 @@ class Contract:
         if self.valid_range is None:
             return []
         return [(self.states.index(c), a) for c, a in self.valid_range.items()]
+
+
+def _force_signs(table: dict, name: str) -> dict:
+    """The contract's ``force_sign`` entries as :class:`ForceSign`, each checked against
+    the outer zeros and the flag it states beside its table."""
+    out = {}
+    keys = ("edges", "zero_between", "zeros", "signs")
+    for coord, entry in dict(table).items():
+        lacks = [k for k in keys if k not in entry]
+        if lacks:
+            raise ValueError(
+                f"model '{name}': CONTRACT force_sign of {coord} lacks {', '.join(lacks)}; "
+                "regenerate it with `gearsym derive`"
+            )
+        sign = ForceSign(
+            tuple(float(z) for z in entry["zeros"]), tuple(int(s) for s in entry["signs"])
+        )
+        stated = (tuple(float(e) for e in entry["edges"]), bool(entry["zero_between"]))
+        if not sign.problems() and stated != (sign.edges, sign.zero_between):
+            raise ValueError(
+                f"model '{name}': CONTRACT force_sign of {coord} states edges and flag "
+                f"{stated}, its zeros and signs give {(sign.edges, sign.zero_between)}; "
+                "regenerate it with `gearsym derive`"
+            )
+        out[coord] = sign
+    return out
 
 
 # Modules run from a file, by (path, sha256 of the bytes run): a worker that meets the same

@@ -107,7 +107,7 @@ def _cmd_simulate(args) -> int:
         from gearsym.solver import plots
 
         out = write_json(args.out, "point.json", data)
-        plots.point_figure(result.trajectory, out / "point.png", title=system.name)
+        plots.point_figure(result, out / "point.png", title=system.name)
     tr = result.trajectory
     # exit status 3: the run ended invalid, divergent or failed (docs/user-guide.md)
     code = 0 if tr.status == "ok" else 3
@@ -139,7 +139,9 @@ def _cmd_simulate(args) -> int:
         line = f"  {c}: range [{num(low)}, {num(high)}]  peaks at {peaks or 'n/a'}"
         if c in shares:
             f, s, b = (num(shares[c][key], ".2f") for key in ("forward", "separated", "backward"))
-            line += f"  forward/separated/backward {f}/{s}/{b}"
+            line += f"  force forward/zero/backward {f}/{s}/{b}"
+            if shares[c].get("loaded_in_gap") is not None:
+                line += f" (inside the gap, loaded: {num(shares[c]['loaded_in_gap'], '.2f')})"
         print(line)
         sp = k.evidence.get("spread")
         if sp and k.period is None:

@@ -17,7 +17,7 @@ import sympy as sp
 from ..escape import markdown
 from ..input.paths import display_path
 from ..input.readings import reading_section
-from ..mesh.backlash import fit_dead_zone
+from ..mesh.backlash import ForceSign, fit_dead_zone
 from ..model import Model
 from .audit_structure import structure_sections
 from .audit_torsion import torsional_sections
@@ -236,9 +236,11 @@ def _contract_paragraph(model: Model) -> str:
         + f"; forcing frequency `{c['forcing_frequency']}` (period $2\\pi/\\bar\\omega$); "
         + "loads "
         + (", ".join(f"`{q}` → `{f}`" for q, f in c["loads"].items()) or "none")
-        + "; contact edges "
+        + "; backlash gap "
         + ", ".join(f"`{q}` ∈ [{lo:g}, {hi:g}]" for q, (lo, hi) in c["contact"].items())
-        + " (separated inside, in contact outside); "
+        + "; "
+        + _force_sign_clause(c["force_sign"])
+        + "; "
         + (
             f"piecewise, with switching surfaces {surfaces}"
             if c["piecewise"]
@@ -251,6 +253,23 @@ def _contract_paragraph(model: Model) -> str:
             else "valid for " + ", ".join(f"$|{q}| \\le {a:g}$" for q, a in valid.items())
         )
         + ".\n"
+    )
+
+
+def _force_sign_clause(table: dict) -> str:
+    """Where each mesh's force is zero and its sign (``force_sign``): what contact and
+    separation are read from, not the gap."""
+    groups: dict[tuple, list[str]] = {}
+    for q, e in table.items():
+        groups.setdefault((e["zeros"], e["signs"]), []).append(f"`{q}`")
+    return "; ".join(
+        f"force sign (`force_sign`) of {', '.join(qs)}: {ForceSign(*key).describe()}, so "
+        + (
+            "the teeth are apart where $g = 0$ and in contact outside"
+            if ForceSign(*key).zero_between
+            else "contact and separation are read from the sign of $g$, not from the gap"
+        )
+        for key, qs in groups.items()
     )
 
 
@@ -326,7 +345,10 @@ def index_page(models: list[Model], command: str) -> str:
         "`DEFAULTS`, `VALID_RANGE`, `OMEGA_N`, `HALF_BACKLASH`, `FEATURES`, "
         "`SCENE_PARAMETERS`, `OPERATIONS`; `CONTRACT`, what a solver needs to know as plain "
         "data (the velocity index of each coordinate, the forcing-frequency parameter, the "
-        "load parameters, the contact edges, piecewise or smooth with its switching surfaces "
+        "load parameters, the backlash gap's edges, where each mesh's force $g$ is zero and "
+        "its sign elsewhere (`force_sign`: its zeros, its outer zeros and whether it vanishes "
+        "between them, from which contact and separation are read), piecewise or smooth "
+        "with its switching surfaces "
         "$x_i = c$, the valid range); `rhs(tau, x, p)`, `jacobian(tau, x, p)`, "
         "`parameters(**values)`, `casadi_functions()`, `STRUCTURE` (the physical mass "
         "matrix, $R$ and the springs, for `gearsym modes`), and the C right-hand side `C_SOURCE` "

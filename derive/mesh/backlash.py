@@ -18,6 +18,12 @@ coefficients of the reference study, ``0.0017 x^7 - 0.0366 x^5 + 0.2833 x^3 - 0.
 Each model also lists the kinks of ``g`` (where its slope jumps) in ``kinks``: the dead
 zone's edges ``+1, -1``; the smooth, linear and polynomial models have none.  The model's
 contract (``derive/model.py``) turns them into switching surfaces for the solver.
+
+Each model states where its force is zero and its sign elsewhere (:meth:`Backlash.force_sign`,
+``force_sign.py``): the dead zone is zero on ``[-1, 1]``; the linear and smooth laws only
+at ``x = 0``; the polynomial at its real zeros (``0`` and ``+-0.7701`` for the study's fit),
+with load inside the gap.  The contract carries it, so that "contact" and "separation"
+follow the model's own force.
 """
 
 from __future__ import annotations
@@ -30,11 +36,14 @@ from typing import ClassVar
 import numpy as np
 import sympy as sp
 
+from .force_sign import ForceSign, polynomial_sign, spurious_load_limit, static_equilibria
+
 __all__ = [
     "BACKLASH_MODELS",
     "DEAD_ZONE_EDGES",
     "Backlash",
     "DeadZone",
+    "ForceSign",
     "LinearContact",
     "PolynomialFit",
     "SmoothDeadZone",
@@ -81,6 +90,10 @@ class Backlash:
         """g(x) as a SymPy expression in ``x`` and the symbols of :meth:`parameters`."""
         raise NotImplementedError
 
+    def force_sign(self) -> ForceSign:
+        """Where g(x) is zero and its sign elsewhere (the contract's ``force_sign``)."""
+        raise NotImplementedError
+
     def evaluate(self, x: np.ndarray) -> np.ndarray:
         """g(x) numerically, with the model's own parameter values."""
         xs = sp.Symbol("x", real=True)
@@ -115,6 +128,9 @@ class LinearContact(Backlash):
     def expression(self, x):
         return x
 
+    def force_sign(self):
+        return ForceSign((0.0,), (-1, 1))
+
 
 @dataclass(frozen=True)
 class DeadZone(Backlash):
@@ -125,6 +141,9 @@ class DeadZone(Backlash):
 
     def expression(self, x):
         return sp.Piecewise((x - 1, x > 1), (x + 1, x < -1), (0, True))
+
+    def force_sign(self):
+        return ForceSign(DEAD_ZONE_EDGES, (-1, 0, 1))
 
 
 @dataclass(frozen=True)
@@ -148,6 +167,11 @@ class SmoothDeadZone(Backlash):
     def expression(self, x):
         e = sp.Symbol("eps_g", real=True)
         return x - (sp.sqrt((x + 1) ** 2 + e**2) - sp.sqrt((x - 1) ** 2 + e**2)) / 2
+
+    def force_sign(self):
+        # g' = 1 - ((x+1)/r1 - (x-1)/r2)/2 with |(x -+ 1)/r| < 1, so g' > 0: g is strictly
+        # increasing, zero only at x = 0, loaded in the gap by about e^2 x / (2 (1 - x^2)).
+        return ForceSign((0.0,), (-1, 1))
 
 
 @dataclass(frozen=True)
@@ -197,6 +221,18 @@ class PolynomialFit(Backlash):
         for k in reversed(self.powers[:-1]):
             acc = sp.Symbol(f"g{k}", real=True) + x2 * acc
         return x * acc
+
+    def force_sign(self):
+        """The real zeros of g in ``[-A, A]`` (exact root isolation) and its sign between."""
+        return polynomial_sign(self.coefficients, self.powers, self.valid_range)
+
+    def equilibria(self, load: float):
+        """Static equilibria ``g(x) = F`` in ``[-A, A]`` (:func:`static_equilibria`)."""
+        return static_equilibria(self.coefficients, self.powers, load, self.valid_range)
+
+    def spurious_load_limit(self) -> float:
+        """``F*``: a spurious stable equilibrium exists for ``0 < |F| < F*``."""
+        return spurious_load_limit(self.coefficients, self.powers, self.valid_range)
 
 
 BACKLASH_MODELS = {

@@ -1,4 +1,5 @@
-"""Post-processing of a sampled response: spectra, extremes and meshing states.
+"""Post-processing of a sampled response: spectra and extremes (the meshing states,
+read from the sign of the model's force, are in ``meshing.py``; re-exported here).
 
 All frequencies are non-dimensional angular frequencies (rad per unit of tau), the units
 in which the reference study quotes its spectral peaks (0.5 and 1.0 for omega = 0.5);
@@ -13,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..integrate import Trajectory
+from .meshing import meshing_states
 
 __all__ = ["Spectrum", "extremes", "meshing_states", "spectrum"]
 
@@ -115,29 +117,5 @@ def extremes(tr: Trajectory) -> dict:
         out[s] = {
             "max": float(finite.max()) if finite.size else None,
             "min": float(finite.min()) if finite.size else None,
-        }
-    return out
-
-
-def meshing_states(tr: Trajectory) -> dict:
-    """Share of the sampled time each mesh spends in forward contact (past the upper
-    contact edge, u > 1), separated (between the edges) and in backward contact (u < -1):
-    the state switching of the study.  Coordinates without contact edges in the model's
-    contract are left out."""
-    out = {}
-    contact = tr.system.contract.contact
-    for c in tr.system.coordinates:
-        if c not in contact:
-            continue
-        lower, upper = contact[c]
-        u = tr.coordinate(c)
-        u = u[np.isfinite(u)]
-        if not u.size:
-            out[c] = {"forward": None, "separated": None, "backward": None}
-            continue
-        out[c] = {
-            "forward": float(np.mean(u > upper)),
-            "separated": float(np.mean((u >= lower) & (u <= upper))),
-            "backward": float(np.mean(u < lower)),
         }
     return out

@@ -1,14 +1,12 @@
-"""From map runs to attractors: each run classified, runs of one grid point grouped.
+"""From map runs to attractors: each run judged, runs of one grid point grouped.
 
-A run (one initial state at one grid point) is classified per mesh coordinate from its
-Poincare points and the exponent (``analysis.classify_points``), and its meshing regime
-is read from the extremes of each mesh coordinate against the contract's contact edges
-(Kahraman and Singh 1990, "Non-linear dynamics of a spur gear pair", J. Sound Vib. 142):
-
-* ``no impact``: the mesh stays in contact on one side the whole time;
-* ``single-sided impact``: it separates and comes back to the same flank;
-* ``double-sided impact``: it reaches both flanks (back-side impacts);
-* ``no contact``: it never reaches either flank in the window.
+A run (one initial state at one grid point) gets the attractor's verdict
+(``analysis.settle``: continued from where it ended until settled), and its meshing regime
+is read from the extremes of each mesh coordinate against the zeros of the model's own
+force (``analysis.meshing``, after Kahraman and Singh 1990, "Non-linear dynamics of a spur
+gear pair", J. Sound Vib. 142): no impact, single-sided or double-sided impact, no contact
+for the dead zone; for a force law loaded inside the gap (the study's polynomial) the
+regimes say where the force changes sign instead.
 
 Runs of one grid point reach the same attractor when they end with the same status and
 
@@ -30,28 +28,14 @@ import numpy as np
 
 from ..analysis.classify import Classification
 from ..analysis.lyapunov import LyapunovEstimate
+from ..analysis.meshing import contract_regimes, meshing_regime
 from ..analysis.record import Extremes, RunRecord
 from ..analysis.settle import BUDGET, FIRST_WINDOW, per_coordinate, settle
 
-__all__ = ["Attractor", "group_runs", "meshing_regime", "outcome"]
+__all__ = ["Attractor", "group_runs", "meshing_regime", "outcome"]  # meshing_regime: re-exported
 
 SAME_TOL = 1e-4  # periodic orbits: Poincare sets closer than this (relative) are one
 CLOUD_TOL = 0.05  # non-periodic sets: extremes closer than this (relative) are one
-
-
-def meshing_regime(lo: float, hi: float, lower: float, upper: float) -> str:
-    """Kahraman and Singh's regime of a mesh coordinate with extremes ``lo``, ``hi`` and
-    contact edges ``lower < upper`` (contact beyond them)."""
-    if not (np.isfinite(lo) and np.isfinite(hi)):
-        return "undetermined"
-    front, back = hi > upper, lo < lower
-    if front and back:
-        return "double-sided impact"
-    if lo > upper or hi < lower:
-        return "no impact"
-    if front or back:
-        return "single-sided impact"
-    return "no contact"
 
 
 def outcome(
@@ -93,7 +77,7 @@ def outcome(
             },
             start=start,
             x0=None if x0 is None else np.array(x0, dtype=float),
-            meshing_regime={k: "undetermined" for k in c.contact},
+            meshing_regime=dict.fromkeys(c.force_sign, "undetermined"),
             poincare={s: np.asarray(poincare[-64:, k], float) for k, s in enumerate(system.states)},
             verdict={"motion": motion, "period": None, "periods_run": None},
         )
@@ -131,10 +115,7 @@ def outcome(
         xmin, xmax = st.extremes
     spreads = v.evidence.get("spread", {})
     verdicts = per_coordinate(system, v)
-    meshing = {
-        k: meshing_regime(xmin[c.index(k)], xmax[c.index(k)], lower, upper)
-        for k, (lower, upper) in c.contact.items()
-    }
+    meshing = contract_regimes(c, xmin, xmax)
     tail = np.asarray(st.points[:, -64:], float)
     summary = st.lyapunov
     if summary is not None:

@@ -25,6 +25,7 @@ KEYS = (
     "forcing_frequency",
     "loads",
     "contact",
+    "force_sign",
     "piecewise",
     "switching_surfaces",
     "valid_range",
@@ -69,7 +70,7 @@ def test_every_contract_has_the_format_and_the_model_order(models):
     for model in models.values():
         c = model.contract
         assert tuple(c) == KEYS
-        assert c["format"] == CONTRACT_FORMAT == 1
+        assert c["format"] == CONTRACT_FORMAT == 2
         assert c["states"] == model.states and c["coordinates"] == model.coordinates
         assert c["parameters"] == model.parameter_names
         assert c["forcing_frequency"] == "omega" == c["parameters"][0]

@@ -1,0 +1,130 @@
+"""Meshing state of each mesh, read from the sign of the model's own backlash force.
+
+The teeth are in forward contact where the backlash force ``g(u) > 0``, apart where
+``g(u) = 0`` and in backward contact where ``g(u) < 0``; the model's contract states where
+``g`` is zero and its sign between (``Contract.force_sign``).  For the exact dead zone
+that is ``u > 1``, ``|u| <= 1`` and ``u < -1``.  The study's polynomial fit is zero only at
+``u = 0, +-0.7701``: it never separates, and inside the backlash gap ``|u| < 1`` it still
+carries load (negative on ``(0, 0.7701)``, positive on ``(-0.7701, 0)``), which is reported
+as its own share, not as separation.
+
+Kahraman and Singh's regimes (1990, "Non-linear dynamics of a spur gear pair", J. Sound
+Vib. 142) are read from a coordinate's extremes against the force's outer zeros.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..integrate import Trajectory
+
+__all__ = ["GAP_LOADED_REGIMES", "REGIMES", "contract_regimes", "meshing_regime", "meshing_states"]
+
+# Kahraman and Singh's regimes (a force that vanishes between its edges: a dead zone) and
+# their counterparts for a force that only crosses zero there (nothing separates, nothing
+# impacts: the force reverses inside the gap).
+REGIMES = ("no impact", "single-sided impact", "double-sided impact", "no contact")
+GAP_LOADED_REGIMES = (
+    "no impact",
+    "single-sided force reversal",
+    "double-sided force reversal",
+    "inside the outer zeros, loaded",
+)
+
+
+def meshing_regime(
+    lo: float, hi: float, lower: float, upper: float, *, zero_between: bool = True
+) -> str:
+    """The meshing regime of a coordinate whose extremes over the window are ``lo, hi``.
+
+    Parameters
+    ----------
+    lo, hi : float
+        Minimum and maximum of the coordinate (half backlashes).
+    lower, upper : float
+        The outer zeros of the force (``lower <= upper``): ``g > 0`` beyond ``upper`` and
+        ``g < 0`` below ``lower``.
+    zero_between : bool
+        True when ``g`` vanishes on all of ``[lower, upper]`` (the dead zone): the names
+        of Kahraman and Singh (:data:`REGIMES`).  False when it only crosses zero there (a
+        polynomial fit): the same reading named by what the force does
+        (:data:`GAP_LOADED_REGIMES`).
+
+    Returns
+    -------
+    str
+        ``no impact`` (beyond one edge throughout: the force keeps its sign), the
+        one-sided and two-sided regimes, the regime inside the edges, or
+        ``undetermined`` for non-finite extremes.
+    """
+    if not (np.isfinite(lo) and np.isfinite(hi)):
+        return "undetermined"
+    names = REGIMES if zero_between else GAP_LOADED_REGIMES
+    front, back = hi > upper, lo < lower
+    if front and back:
+        return names[2]
+    if lo > upper or hi < lower:
+        return names[0]
+    if front or back:
+        return names[1]
+    return names[3]
+
+
+def contract_regimes(contract, xmin, xmax) -> dict:
+    """Coordinate -> :func:`meshing_regime` of each mesh with a force sign in
+    ``contract``, from the window's extremes ``xmin``, ``xmax`` ((n,) by state index)."""
+    out = {}
+    for coord, sign in contract.force_sign.items():
+        k = contract.index(coord)
+        lower, upper = sign.edges
+        out[coord] = meshing_regime(xmin[k], xmax[k], lower, upper, zero_between=sign.zero_between)
+    return out
+
+
+def meshing_states(tr: Trajectory) -> dict:
+    """Share of the sampled time each mesh spends by the sign of its backlash force.
+
+    Returns
+    -------
+    dict
+        mesh -> ``{"forward": share with g(u) > 0, "separated": share with g(u) = 0,
+        "backward": share with g(u) < 0}`` over the finite samples (None each when there
+        are none); for a force law that is loaded inside the gap (every model but the dead
+        zone) also ``"loaded_in_gap"``: the share inside the backlash gap
+        (``lower < u < upper`` of the contract's ``contact``) with ``g(u) != 0``, time a
+        dead zone would spend separated.  Coordinates without a force sign in the
+        contract are left out.
+    """
+    out = {}
+    c = tr.system.contract
+    for coord in tr.system.coordinates:
+        sign = c.force_sign.get(coord)
+        if sign is None:
+            continue
+        u = tr.coordinate(coord)
+        u = u[np.isfinite(u)]
+        gap = c.contact.get(coord)
+        loaded = gap is not None and _loaded_in(sign, *gap)
+        if not u.size:
+            out[coord] = dict.fromkeys(("forward", "separated", "backward"), None)
+            if loaded:
+                out[coord]["loaded_in_gap"] = None
+            continue
+        s = sign.sign(u)
+        out[coord] = {
+            "forward": float(np.mean(s > 0)),
+            "separated": float(np.mean(s == 0)),
+            "backward": float(np.mean(s < 0)),
+        }
+        if loaded:
+            out[coord]["loaded_in_gap"] = float(np.mean((u > gap[0]) & (u < gap[1]) & (s != 0)))
+    return out
+
+
+def _loaded_in(sign, lower: float, upper: float) -> bool:
+    """``g`` is nonzero somewhere in the open gap ``(lower, upper)``."""
+    bounds = (-np.inf, *sign.zeros, np.inf)
+    return any(
+        s != 0 and a < upper and b > lower
+        for s, a, b in zip(sign.signs, bounds[:-1], bounds[1:], strict=True)
+    )
