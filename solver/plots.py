@@ -1,11 +1,15 @@
 """Matplotlib figures: bifurcation diagrams, time series, spectra, phase portraits, maps.
 
 Every function takes data and a path, writes one PNG (Agg back end, no display needed) and
-returns the path.  Axes are labelled with their (non-dimensional) units.
+returns the path.  Axes are labelled with their (non-dimensional) units.  One meaning has
+one colour in every figure of the package: the palettes are in :mod:`.plots_maps`;
+markers are at least 3 px, legends sit outside the axes, and a figure of one operating
+point says that point (ω̄, loads, backlash model) and its verdict in its title.
 """
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import matplotlib
@@ -16,13 +20,29 @@ import numpy as np  # noqa: E402
 
 from .analysis import spectrum  # noqa: E402
 from .integrate import Trajectory  # noqa: E402
+from .plots_maps import (  # noqa: E402
+    BIFURCATIONS,
+    MOTION_CLASSES,
+    categorical,
+    legend_below,
+    motion_class,
+    not_ok_marks,
+    operating_point,
+    period_colour,
+    sweep_marker,
+)
 from .sweep import SweepResult  # noqa: E402
 
-__all__ = ["bifurcation_diagram", "map_figure", "point_figure"]
+__all__ = [
+    "bifurcation_diagram",
+    "branch_figure",
+    "map_figure",
+    "multipliers_figure",
+    "point_figure",
+]
 
 PORTRAIT_PERIODS = 500  # periods a phase portrait draws at most
-
-_COLOURS = {"forward": "tab:blue", "backward": "tab:orange", "independent": "tab:blue"}
+HARMONICS_SHOWN = 6  # a spectrum runs to (HARMONICS_SHOWN + 1/2) omega: the 6th is whole
 
 
 def _save(fig, path: Path) -> Path:
@@ -33,60 +53,142 @@ def _save(fig, path: Path) -> Path:
     return path
 
 
+def _distinct(pts: np.ndarray, lo: float, cell: float) -> np.ndarray:
+    """A periodic orbit's points repeat: each place once (closer than ``cell``: one)."""
+    pts = pts[np.isfinite(pts)]
+    _, first = np.unique(np.round((pts - lo) / cell), return_index=True)
+    return pts[np.sort(first)]
+
+
 def bifurcation_diagram(
-    sweeps: list[SweepResult], states: list[str], path: Path, title: str = ""
+    sweeps: list[SweepResult],
+    states: list[str],
+    path: Path,
+    title: str = "",
+    *,
+    system=None,
 ) -> Path:
-    """Poincare points of each state against the swept parameter, one panel per state;
-    forward and backward continuation overlaid (hysteresis shows as two colours apart)."""
+    """Poincaré points of each state against the swept parameter, one panel per state.
+
+    Forward and backward sweeps are both visible where they agree: the backward sweep's
+    points are open circles (6 px across) drawn first, the forward sweep's filled dots
+    (3.5 px) on top; hysteresis shows as rings and dots apart.  Points whose run did not
+    end normally (diverged, left the valid range) are crosses on the panel's lower edge.
+    ``system``: the model the sweeps ran on; the title then states ω̄ and the loads (from
+    the sweep's first to its last value).  Units: half backlashes.
+    """
     fig, axes = plt.subplots(
-        len(states), 1, figsize=(7, 2.8 * len(states)), sharex=True, squeeze=False
+        len(states), 1, figsize=(7.5, 2.8 * len(states)), sharex=True, squeeze=False
     )
+    order = sorted(sweeps, key=lambda sw: sw.direction != "backward")  # backward first
     for ax, state in zip(axes[:, 0], states, strict=True):
         finite = [p[np.isfinite(p)] for sw in sweeps for p in sw.poincare(state)]
         finite = np.concatenate(finite) if finite else np.zeros(0)
         lo = finite.min() if finite.size else 0.0
         cell = max(float(np.ptp(finite)) if finite.size else 0.0, 1e-12) * 1e-4
-        for sw in sweeps:
+        for sw in order:
             xs, ys = [], []
             for value, pts in zip(sw.values, sw.poincare(state), strict=True):
-                # a periodic orbit's points repeat: draw each place once (points closer
-                # than 1e-4 of the panel's height, far below a pixel, are one place)
-                pts = pts[np.isfinite(pts)]
-                _, first = np.unique(np.round((pts - lo) / cell), return_index=True)
-                pts = pts[np.sort(first)]
+                pts = _distinct(np.asarray(pts, float), lo, cell)
                 xs.append(np.full(pts.size, value))
                 ys.append(pts)
             ax.plot(
-                np.concatenate(xs),
-                np.concatenate(ys),
-                ".",
-                markersize=1.5,
-                alpha=1.0,
-                color=_COLOURS[sw.direction],
+                np.concatenate(xs) if xs else [],
+                np.concatenate(ys) if ys else [],
+                ls="none",
                 label=f"{sw.direction} sweep",
+                **sweep_marker(sw.direction),
             )
+            not_ok_marks(ax, sw.values, [p.status for p in sw.points])
         ax.set_ylabel(f"{state} (Poincaré), half backlashes")
         ax.grid(alpha=0.3)
-    axes[0, 0].legend(loc="best", markerscale=6, fontsize=8)
     axes[-1, 0].set_xlabel(sweeps[0].parameter)
-    if title:
-        axes[0, 0].set_title(title)
+    head = title
+    if system is not None:
+        head += ("\n" if head else "") + operating_point(
+            system, sweeps[0].parameter, sweeps[0].values
+        )
+    if head:
+        axes[0, 0].set_title(head, fontsize=10)
+    legend_below(fig, axes.ravel())
     return _save(fig, path)
 
 
-def point_figure(tr: Trajectory, path: Path, title: str = "", periods_shown: int = 20) -> Path:
-    """One operating point: time series, phase portrait with Poincare points, and spectrum
-    of each mesh coordinate (one row per coordinate)."""
+def _title(tr: Trajectory, point, title: str) -> str:
+    lines = [title] if title else []
+    lines.append(operating_point(tr.system))
+    if point is not None:
+        lines.append(textwrap.fill(_verdict_text(point, tr.system.coordinates), 150))
+    return "\n".join(lines)
+
+
+def _verdict_text(point, coordinates) -> str:
+    """The verdict line of one analysed point (a ``PointResult``): the motion (one label
+    when the coordinates agree) and its evidence: the periods run, the orbit's largest
+    Floquet multiplier |μ| or the last window's exponent interval (per unit τ) and 0-1
+    test K, the reason of an undetermined verdict, a chaotic transient."""
+    cls = point.classification
+    motions = {c: getattr(cls[c], "motion", str(cls[c])) for c in coordinates}
+    if len(set(motions.values())) == 1:
+        parts = [f"verdict: {next(iter(motions.values()))} ({', '.join(motions)})"]
+    else:
+        parts = ["verdict: " + ", ".join(f"{c} {m}" for c, m in motions.items())]
+    verdict = getattr(point, "verdict", None)
+    s = verdict.summary() if verdict is not None else {}
+    if "periods_run" in s:
+        parts.append(f"{s['periods_run']} periods run")
+    if s.get("largest_multiplier") is not None:
+        parts.append(f"largest |Floquet multiplier| {s['largest_multiplier']:.4f}")
+    if "exponent_interval" in s:
+        lo, hi = s["exponent_interval"]
+        parts.append(f"largest Lyapunov exponent in [{lo:+.4f}, {hi:+.4f}] per unit τ")
+    elif point.lyapunov is not None:
+        lam = point.lyapunov
+        parts.append(
+            f"largest Lyapunov exponent {lam.exponent:+.4f} ± {lam.uncertainty:.4f} "
+            f"per unit τ ({lam.periods} periods)"
+        )
+    if "zero_one_K" in s:
+        parts.append(f"0-1 test K = {s['zero_one_K']:.2f}")
+    if "transient_chaos" in s:
+        parts.append(str(s["transient_chaos"].get("text", "chaotic transient")))
+    if "why" in s:
+        parts.append(f"why: {s['why']}")
+    return "; ".join(parts)
+
+
+def point_figure(point, path: Path, title: str = "", periods_shown: int = 20) -> Path:
+    """One operating point: time series, phase portrait with Poincaré points, and spectrum
+    of each mesh coordinate (one row per coordinate).
+
+    ``point`` is a :class:`~.analysis.PointResult` (any point, periodic or chaotic: its
+    verdict per coordinate and largest Lyapunov exponent go into the title) or a bare
+    :class:`~.integrate.Trajectory` (no verdict).  The title states ω̄, the loads and the
+    backlash model.  Spectra: amplitude in half backlashes (Hann window, a cosine of
+    amplitude a reads a) against frequency in rad per unit τ, up to 6.5 ω̄ so the sixth
+    harmonic is whole; the top axis counts multiples of ω̄.  Nothing is floored: bins the
+    FFT finds exactly zero are left out of the log axis.
+    """
+    tr = getattr(point, "trajectory", point)
+    result = None if tr is point else point
     coords = tr.system.coordinates
-    fig, axes = plt.subplots(len(coords), 3, figsize=(13, 3.2 * len(coords)), squeeze=False)
+    fig, axes = plt.subplots(len(coords), 3, figsize=(13, 3.3 * len(coords)), squeeze=False)
     spp = tr.samples_per_period
     shown = slice(max(0, tr.t.size - periods_shown * spp), None)
     for row, c in enumerate(coords):
         u, du = tr.coordinate(c), tr.velocity(c)
         ax = axes[row, 0]
-        ax.plot(tr.t[shown], u[shown], lw=0.8)
-        for edge in tr.system.contract.contact.get(c, ()):
-            ax.axhline(edge, color="grey", lw=0.6, ls="--")
+        ax.plot(tr.t[shown], u[shown], lw=0.8, color="#1f1f1f", label="response")
+        edges = tr.system.contract.contact.get(c, ())
+        for k, edge in enumerate(edges):
+            where = ", ".join(f"{e:g}" for e in edges)
+            ax.axhline(
+                edge,
+                color="grey",
+                lw=0.8,
+                ls="--",
+                label=None if k else f"contact edges {c} = {where} (the model's contract)",
+            )
         ax.set_xlabel("τ (non-dimensional time)")
         ax.set_ylabel(f"{c} (half backlashes)")
         ax.set_title(f"{c}: time series (last {periods_shown} periods)", fontsize=9)
@@ -94,48 +196,62 @@ def point_figure(tr: Trajectory, path: Path, title: str = "", periods_shown: int
         # at most the last PORTRAIT_PERIODS periods (a path of every sample of a long run
         # takes matplotlib gigabytes); the Poincare points likewise
         tail = slice(max(0, tr.t.size - PORTRAIT_PERIODS * spp), None)
-        ax.plot(u[tail], du[tail], lw=0.3, color="tab:blue", alpha=0.6)
+        ax.plot(u[tail], du[tail], lw=0.3, color="#1f1f1f", alpha=0.6)
         ax.plot(
             tr.poincare[tr.system.index(c)][-PORTRAIT_PERIODS:],
             tr.poincare[tr.system.velocity_index(c)][-PORTRAIT_PERIODS:],
             "o",
-            ms=2.5,
-            color="tab:red",
-            label="Poincaré",
+            ms=3,
+            color="#ce1256",
+            label="Poincaré points (τ = 0 mod T)",
         )
-        ax.set_xlabel(c)
+        ax.set_xlabel(f"{c} (half backlashes)")
         ax.set_ylabel(f"d{c}/dτ")
         shown_periods = min(PORTRAIT_PERIODS, tr.poincare.shape[1])
         ax.set_title(f"{c}: phase portrait (last {shown_periods} periods)", fontsize=9)
-        ax.legend(fontsize=7, loc="upper right")
-        ax = axes[row, 2]
-        sp = spectrum(tr, c)
-        keep = sp.frequency <= 6 * sp.omega
-        ax.semilogy(sp.frequency[keep], np.maximum(sp.amplitude[keep], 1e-8), lw=0.8)
-        ax.set_xlabel("frequency (rad per unit τ)")
-        ax.set_ylabel("amplitude")
-        ax.set_title(f"{c}: spectrum (ω̄ = {sp.omega:g})", fontsize=9)
-        ax.grid(alpha=0.3)
-    if title:
-        fig.suptitle(title)
+        _spectrum_panel(axes[row, 2], tr, c)
+    fig.suptitle(_title(tr, result, title), fontsize=10)
     fig.tight_layout()
+    handles = {}
+    for ax in axes[0]:
+        for h, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            handles.setdefault(label.replace(f" {coords[0]} = ", " = "), h)
+    fig.legend(
+        handles.values(),
+        handles.keys(),
+        loc="upper center",
+        bbox_to_anchor=(0.5, 0.0),
+        ncol=len(handles),
+        fontsize=8,
+        frameon=False,
+    )
     return _save(fig, path)
 
 
-_MOTION_CODES = {
-    "period-1": 1,
-    "period-n": 2,
-    "quasi-periodic": 3,
-    "chaotic": 4,
-    "undetermined": 5,
-    "divergent": 6,
-}
-
-
-def motion_code(motion: str) -> int:
-    if motion.startswith("period-") and motion != "period-1":
-        return _MOTION_CODES["period-n"]
-    return _MOTION_CODES.get(motion, 5)
+def _spectrum_panel(ax, tr: Trajectory, c: str) -> None:
+    sp = spectrum(tr, c)
+    top = (HARMONICS_SHOWN + 0.5) * sp.omega
+    keep = (sp.frequency <= top) & (sp.amplitude > 0)
+    ax.semilogy(sp.frequency[keep], sp.amplitude[keep], lw=0.8, color="#1f1f1f")
+    ax.set_xlim(0, top)
+    if np.any(keep):  # what the integration's relative tolerance cannot resolve
+        level = tr.rtol * float(sp.amplitude[keep].max())
+        bottom = min(ax.get_ylim()[0], level)
+        ax.axhspan(bottom, level, color="0.9", zorder=0, label="below rtol × the largest peak")
+        ax.set_ylim(bottom=bottom)
+    ax.set_xlabel("frequency (rad per unit τ)")
+    ax.set_ylabel(f"amplitude of {c} (half backlashes)")
+    harmonics = ax.secondary_xaxis(
+        "top", functions=(lambda f, w=sp.omega: f / w, lambda k, w=sp.omega: k * w)
+    )
+    harmonics.set_xticks(range(HARMONICS_SHOWN + 1))
+    harmonics.tick_params(labelsize=7)
+    ax.set_title(
+        f"{c}: spectrum, top axis in multiples of ω̄ = {sp.omega:g}; "
+        f"{sp.duration:.0f} τ, bin {sp.resolution:.2g}",
+        fontsize=8,
+    )
+    ax.grid(alpha=0.3)
 
 
 def map_figure(
@@ -150,36 +266,29 @@ def map_figure(
     names: tuple[str, str, str, str],
 ) -> Path:
     """Maps over two parameters (``names[0]`` on the y axis, ``names[1]`` on x): the max of
-    state ``names[2]``, the min of state ``names[3]`` and the motion type of ``names[3]``."""
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4))
+    state ``names[2]``, the min of state ``names[3]`` (half backlashes) and the motion
+    type of ``names[3]`` in the package's motion palette (:data:`MOTION_CLASSES`)."""
+    fig, axes = plt.subplots(1, 3, figsize=(16, 4))
 
-    # Cells centred on the sampled values.
-    def edges(v):
+    def edges(v):  # cells centred on the sampled values
         v = np.asarray(v, dtype=float)
-        half = (v[1] - v[0]) / 2 if v.size > 1 else 0.5
-        return v[0] - half, v[-1] + half
+        if v.size == 1:
+            return np.array([v[0] - 0.5, v[0] + 0.5])
+        mid = (v[1:] + v[:-1]) / 2
+        return np.concatenate([[2 * v[0] - mid[0]], mid, [2 * v[-1] - mid[-1]]])
 
-    extent = [*edges(lam_values), *edges(f_values)]
+    xe, ye = edges(lam_values), edges(f_values)
     for ax, data, label in (
-        (axes[0], max_u, f"Max({names[2]})"),
-        (axes[1], min_v, f"Min({names[3]})"),
+        (axes[0], max_u, f"Max({names[2]}) (half backlashes)"),
+        (axes[1], min_v, f"Min({names[3]}) (half backlashes)"),
     ):
-        im = ax.imshow(np.asarray(data), origin="lower", aspect="auto", extent=extent)
+        im = ax.pcolormesh(xe, ye, np.asarray(data, float), cmap="viridis")
         fig.colorbar(im, ax=ax, label=label)
         ax.set_xlabel(names[1])
         ax.set_ylabel(names[0])
-        ax.set_title(label)
-    codes = np.vectorize(motion_code)(np.asarray(motion_v))
-    cmap = matplotlib.colors.ListedColormap(
-        ["tab:green", "tab:olive", "tab:blue", "tab:red", "lightgrey", "black"]
-    )
-    im = axes[2].imshow(
-        codes, origin="lower", aspect="auto", extent=extent, cmap=cmap, vmin=0.5, vmax=6.5
-    )
-    cbar = fig.colorbar(im, ax=axes[2], ticks=range(1, 7))
-    cbar.ax.set_yticklabels(
-        ["period-1", "period-n", "quasi-periodic", "chaotic", "undetermined", "divergent"]
-    )
+        ax.set_title(label.split(" (")[0])
+    labels = np.vectorize(motion_class)(np.asarray(motion_v, dtype=object))
+    categorical(axes[2], xe, ye, labels, MOTION_CLASSES)
     axes[2].set_xlabel(names[1])
     axes[2].set_ylabel(names[0])
     axes[2].set_title(f"motion of {names[3]}")
@@ -189,70 +298,81 @@ def map_figure(
     return _save(fig, path)
 
 
+def _drawable(branches) -> tuple[list, list]:
+    """Branches with an extent in the parameter, and those without (a continuation asked
+    to go from a value to itself returns its start twice: nothing to draw)."""
+    keep, empty = [], []
+    for br in branches:
+        lam = np.asarray(br.values, float)
+        (keep if lam.size > 1 and np.ptp(lam) > 0 else empty).append(br)
+    return keep, empty
+
+
 def branch_figure(
-    branches, path: Path, state: str | None = None, sweeps=None, title: str = ""
+    branches, path: Path, state=None, sweeps=None, title: str = "", *, system=None
 ) -> Path:
     """Continuation branches over the brute-force diagram: stable solid, unstable dashed,
-    bifurcations marked; Poincare points of brute-force sweeps in the background."""
-    fig, ax = plt.subplots(figsize=(8, 4.5))
-    for sw in sweeps or []:
-        xs, ys = [], []
-        for value, pts in zip(sw.values, sw.poincare(state), strict=True):
-            xs.append(np.full(np.size(pts), value))
-            ys.append(np.asarray(pts))
-        if xs:
-            ax.plot(
-                np.concatenate(xs),
-                np.concatenate(ys),
-                ".",
-                markersize=2,
-                color="0.6",
-                label="brute force ("
-                + " and ".join(dict.fromkeys(w.direction for w in sweeps))
-                + ")"
-                if sw is sweeps[0]
-                else None,
-            )
-    markers = {
-        "fold": ("s", "tab:red"),
-        "period-doubling": ("D", "tab:purple"),
-        "neimark-sacker": ("o", "tab:green"),
-    }
-    if state is None and branches:
-        state = branches[0].state_names[0]
-    # One colour per period: branches of the same period share their legend entry.
-    colours = {n: f"C{i}" for i, n in enumerate(sorted({br.n for br in branches}))}
-    for br in branches:
-        index = br.state_names.index(state)
-        lam = np.asarray(br.values)
-        y = np.array([s[index] for s in br.states])
-        stable = np.asarray(br.stable)
-        colour = colours[br.n]
-        for flag, style in ((True, "-"), (False, "--")):
-            if not np.any(stable == flag):
-                continue  # no legend entry for a kind of point the branch does not have
-            yy = np.where(stable == flag, y, np.nan)
-            ax.plot(
-                lam,
-                yy,
-                style,
-                color=colour,
-                lw=1.4,
-                label=f"period-{br.n} {'stable' if flag else 'unstable'}",
-            )
-        for b in br.bifurcations:
-            m, c = markers[b.kind]
-            ax.plot(b.value, b.x0[index], m, color=c, ms=7, label=b.kind)
-    handles, labels = ax.get_legend_handles_labels()
-    seen: dict = {}
-    for label, handle in zip(labels, handles, strict=True):
-        seen.setdefault(label, handle)
-    ax.legend(seen.values(), seen.keys(), fontsize=8, loc="best")
-    ax.set_xlabel(branches[0].parameter if branches else "")
-    ax.set_ylabel(f"{state} at τ = 0 mod nT (half backlashes)")
-    ax.grid(alpha=0.3)
-    if title:
-        ax.set_title(title)
+    bifurcations marked; the Poincaré points of brute-force sweeps behind them (in the
+    sweeps' palette).
+
+    ``state``: one state name (one panel), a sequence of names (one panel each: a jump
+    may show in one coordinate only), or None (the branches' first state).  One legend
+    for the figure, below it.  Branches without extent in the parameter are not drawn
+    and the title says how many.  ``system``: the model, for ω̄ and loads in the title.
+    Units: half backlashes.
+    """
+    drawn, empty = _drawable(branches)
+    if state is None:
+        state = branches[0].state_names[0] if branches else "x"
+    names = [state] if isinstance(state, str) else list(state)
+    fig, axes = plt.subplots(
+        len(names), 1, figsize=(8.5, 3.6 * len(names)), sharex=True, squeeze=False
+    )
+    for ax, name in zip(axes[:, 0], names, strict=True):
+        for sw in sorted(sweeps or [], key=lambda sw: sw.direction != "backward"):
+            xs, ys = [], []
+            for value, pts in zip(sw.values, sw.poincare(name), strict=True):
+                xs.append(np.full(np.size(pts), value))
+                ys.append(np.asarray(pts, float))
+            if xs:
+                style = sweep_marker(sw.direction) | {"alpha": 0.5}
+                label = f"brute force, {sw.direction} sweep (Poincaré points)"
+                ax.plot(np.concatenate(xs), np.concatenate(ys), ls="none", label=label, **style)
+        for br in drawn:
+            index = br.state_names.index(name)
+            lam = np.asarray(br.values)
+            y = np.array([s[index] for s in br.states])
+            stable = np.asarray(br.stable)
+            for flag, style in ((True, "-"), (False, "--")):
+                if not np.any(stable == flag):
+                    continue  # no legend entry for a kind of point the branch does not have
+                ax.plot(
+                    lam,
+                    np.where(stable == flag, y, np.nan),
+                    style,
+                    color=period_colour(br.n),
+                    lw=1.4,
+                    label=f"period-{br.n} {'stable' if flag else 'unstable'} (continuation)",
+                )
+            for b in br.bifurcations:
+                marker, colour = BIFURCATIONS[b.kind]
+                ax.plot(b.value, b.x0[index], marker, color=colour, ms=7, mfc="none", mew=1.5)
+                ax.plot([], [], marker, color=colour, ms=7, mfc="none", mew=1.5, label=b.kind)
+        ax.set_ylabel(f"{name} at τ = 0 mod nT\n(half backlashes)")
+        ax.grid(alpha=0.3)
+    axes[-1, 0].set_xlabel(branches[0].parameter if branches else "")
+    head = [title] if title else []
+    if system is not None and drawn:
+        span = np.concatenate([np.asarray(br.values, float) for br in drawn])
+        head.append(operating_point(system, drawn[0].parameter, span))
+    if empty:
+        head.append(
+            f"{len(empty)} branch(es) without extent in the parameter not drawn "
+            "(continued from a value to itself)"
+        )
+    if head:
+        axes[0, 0].set_title("\n".join(head), fontsize=10)
+    legend_below(fig, axes.ravel())
     return _save(fig, path)
 
 
@@ -260,14 +380,15 @@ def multipliers_figure(multipliers, path: Path, title: str = "") -> Path:
     """Floquet multipliers in the complex plane with the unit circle."""
     fig, ax = plt.subplots(figsize=(4.5, 4.5))
     th = np.linspace(0, 2 * np.pi, 400)
-    ax.plot(np.cos(th), np.sin(th), color="0.5", lw=0.8)
+    ax.plot(np.cos(th), np.sin(th), color="0.5", lw=0.8, label="|μ| = 1")
     mu = np.asarray(multipliers)
-    ax.plot(mu.real, mu.imag, "x", ms=8, color="tab:red")
+    ax.plot(mu.real, mu.imag, "x", ms=8, mew=1.5, color="#e6550d", label="multipliers")
     ax.set_aspect("equal")
     ax.axhline(0, color="0.8", lw=0.5)
     ax.axvline(0, color="0.8", lw=0.5)
     ax.set_xlabel("Re μ")
     ax.set_ylabel("Im μ")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
     if title:
         ax.set_title(title, fontsize=9)
     return _save(fig, path)

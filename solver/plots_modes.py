@@ -62,5 +62,11 @@ def campbell_figure(
     )
     ax.set_ylabel("frequency (Hz)")
     ax.set_title(f"{result.model}: natural frequencies and mesh-frequency harmonics")
-    ax.legend(title="mode (kinetic energy)", loc="upper left", fontsize=8)
+    ax.legend(
+        title="mode (kinetic energy)",
+        loc="upper left",
+        bbox_to_anchor=(1.01, 1.0),
+        fontsize=8,
+        frameon=False,
+    )
     return _save(fig, path)

@@ -14,15 +14,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-__all__ = ["frequency_response_figure"]
+from .plots_maps import BIFURCATIONS, SWEEPS, legend_below  # noqa: E402
 
-_COLOURS = {"hb": "tab:blue", "shooting": "tab:orange"}
+__all__ = ["METHODS", "frequency_response_figure"]
+
+METHODS = {"hb": "#1b9e77", "shooting": "#7570b3"}  # one colour per method, every figure
 _NAMES = {"hb": "harmonic balance", "shooting": "shooting", "integration": "integration"}
-_MARKS = {
-    "fold": ("s", "tab:red"),
-    "period-doubling": ("D", "tab:purple"),
-    "neimark-sacker": ("o", "tab:green"),
-}
+# the up and down sweeps of time integration: the sweeps' palette, triangles pointing
+# the way the sweep went
+_SWEPT = {"up": ("forward", "^"), "down": ("backward", "v")}
 
 
 def _segments(x, y, stable):
@@ -51,18 +51,19 @@ def frequency_response_figure(resp, path, physical: bool = False, title: str = "
         for curve in resp.curves:
             x = curve.values * fx
             y = curve.stats[c]["amplitude"] * fy
-            colour = _COLOURS.get(curve.method, "k")
+            colour = METHODS.get(curve.method, "k")
             if curve.method == "integration":
-                up = curve.details.get("direction") == "up"
+                way = "up" if curve.details.get("direction") == "up" else "down"
+                direction, marker = _SWEPT[way]
                 ax.plot(
                     x,
                     y,
-                    "^" if up else "v",
-                    color="tab:green" if up else "tab:olive",
-                    ms=3,
+                    marker,
+                    color=SWEEPS[direction]["color"],
+                    ms=4,
                     mfc="none",
                     lw=0,
-                    label=f"integration, {'up' if up else 'down'} sweep",
+                    label=f"integration, {way} sweep",
                 )
                 continue
             shown = set()
@@ -78,7 +79,7 @@ def frequency_response_figure(resp, path, physical: bool = False, title: str = "
                 )
                 shown.add(label)
             for e in curve.events:
-                marker, mc = _MARKS.get(e.kind, ("x", "k"))
+                marker, mc = BIFURCATIONS.get(e.kind, ("x", "k"))
                 v = e.value
                 # the point before the event on the curve (a fold has two sides at
                 # nearly one parameter value: the nearest value would not do)
@@ -97,15 +98,12 @@ def frequency_response_figure(resp, path, physical: bool = False, title: str = "
                 )
         ax.set_ylabel(f"half peak-to-peak of {c}" + (" (µm)" if physical else " (half backlashes)"))
         ax.grid(alpha=0.3)
-        handles, labels = ax.get_legend_handles_labels()
-        unique = dict(zip(labels, handles, strict=True))
-        ax.legend(unique.values(), unique.keys(), fontsize=7, loc="best")
     axes[-1, 0].set_xlabel("mesh frequency (Hz)" if physical else resp.parameter)
     if title:
         axes[0, 0].set_title(title, fontsize=10)
-    fig.tight_layout()
+    legend_below(fig, axes.ravel())  # one legend: each entry once, not once per panel
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
+    fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
     return path

@@ -357,8 +357,9 @@ def _cmd_continue(args) -> int:
     plots.branch_figure(
         branches,
         out / "branches.png",
-        system.coordinates[0],
+        system.coordinates,
         title=f"{system.name}: continuation in {args.param}",
+        system=system,
     )
     for k, br in enumerate(branches):
         smap = StroboscopicMap(system, br.n)

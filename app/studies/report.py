@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 from gearsym.solver.analysis import spectrum
+from gearsym.solver.analysis.meshing import meshing_states
 
 from .cases import CASES, RESOLUTIONS
 
@@ -81,6 +82,9 @@ def _segment_distance(q, a, b) -> float:
     return float(np.linalg.norm(q - (a + w * d)))
 
 
+FIGURES_MARK = "<!-- the figures written, listed by reproduce.py -->"
+
+
 def report(
     res, lam, by_case, points, maps, map_lam, elapsed, quick, systems, branches, method: str
 ) -> str:
@@ -142,11 +146,20 @@ def report(
 
     r, tr, mo = point("light", 0.1)
     u_rng, v_rng = _range(tr, "u"), _range(tr, "v")
+    sh = meshing_states(tr).get("u", {})
+    separates = (sh.get("separated") or 0) > 0
     row(
         "f1 = 0.1, λ = 0.1: u ∈ [0.7, 1.3] (meshing and separation)",
-        f"u ∈ [{u_rng[0]:.3f}, {u_rng[1]:.3f}], {mo['u']}",
-        _grade(near(u_rng, 0.7, 1.3), u_rng[0] < 1 < u_rng[1]),
-        "sampled window",
+        f"u ∈ [{u_rng[0]:.3f}, {u_rng[1]:.3f}], {mo['u']}; the model's force on u is "
+        f"forward {sh.get('forward', 0):.2f}, zero {sh.get('separated', 0):.2f} of the time"
+        + (
+            f", inside the gap yet loaded {sh['loaded_in_gap']:.2f} (the polynomial carries "
+            "load there: it is zero only at 0 and ±0.770)"
+            if sh.get("loaded_in_gap")
+            else ""
+        ),
+        _grade(near(u_rng, 0.7, 1.3) and separates, near(u_rng, 0.7, 1.3) or separates),
+        "sampled window; separation read from the sign and zero of the model's own force",
     )
     impacts = v_rng[0] < -1 and v_rng[1] > 1
     row(
@@ -286,22 +299,7 @@ def report(
         "",
         "## Figures",
         "",
-        "- `bifurcation_light.png`, `bifurcation_heavy.png`: Poincaré points of u and v against "
-        "λ, forward and backward continuation.",
-        "- `point_<case>_lambda_<λ>.png`: time series, phase portrait with Poincaré points, and "
-        "spectrum of u and v.",
-        "- `map_f1_lambda.png`: Max(u), Min(v) and the motion of v over (f1, λ).",
-        "- `continuation_<case>.png`: continued branches (stable solid, unstable dashed, "
-        "bifurcations marked) over the brute-force Poincaré points.",
-        "- `meshing_lyapunov_<case>.png`: share of time each mesh spends in forward contact, "
-        "separated and in backward contact, and the largest Lyapunov exponent with its "
-        "uncertainty, against λ, both sweeps.",
-        "- `backlash.png`: the model's polynomial g(x) against the exact dead zone, contact "
-        "edges ±1 and the fit's valid range marked.",
-        "- `floquet_<case>.png`: moduli of the Floquet multipliers along each continued "
-        "branch against λ, the unit circle and the bifurcations located marked.",
-        "- `stiffness.png`: k(τ)/k_m of both meshes over two mesh periods, with their phase lag.",
-        "- `sensitivity/<load>-<open value>-*.png`: regime maps over λ by each open value.",
+        FIGURES_MARK,
         "",
         "Data (parameter values, scales and model hash with every point) are in `data/`.",
         "",
@@ -322,4 +320,5 @@ def _fmt(values) -> str:
 
 
 def _lyap(r) -> str:
-    return "n/a" if r.lyapunov is None else f"{r.lyapunov.exponent:.4f}"
+    rec = r.record().lyapunov
+    return "n/a" if rec is None else f"{rec['exponent']:.4f}"

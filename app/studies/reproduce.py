@@ -27,7 +27,8 @@ from gearsym.solver.system import System
 
 from .bearings import bearing_jobs, bearings_section
 from .cases import CASES, RESOLUTIONS, TOLERANCES
-from .report import report
+from .figures import figure_list
+from .report import FIGURES_MARK, report
 
 __all__ = ["reproduce"]
 
@@ -115,6 +116,7 @@ def reproduce(
             ["u", "v"],
             out / f"bifurcation_{case}.png",
             title=f"{case} load, f1 = {f1}: Poincaré points against lambda",
+            system=systems[case],
         )
         for value in (0.1, 0.8):
             forward = by_case[case][0]
@@ -123,13 +125,14 @@ def reproduce(
             result = analyse_point(systems[case].with_values(**{"lambda": value}), x0, **settings)
             points[(case, value)] = result
             plots.point_figure(
-                result.trajectory,
+                result,
                 out / f"point_{case}_lambda_{value}.png",
                 title=f"{case} load (f1 = {f1}), lambda = {value}",
             )
             (out / "data" / f"point_{case}_lambda_{value}.json").write_text(
                 dumps(result.describe()), encoding="utf-8"
             )
+    points.update(_chaotic_points(by_case, systems, settings, out))
     max_u = [sw.maxima("u") for sw in maps]
     min_v = [sw.minima("v") for sw in maps]
     motion_v = [sw.motion("v") for sw in maps]
@@ -149,9 +152,10 @@ def reproduce(
         plots.branch_figure(
             branches[case],
             out / f"continuation_{case}.png",
-            "u",
+            ("u", "v"),
             sweeps=by_case[case],
-            title=f"{case} load, f1 = {f1}: period-1 branch over the sweeps",
+            title=f"{case} load, f1 = {f1}: periodic branches over the sweeps",
+            system=systems[case],
         )
         floquet_figure(
             branches[case],
@@ -195,9 +199,33 @@ def reproduce(
         + sep
         + tail
     )
+    text = text.replace(FIGURES_MARK, figure_list(out))
     path = out / "report.md"
     path.write_text(text, encoding="utf-8")
     return path
+
+
+def _chaotic_points(by_case, systems, settings, out) -> dict:
+    """The first point of each case's sweeps judged chaotic, analysed again from where its
+    sweep run ended and drawn (``point_chaotic_<case>_lambda_<value>.png``)."""
+    from gearsym.solver import plots
+
+    found = {}
+    for case, sweeps in by_case.items():
+        hit = next((p for sw in sweeps for p in sw.points if p.motion("u") == "chaotic"), None)
+        if hit is None:
+            continue
+        value = hit.values["lambda"]
+        result = analyse_point(
+            systems[case].with_values(**{"lambda": value}), hit.x_final, **settings
+        )
+        found[(case, value)] = result
+        plots.point_figure(
+            result,
+            out / f"point_chaotic_{case}_lambda_{value:.4g}.png",
+            title=f"{case} load, lambda = {value:.4g}: a point the sweep judged chaotic",
+        )
+    return found
 
 
 def _continue_case(args):
@@ -213,6 +241,8 @@ def _continue_case(args):
         n = point.period("u")
         x0 = point.poincare_state(system.states)
         for target in (1.0, 0.0):  # both ways from where the sweep found it
+            if target == float(value):
+                continue  # no branch of zero length
             try:
                 br = continue_orbit(
                     system, "lambda", float(value), target, x0, n=n, ds=step, ds_max=4 * step

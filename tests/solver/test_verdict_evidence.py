@@ -54,7 +54,9 @@ def test_two_frequency_motion_is_a_torus_with_the_closed_form_rotation_number():
     for w in v.evidence["windows"][-2:]:
         assert w["label"] == "torus"
         assert w["rotation_number"] == pytest.approx(1 - 1 / np.sqrt(2.0), abs=1e-6)
-        assert abs(w["exponent"]["exponent"]) + w["exponent"]["uncertainty"] <= w["exponent"]["delta"]
+        assert (
+            abs(w["exponent"]["exponent"]) + w["exponent"]["uncertainty"] <= w["exponent"]["delta"]
+        )
         assert w["zero_one"]["K"] < 0.2  # regular (Gottwald and Melbourne)
 
 

@@ -4,7 +4,7 @@ sample for the correlation dimension (now: test_verdict_evidence.py)."""
 
 import numpy as np
 import pytest
-from gearsym.solver.analysis import analyse_point, classify_points, largest_lyapunov
+from gearsym.solver.analysis import classify_points, largest_lyapunov
 from gearsym.solver.integrate import simulate
 from gearsym.solver.periodic import FlowMap, shoot
 from gearsym.solver.periodic.shooting import search
