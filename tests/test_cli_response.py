@@ -21,7 +21,7 @@ def test_records_files_and_folds(capsys, tmp_path):
     for r in records:
         assert r["method"] == "hb" and isinstance(r["stable"], bool)
         assert set(r) == {"method", "omega", "stable", "u", "v"}
-        assert set(r["u"]) == {"mean", "amplitude", "rms", "dynamic_factor"}
+        assert set(r["u"]) == {"mean", "amplitude", "rms", "min", "max", "dynamic_factor"}
         assert r["u"]["amplitude"] >= 0 and r["u"]["dynamic_factor"] >= 1 - 1e-9
     omegas = [r["omega"] for r in records]
     assert min(omegas) == pytest.approx(0.3) and omegas[-1] == pytest.approx(0.9)

@@ -162,6 +162,46 @@ class HarmonicBalance:
             A[a * Mh : (a + 1) * Mh, a * Mh : (a + 1) * Mh] -= w * D
         return A
 
+    def extrema(self, X) -> tuple[np.ndarray, np.ndarray]:
+        """The smallest and the largest value over the period of each row of ``X``
+        ((rows, 2H + 1) coefficients; two arrays (rows,)), read off the trigonometric
+        polynomial itself, not off samples of it.
+
+        The extremes are first found on ``max(64, 8 (2H + 1))`` equally spaced phases
+        (about 16 a period of the highest harmonic, so the sample nearest each extreme
+        lies in its basin) and then refined by Newton's method on ``x'(s) = 0`` with the
+        exact derivatives ``x'(s) = sum k (s_k cos ks - c_k sin ks)`` and ``x''(s) = -sum
+        k^2 (c_k cos ks + s_k sin ks)``, kept within one sample of the start; a refined
+        value never replaces a better sampled one.  Converges quadratically: a sampled
+        half peak-to-peak is off by ``O(h^2 x'')`` (1.9e-5 on a linear oscillator at 512
+        phases), the refined one by rounding."""
+        X = np.atleast_2d(np.asarray(X, float))
+        grid = max(64, 8 * self.M)
+        h = 2 * np.pi / grid
+        s = h * np.arange(grid)
+        y = self.time_series(X, s)
+        lo = np.minimum(y.min(axis=1), self._refine(X, s[np.argmin(y, axis=1)], h))
+        hi = np.maximum(y.max(axis=1), self._refine(X, s[np.argmax(y, axis=1)], h))
+        return lo, hi
+
+    def _refine(self, X, start, h, iterations: int = 8) -> np.ndarray:
+        """The value at the stationary point within ``start +- h`` of each row (Newton on
+        ``x'(s) = 0``, clipped to the bracket)."""
+        k = np.arange(1, self.H + 1)
+        c, d = X[:, 1::2], X[:, 2::2]
+        t = start.copy()
+        for _ in range(iterations):
+            ks = np.outer(t, k)
+            cos, sin = np.cos(ks), np.sin(ks)
+            d1 = np.sum(k * (d * cos - c * sin), axis=1)
+            d2 = -np.sum(k**2 * (c * cos + d * sin), axis=1)
+            step = np.divide(d1, d2, out=np.zeros_like(d1), where=d2 != 0)
+            t = np.clip(t - step, start - h, start + h)
+            if np.max(np.abs(step)) <= 1e-15 * np.pi:
+                break
+        ks = np.outer(t, k)
+        return X[:, 0] + np.sum(c * np.cos(ks) + d * np.sin(ks), axis=1)
+
     def time_series(self, X, phases) -> np.ndarray:
         """The states at the phases ``s`` (radians of the base period), (states, len)."""
         s = np.atleast_1d(np.asarray(phases, float))

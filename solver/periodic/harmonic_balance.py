@@ -93,18 +93,21 @@ class HBSolution:
         """The state at ``t0`` (a shooting start, for example)."""
         return self.at(np.array([t0]))[:, 0]
 
-    def _dense(self, name: str, points: int = 1024) -> np.ndarray:
+    def extremes(self, name: str) -> tuple[float, float]:
+        """The smallest and largest value of ``name`` over the period n T, at the extrema
+        of its trigonometric polynomial (refined, :meth:`~.aft.HarmonicBalance.extrema`)."""
         i = self.system.index(name)
-        s = 2 * np.pi * np.arange(points) / points
-        return self._problem().time_series(self.coefficients[i : i + 1], s)[0]
+        lo, hi = self._problem().extrema(self.coefficients[i : i + 1])
+        return float(lo[0]), float(hi[0])
 
     def mean(self, name: str) -> float:
         return float(self.coefficients[self.system.index(name), 0])
 
     def amplitude(self, name: str) -> float:
-        """Half the peak-to-peak value of ``name`` over the period (1024 phases)."""
-        y = self._dense(name)
-        return float((y.max() - y.min()) / 2)
+        """Half the peak-to-peak value of ``name`` over the period, ``(max - min) / 2``
+        at the refined extrema (:meth:`extremes`)."""
+        lo, hi = self.extremes(name)
+        return (hi - lo) / 2
 
     def rms(self, name: str) -> float:
         """Root mean square of ``name`` (Parseval, exact on the series)."""
@@ -140,7 +143,13 @@ class HBSolution:
             "tail_share": self.tail_share(),
             "values": {k: float(v) for k, v in self.system.values.items()},
             "coordinates": {
-                c: {"mean": self.mean(c), "amplitude": self.amplitude(c), "rms": self.rms(c)}
+                c: {
+                    "mean": self.mean(c),
+                    "amplitude": self.amplitude(c),
+                    "rms": self.rms(c),
+                    "min": self.extremes(c)[0],
+                    "max": self.extremes(c)[1],
+                }
                 for c in self.system.coordinates
             },
             "stable": None if self.floquet is None else self.floquet.stable,

@@ -22,7 +22,9 @@ from ._bounds import interval_of
 from .continuation import model_fields
 from .engine import Linearisation, Settings, continue_branch
 from .floquet import Floquet, multiplier_tests
+from .flow import FlowMap, StroboscopicMap
 from .harmonic_balance import HarmonicBalance, harmonic_balance, hill
+from .hb_confirm import RTOL, located_monodromy, screen
 from .newton import newton
 from .records import Branch, BranchPoint
 
@@ -47,6 +49,9 @@ class HarmonicBalanceProblem:
         self.shape = (system.n, problem.M)
         self.valid = interval_of(system, parameter)  # a scene or model parameter
         self.tol, self.with_stability, self.check = tol, stability, check
+        # the located monodromies at the events of a piecewise model, by parameter value
+        # (``hb_confirm.py`` reuses them)
+        self.monodromies: dict[float, np.ndarray] = {}
 
     def p(self, lam: float) -> np.ndarray:
         if lam not in self.valid:
@@ -118,14 +123,35 @@ class HarmonicBalanceProblem:
 
 def monodromy_check(curve: HarmonicBalanceProblem, z, n: int) -> dict:
     """Hill's multipliers at ``z`` against the monodromy of the time integration from the
-    harmonic-balance state (central differences of the flow over n T, compiled DOP853 at
-    rtol 1e-12, the 2 n_states runs in one lockstep group): the largest distance from a
-    Hill multiplier to the nearest monodromy multiplier."""
-    from ..integrate.native import run_batch
-
+    harmonic-balance state: the largest distance from a Hill multiplier to the nearest
+    monodromy multiplier, and the largest monodromy multiplier's modulus.  A smooth model:
+    central differences of the flow over n T, compiled DOP853 at rtol 1e-12, the
+    2 n_states runs in one lockstep group.  A piecewise model: the located variational
+    equations (:func:`~.hb_confirm.located_monodromy`, kept in ``curve.monodromies``)."""
     X, lam = z[:-1].reshape(curve.shape), float(z[-1])
     p = curve.p(lam)
     x0 = curve.problem.synthesis(X)[:, 0]
+    if curve.system.piecewise:
+        M = _located(curve, lam, x0)
+    else:
+        M = _central(curve, p, x0, n)
+    mu = np.linalg.eigvals(M)
+    _, fl = hill(curve.problem, X, p)
+    gap = max(float(np.min(np.abs(mu - m))) for m in fl.multipliers)
+    return {"hill_vs_monodromy": gap, "max_monodromy_multiplier": float(np.max(np.abs(mu)))}
+
+
+def _located(curve: HarmonicBalanceProblem, lam: float, x0) -> np.ndarray:
+    flow = FlowMap(curve.system, rtol=RTOL, atol=RTOL * 1e-2, locate=True)
+    smap = StroboscopicMap(curve.system, curve.n, flow=flow)
+    M = located_monodromy(smap, curve.system, curve.parameter, lam, x0)
+    curve.monodromies[lam] = M
+    return M
+
+
+def _central(curve: HarmonicBalanceProblem, p, x0, n: int) -> np.ndarray:
+    from ..integrate.native import run_batch
+
     nx = x0.size
     h = 1e-6 * max(1.0, float(np.max(np.abs(x0))))
     starts = np.vstack([x0 + h * e for e in np.eye(nx)] + [x0 - h * e for e in np.eye(nx)])
@@ -142,11 +168,7 @@ def monodromy_check(curve: HarmonicBalanceProblem, z, n: int) -> dict:
         samples_per_period=1,
     )
     end = run.x[:, -1, :]
-    M = ((end[:nx] - end[nx:]) / (2 * h)).T
-    mu = np.linalg.eigvals(M)
-    _, fl = hill(curve.problem, X, p)
-    gap = max(float(np.min(np.abs(mu - m))) for m in fl.multipliers)
-    return {"hill_vs_monodromy": gap, "max_monodromy_multiplier": float(np.max(np.abs(mu)))}
+    return ((end[:nx] - end[nx:]) / (2 * h)).T
 
 
 def continue_hb(
@@ -167,6 +189,7 @@ def continue_hb(
     stability: bool = True,
     locate: bool = True,
     check: bool = True,
+    confirm: bool | None = None,
 ) -> Branch:
     """Continue the harmonic-balance solution from ``parameter = start`` to ``stop``.
 
@@ -182,7 +205,10 @@ def continue_hb(
     ``message`` say which.  ``stability``: Hill's multipliers at every point (and the
     period doublings and Neimark-Sacker points located); ``check``: every located
     bifurcation also carries the distance of Hill's multipliers from the monodromy of a
-    time integration there (:func:`monodromy_check`) as its evidence.
+    time integration there (:func:`monodromy_check`) as its evidence.  ``confirm``
+    (default: on a piecewise model, with ``stability`` and ``locate``): keep only the
+    events the monodromy of a located time integration confirms, typed by it
+    (:func:`~.hb_confirm.screen`; the branch's notes count the dropped ones).
     """
     started = time.perf_counter()
     if start == stop:
@@ -215,4 +241,8 @@ def continue_hb(
     )
     z = np.r_[first.coefficients.ravel(), float(start)]
     branch = continue_branch(curve, z, stop, settings, locate=locate)
+    if confirm is None:
+        confirm = system.piecewise and stability and locate
+    if confirm:
+        branch = screen(system, branch, curve.monodromies).branch
     return replace(branch, wall_time=time.perf_counter() - started)

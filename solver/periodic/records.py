@@ -195,16 +195,22 @@ class Branch:
         """The mean of ``name`` (its coefficient c0) at every point."""
         return self._coefficients(self._fourier().system.index(name), 0)
 
+    def extrema(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """Min and max of ``name`` at every point, read off the trigonometric polynomial
+        at its refined extrema (``aft.HarmonicBalance.extrema``), not off samples."""
+        prob = self._fourier()
+        return prob.extrema(self._coefficients(prob.system.index(name)))
+
     def amplitude(self, name: str) -> np.ndarray:
-        """Half peak-to-peak of ``name`` at every point."""
-        y = self.series(name)
-        return (y.max(axis=1) - y.min(axis=1)) / 2
+        """Half peak-to-peak of ``name`` at every point (refined extrema)."""
+        lo, hi = self.extrema(name)
+        return (hi - lo) / 2
 
     def maximum(self, name: str) -> np.ndarray:
-        return self.series(name).max(axis=1)
+        return self.extrema(name)[1]
 
     def minimum(self, name: str) -> np.ndarray:
-        return self.series(name).min(axis=1)
+        return self.extrema(name)[0]
 
     def rms(self, name: str) -> np.ndarray:
         """``sqrt(c0^2 + (1/2) sum_k (c_k^2 + s_k^2))`` of ``name`` at every point."""
@@ -228,15 +234,22 @@ class Branch:
 
     def records(self) -> list[dict]:
         """One record per point: the parameter under its own name, ``stable``,
-        ``stability`` and per coordinate its ``mean``, ``amplitude`` (half peak-to-peak)
-        and ``rms`` (harmonic balance)."""
+        ``stability`` and per coordinate its ``mean``, ``amplitude`` (half peak-to-peak),
+        ``rms``, ``min`` and ``max`` (harmonic balance; extremes refined on the
+        trigonometric polynomial)."""
         coords = self._fourier().system.coordinates
-        stats = {c: (self.mean(c), self.amplitude(c), self.rms(c)) for c in coords}
+        stats = {c: (self.mean(c), *self.extrema(c), self.rms(c)) for c in coords}
         out = []
         for k, p in enumerate(self.points):
             rec = {self.parameter: p.value, "stable": p.stable, "stability": p.stability}
             for c in coords:
-                m, a, r = stats[c]
-                rec[c] = {"mean": float(m[k]), "amplitude": float(a[k]), "rms": float(r[k])}
+                m, lo, hi, r = stats[c]
+                rec[c] = {
+                    "mean": float(m[k]),
+                    "amplitude": float(hi[k] - lo[k]) / 2,
+                    "rms": float(r[k]),
+                    "min": float(lo[k]),
+                    "max": float(hi[k]),
+                }
             out.append(rec)
         return out

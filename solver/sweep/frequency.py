@@ -104,16 +104,28 @@ def _hb_curve(system, parameter, start, stop, harmonics, n, ds) -> Curve:
         ds=ds,
         ds_max=span / 10,
         dlam_max=ds,
+        confirm=False,
     )
+    screening = None
+    if system.piecewise:
+        # Hill's flags on a piecewise model: kept only where the located monodromy
+        # confirms them (hb_confirm.py); the counts go into the curve's details
+        from ..periodic.hb_confirm import screen
+
+        screening = screen(system, br)
+        br = screening.branch
     stats = {}
+    prob = br.harmonic_balance
     for c in system.coordinates:
-        y = br.series(c)
+        i = system.index(c)
+        C = np.array([pt.coefficients[i] for pt in br.points]).reshape(-1, prob.M)
+        lo, hi = prob.extrema(C)  # at the polynomial's refined extrema, not on a grid
         stats[c] = {
             "mean": br.mean(c),
-            "amplitude": (y.max(axis=1) - y.min(axis=1)) / 2,
+            "amplitude": (hi - lo) / 2,
             "rms": br.rms(c),
-            "max": y.max(axis=1),
-            "min": y.min(axis=1),
+            "max": hi,
+            "min": lo,
         }
     for c, d in _hb_factors(system, parameter, br, n).items():
         stats[c]["dynamic_factor"] = d
@@ -125,7 +137,7 @@ def _hb_curve(system, parameter, start, stop, harmonics, n, ds) -> Curve:
         br.stable,
         stats,
         br.bifurcations,
-        br.wall_time,
+        br.wall_time + (0.0 if screening is None else screening.wall_time),
         {
             "harmonics": harmonics,
             "samples": br.harmonic_balance.N,
@@ -133,6 +145,7 @@ def _hb_curve(system, parameter, start, stop, harmonics, n, ds) -> Curve:
             "notes": list(br.notes),
             "status": br.status,
             "message": br.message,
+            "screening": None if screening is None else screening.describe(),
         },
         br.states,
     )

@@ -9,13 +9,20 @@ import numpy as np
 
 from ..system import System
 
-__all__ = ["Curve", "FrequencyResponse"]
+__all__ = ["QUANTITIES", "Curve", "FrequencyResponse"]
+
+# What each record keeps per coordinate (and the dynamic factor where the model emits its
+# mesh forces): the extremes too, since impact regimes are read from them (|u| > 1:
+# contact, u < -1: back contact).
+QUANTITIES = ("mean", "amplitude", "rms", "min", "max")
 
 
 @dataclass(frozen=True)
 class Curve:
     """One method's solution curve: per point the parameter value, stability and, per
-    coordinate, mean, amplitude and RMS; the located events."""
+    coordinate, mean, amplitude (half peak-to-peak), RMS, minimum and maximum (harmonic
+    balance: at the refined extrema of the trigonometric polynomial; shooting and
+    integration: over the samples); the located events."""
 
     method: str
     parameter: str
@@ -37,7 +44,7 @@ class Curve:
             if "direction" in self.details:
                 rec["direction"] = self.details["direction"]
             for c, s in self.stats.items():
-                rec[c] = {q: float(s[q][k]) for q in ("mean", "amplitude", "rms")}
+                rec[c] = {q: float(s[q][k]) for q in QUANTITIES}
                 if "dynamic_factor" in s:
                     rec[c]["dynamic_factor"] = float(s["dynamic_factor"][k])
             out.append(rec)
@@ -80,7 +87,7 @@ class FrequencyResponse:
     def to_table(self) -> tuple[list, list]:
         coords = self.system.coordinates
         columns = ["method", self.parameter, "stable"] + [
-            f"{c}_{q}" for c in coords for q in ("mean", "amplitude", "rms", "dynamic_factor")
+            f"{c}_{q}" for c in coords for q in (*QUANTITIES, "dynamic_factor")
         ]
         rows = []
         for r in self.records():
@@ -90,7 +97,7 @@ class FrequencyResponse:
                 + [
                     r[c].get(q, float("nan"))
                     for c in coords
-                    for q in ("mean", "amplitude", "rms", "dynamic_factor")
+                    for q in (*QUANTITIES, "dynamic_factor")
                 ]
             )
         return columns, rows

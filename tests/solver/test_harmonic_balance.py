@@ -190,7 +190,7 @@ def test_continuation_through_the_hysteresis_band_of_a_hardening_duffing():
         )
     records = branch.records()
     assert set(records[0]) == {"omega", "stable", "stability", "x"}
-    assert set(records[0]["x"]) == {"mean", "amplitude", "rms"}
+    assert set(records[0]["x"]) == {"mean", "amplitude", "rms", "min", "max"}
 
 
 def test_integration_sweeps_in_the_phase_agree_with_harmonic_balance():
