@@ -56,6 +56,10 @@ MESHING_CLASSES = (
     ("single-sided impact", "#e377c2"),
     ("double-sided impact", "#7b0051"),
     ("no contact", "#ffed6f"),
+    # a force law loaded inside the gap (the study's polynomial): it reverses, never lifts
+    ("single-sided force reversal", "#fdb462"),
+    ("double-sided force reversal", "#8c510a"),
+    ("inside the outer zeros, loaded", "#b3de69"),
     *OUTCOMES,
 )
 # Marker families: a sweep's direction (filled dots over open rings: both stay visible
@@ -379,6 +383,8 @@ def map_figures(
         regime = m.grid("meshing", c)
         pick = np.vectorize(lambda f, r: f or r or "undetermined", otypes=[object])
         labels = pick(failed, regime)
-        categorical_panel(ax, labels, MESHING_CLASSES, f"meshing regime of {c} (Kahraman & Singh)")
+        categorical_panel(
+            ax, labels, MESHING_CLASSES, f"meshing regime of {c} (by the sign of its force)"
+        )
     out.append(_save(fig, folder / f"{prefix}-meshing.png", caption))
     return out

@@ -220,7 +220,12 @@ def refuse_conflicts(args, varied: list[str], option: str) -> None:
 # Bounded work: the most periods a run may ask for (stated in each option's help).  The
 # compiled integrator takes 10 us to 1 ms a period depending on the model, the exponent's
 # variational run about 1 ms: a million periods is seconds to a quarter of an hour.
-LIMITS = {"transient": 1_000_000, "periods": 1_000_000, "lyapunov_periods": 100_000}
+LIMITS = {
+    "transient": 1_000_000,
+    "periods": 1_000_000,
+    "lyapunov_periods": 100_000,
+    "budget": 1_000_000,
+}
 # periods integrated in all by a sweep or a map (points x runs x periods): 1e9 is about
 # three hours of one core on the smallest model, minutes on a cluster
 MAX_TOTAL_PERIODS = 1e9
@@ -231,7 +236,7 @@ def analysis_settings(args) -> dict:
         value = getattr(args, name)
         if not (value > 0 and math.isfinite(value)):
             raise Fail(f"--{name} must be a positive number, got {value}")
-    for name, low in (("transient", 0), ("periods", 1), ("lyapunov_periods", 0)):
+    for name, low in (("transient", 0), ("periods", 1), ("lyapunov_periods", 0), ("budget", 0)):
         if getattr(args, name) < low:
             option = "--" + name.replace("_", "-")
             raise Fail(f"{option} must be a whole number >= {low}, got {getattr(args, name)}")
@@ -269,6 +274,7 @@ def analysis_settings(args) -> dict:
         samples_per_period=spp,
         lyapunov_periods=args.lyapunov_periods,
         on_invalid=args.on_invalid,
+        budget=args.budget,
     )
 
 
@@ -312,9 +318,24 @@ def analysis_options(sub) -> None:
     sub.add_argument(
         "--lyapunov-periods",
         type=int,
-        default=200,
-        help=f"periods for the largest Lyapunov exponent (200; 0: skip; at most "
-        f"{LIMITS['lyapunov_periods']:,})",
+        default=400,
+        help="a run not periodic is continued from its end in windows of this many periods "
+        "(each next one twice as long), each with the largest Lyapunov exponent (400; 0: no "
+        f"exponent, so only periodic verdicts settle; at most {LIMITS['lyapunov_periods']:,})",
+    )
+    budget_option(sub)
+
+
+def budget_option(sub) -> None:
+    from gearsym.solver.analysis import BUDGET
+
+    sub.add_argument(
+        "--budget",
+        type=int,
+        default=BUDGET,
+        help=f"periods a verdict may take in all, from the run's start ({BUDGET:,}; 0: no "
+        "continued windows; borders of sweeps and maps get 8,000; at most "
+        f"{LIMITS['budget']:,})",
     )
 
 

@@ -10,6 +10,7 @@ from ._common import (
     MAX_TOTAL_PERIODS,
     Fail,
     at_most,
+    budget_option,
     out_folder,
     parse_range,
     parse_set,
@@ -53,6 +54,7 @@ def register(sub) -> None:
         f"at most {MAX_INITIAL_STATES})",
     )
     mp.add_argument("--seed", type=int, default=0, help="seed of the random initial states")
+    budget_option(mp)
     mp.add_argument(
         "--box",
         action="append",
@@ -183,7 +185,7 @@ def _cmd_map(args) -> int:
         raise Fail(f"--x and --y name the same parameter '{xn}'; map two different ones")
     if args.initial_states < 1:
         raise Fail(f"--initial-states must be >= 1, got {args.initial_states}")
-    for name in ("transient", "lyapunov_periods"):
+    for name in ("transient", "lyapunov_periods", "budget"):
         if getattr(args, name) < 0:
             raise Fail(f"--{name.replace('_', '-')} must be >= 0")
     if args.periods < 1:
@@ -234,6 +236,7 @@ def _cmd_map(args) -> int:
             transient=args.transient,
             periods=args.periods,
             lyapunov_periods=args.lyapunov_periods,
+            budget=args.budget,
             method=args.method,
             rtol=args.rtol,
             atol=args.atol,

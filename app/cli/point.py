@@ -56,8 +56,8 @@ def register(sub) -> None:
         required=True,
         metavar="START:STOP:NUM",
         help="NUM values from START to STOP; write --range=-1:1:21 when START is negative; "
-        f"NUM at most {MAX_SWEEP_POINTS:,}, and NUM x (--transient + --periods + "
-        f"--lyapunov-periods) at most {MAX_TOTAL_PERIODS:.0e} periods",
+        f"NUM at most {MAX_SWEEP_POINTS:,}, and NUM x the larger of --transient + "
+        f"--periods and --budget at most {MAX_TOTAL_PERIODS:.0e} periods",
     )
     sw.add_argument("--backward", action="store_true", help="continue from STOP to START")
     sw.add_argument(
@@ -186,7 +186,7 @@ def _cmd_sweep(args) -> int:
         f"--range {args.range}: {len(values)} points of {args.periods} periods",
         "sweep fewer points or periods",
     )
-    total = len(values) * (args.transient + args.periods + args.lyapunov_periods)
+    total = len(values) * max(args.transient + args.periods, args.budget)
     if len(values) > MAX_SWEEP_POINTS or total > MAX_TOTAL_PERIODS:
         raise Fail(
             f"--range {args.range}: {len(values):,} points of {args.transient} + "

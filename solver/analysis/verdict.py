@@ -12,8 +12,11 @@ oscillation and batch means over eight blocks).  The labels and their evidence:
   stated tolerance, or they are converging to it (the gaps ``|P_{k+n} - P_k|`` shrink
   over the window).  The exponent is then the orbit's ``log max|mu| / (n T)``.
 * **chaotic** -- in the last two windows the exponent's interval ``lambda +- U`` lies
-  above zero, and the 0-1 test for chaos (``zero_one.py``; Gottwald and Melbourne 2004,
-  2009) on the most spread coordinate gives ``K >= K_CHAOS``.  Chaos in an earlier window
+  above zero, and an independent second test agrees: the 0-1 test for chaos
+  (``zero_one.py``; Gottwald and Melbourne 2004, 2009) on the most spread coordinate gives
+  ``K >= K_CHAOS``, or, where it does not (weak chaos: K converges slowly in the number
+  of samples), the exponent of two nearby trajectories (``two_trajectory.py``, no
+  Jacobian) has its interval above zero too.  Chaos in an earlier window
   that ends on a periodic orbit is reported as a chaotic transient, with its length.
 * **quasi-periodic** -- in the last two windows the exponent's interval lies within
   ``+-delta`` of zero (``delta = DELTA / T``: a growth of at most ``e^0.01`` per period),
@@ -155,6 +158,18 @@ def _exponent(lyap: LyapunovEstimate, period: float) -> dict:
     }
 
 
+def _pair(system, w: Window, upper: float) -> dict:
+    """The two-trajectory exponent over the window (``two_trajectory.py``), or why not."""
+    from .two_trajectory import two_trajectory
+
+    try:
+        return two_trajectory(
+            system, w.points[:, 0], w.points.shape[1], t0=w.start * system.period, upper=upper
+        )
+    except FloatingPointError as err:
+        return {"failed": str(err)}
+
+
 def judge(system, w: Window, tol: float) -> dict:
     """The evidence of one non-periodic window and what it reads as: ``label`` one of
     ``chaotic``, ``torus`` or ``unsettled`` (with ``why``)."""
@@ -174,9 +189,20 @@ def judge(system, w: Window, tol: float) -> dict:
     K = ev.get("zero_one", {}).get("K")
     if ex["sign"] == "positive":
         if K is not None and K >= K_CHAOS:
-            return ev | {"label": "chaotic"}
-        why = "the exponent is positive but the 0-1 test " + (
-            "could not run" if K is None else f"reads K = {K:.2f} (chaos needs >= {K_CHAOS})"
+            return ev | {"label": "chaotic", "second_test": "0-1 test"}
+        pair = _pair(system, w, ex["interval"][1])
+        ev["two_trajectory"] = pair
+        if "interval" in pair and pair["interval"][0] > 0:
+            return ev | {"label": "chaotic", "second_test": "two-trajectory exponent"}
+        why = (
+            "the exponent is positive but the 0-1 test "
+            + ("could not run" if K is None else f"reads K = {K:.2f} (chaos needs >= {K_CHAOS})")
+            + " and the two-trajectory exponent "
+            + (
+                f"lies in [{pair['interval'][0]:.2e}, {pair['interval'][1]:.2e}]"
+                if "interval" in pair
+                else f"failed: {pair['failed']}"
+            )
         )
         return ev | {"label": "unsettled", "why": why}
     if ex["sign"] == "zero":

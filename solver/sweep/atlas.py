@@ -305,7 +305,7 @@ def regime_map(
             for k, r in enumerate(column_runs):
                 runs.setdefault((ix, k // per), []).append(r)
     runs = {cell: _ordered(rs) for cell, rs in runs.items()}
-    looks = map_looks(runs, grid, (nx, ny), _look_options(opts))
+    looks = map_looks(runs, grid, (nx, ny), _look_options(opts)) if opts["budget"] else []
     if looks:
         looked = map_tasks(run_look, [lk for _, _, lk in looks], executor=executor, workers=workers)
         for (cell, k, _), r in zip(looks, looked, strict=True):

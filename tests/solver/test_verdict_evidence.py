@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 from gearsym.solver.analysis import analyse_point, classify_points
 from gearsym.solver.analysis.orbit_check import check_orbit
+from gearsym.solver.analysis.two_trajectory import two_trajectory
 from gearsym.solver.periodic import shoot
 from gearsym.solver.system import System
 
@@ -113,3 +114,20 @@ def test_a_chaotic_transient_is_reported_and_ends_on_the_periodic_orbit():
     for t in transient:
         assert t["chaotic_until_at_least"] < t["periodic_by"]
         assert "chaotic transient" in t["text"]
+
+
+def test_two_trajectory_exponent_against_the_closed_form_and_benettin():
+    # Reference 1 (closed form): x'' + k x' + x = B cos(omega tau) has the exponent -k/2
+    # for every solution.  Reference 2: Benettin's variational estimate on Ueda's
+    # oscillator; the two intervals must overlap (no Jacobian in this one).
+    linear = System.load(DUFFING, a=1.0, c=0.0, k=0.1, omega=1.3, B=0.5)
+    pair = two_trajectory(linear, np.array([0.3, 0.0]), 400, upper=0.01)
+    lo, hi = pair["interval"]
+    assert lo <= -0.05 <= hi and hi - lo < 1e-3
+    ueda = analyse_point(System.load(DUFFING), np.array([2.5, 0.0])).verdict
+    last = ueda.evidence["windows"][-1]
+    start = np.array(analyse_point(System.load(DUFFING), np.array([2.5, 0.0])).settled.x_final)
+    pair = two_trajectory(System.load(DUFFING), start, 800, upper=last["exponent"]["interval"][1])
+    a, b = pair["interval"]
+    c, d = last["exponent"]["interval"]
+    assert a > 0 and max(a, c) <= min(b, d)
