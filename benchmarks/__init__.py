@@ -12,6 +12,11 @@
   batched right-hand side, with and without shared parameters;
 * ``floors`` -- this checkout against another one (``--before DIR``), alternating fresh
   processes: the speed floors of the engine and whether the results are the same;
+* ``verdicts`` -- the verdict benchmark of issue 27: regime-map verdicts at default
+  settings against 10,000-period reference runs classified by ``_verdicts_reference``
+  (its own code: no verdict module of the solver); writes ``docs/verdicts.md`` and
+  ``docs/verdicts.json``; ``verdict_cost`` -- what the verdicts cost: the 400-point sweep and
+  ``gearsym reproduce``, this checkout against another (``--before DIR``);
 * ``robustness`` -- the extremes matrix, every case with every back end
   (``python -m gearsym.benchmarks.robustness``; writes ``docs/robustness.md``, needs the
   checkout, whose tests list the bad-input cases);
