@@ -271,12 +271,6 @@ def _cmd_response(args) -> int:
                 else ""
             )
             print(f"  {e.kind:<16} {name} = {e.value:.8g}{check}")
-        sc = c.details.get("screening")
-        if sc:
-            print(
-                f"  Hill's flags checked by a located monodromy: {sc['flagged']} flagged, "
-                f"{sc['confirmed']} confirmed ({sc['retyped']} retyped), {sc['dropped']} dropped"
-            )
         for note in c.details.get("notes", []):
             print(f"  note: {note}")
         if c.details.get("status") in ("boundary", "max-points"):
