@@ -236,6 +236,7 @@ def _caption(m: RegimeMap, title: str | None = None, shown: str = "dominant") ->
     return (
         f"{title or m.model}{'; ' + fixed if fixed else ''}; {k} initial states per point "
         f"({', '.join(starts)}; seed {s['seed']}); {s['transient']} + {s['periods']} periods, "
+        f"continued to settle the verdict up to {s.get('budget', 0):,} (borders 8,000), "
         f"{s['method']} rtol {s['rtol']:g}; {what}"
     )
 
@@ -334,10 +335,19 @@ def map_figures(
         ax.set_title(text)
 
     if "motion" in kinds:
-        fig, axes = plt.subplots(1, nc, figsize=(5.2 * nc + 1.5, 4.2), squeeze=False)
-        for ax, c in zip(axes[0], coords, strict=True):
-            labels = np.vectorize(motion_class)(m.grid("motion", c), status)
-            categorical_panel(ax, labels, MOTION_CLASSES, f"motion of {c}")
+        grids = [np.vectorize(motion_class)(m.grid("motion", c), status) for c in coords]
+        # one verdict per attractor: the coordinates share it (maps from before that
+        # carried one per coordinate get a panel each)
+        one = all(np.array_equal(g, grids[0]) for g in grids)
+        panels = (
+            [(grids[0], "motion of the attractor")]
+            if one
+            else list(zip(grids, coords, strict=True))
+        )
+        k = len(panels)
+        fig, axes = plt.subplots(1, k, figsize=(5.2 * k + 1.5, 4.2), squeeze=False)
+        for ax, (labels, c) in zip(axes[0], panels, strict=True):
+            categorical_panel(ax, labels, MOTION_CLASSES, c if one else f"motion of {c}")
         out.append(_save(fig, folder / f"{prefix}-motion.png", caption))
 
     if "lyapunov" in kinds:

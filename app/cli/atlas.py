@@ -280,3 +280,15 @@ def _summary(m) -> None:
         print(f"  motion of {c} (dominant attractor): {parts}")
     many = int((m.grid("attractors") > 1).sum())
     print(f"  grid points with more than one outcome: {many} of {n}")
+    runs = [a.run for row in m.cells for cell in row for a in cell.attractors]
+    verdicts = [r.verdict for r in runs if r.verdict]
+    longer = sum(
+        (v.get("periods_run") or 0) > m.settings["transient"] + m.settings["periods"]
+        for v in verdicts
+    )
+    looked = sum("reexamined" in v for v in verdicts)
+    print(
+        f"  verdicts (attractors shown): {longer} of {len(verdicts)} run on past the first "
+        f"{m.settings['transient'] + m.settings['periods']} periods, {looked} re-examined at a "
+        "border with the long budget"
+    )

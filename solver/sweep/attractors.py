@@ -162,6 +162,8 @@ class Attractor:
             "meshing": dict(r.meshing_regime),
             "poincare_spread": dict(r.spread),
             "state": [float(v) for v in r.tail[-1]],
+            "periods_run": (r.verdict or {}).get("periods_run"),
+            "verdict": r.verdict,
             **({"why": why} if why else {}),
             **({"verdicts": self.votes} if self.votes else {}),
         }

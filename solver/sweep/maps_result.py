@@ -106,6 +106,7 @@ class RegimeMap:
 
     def to_table(self) -> tuple[list, list]:
         columns = [self.x, self.y, "attractor", "attractors", "share", "status", "lyapunov"]
+        columns += ["periods_run"]
         columns += [f"motion_{c}" for c in self.coordinates]
         columns += [f"meshing_{c}" for c in self.coordinates]
         columns += [f"max_{s}" for s in self.states] + [f"min_{s}" for s in self.states]
@@ -113,7 +114,7 @@ class RegimeMap:
         for r in self.records():
             rows.append(
                 [r[self.x], r[self.y], r["attractor"], r["attractors"], r["share"]]
-                + [r["status"], r["lyapunov"]]
+                + [r["status"], r["lyapunov"], r.get("periods_run")]
                 + [r["motion"][c] for c in self.coordinates]
                 + [r["meshing"].get(c) for c in self.coordinates]
                 + [r["max"][s] for s in self.states]
@@ -155,6 +156,7 @@ class RegimeMap:
                 lyapunov=lyapunov,
                 poincare={s: np.array([v], float) for s, v in zip(states, r["state"], strict=True)},
                 spread=r["poincare_spread"],
+                verdict=r.get("verdict"),
             )
             key = (float(r[x]), float(r[y]))
             votes = r.get("verdicts", {})
