@@ -242,8 +242,22 @@ def _cmd_sweep(args) -> int:
         print(f"wrote {path} and {fig}")
     else:
         print(f"wrote {path}")
-    for c in system.coordinates:
-        print(f"  {c}: {runs_text(values, result.motion(c))}")
+    motions = [result.motion(c) for c in system.coordinates]
+    if all(m == motions[0] for m in motions):  # one verdict per attractor: said once
+        print(f"  attractor: {runs_text(values, motions[0])}")
+    else:
+        for c, m in zip(system.coordinates, motions, strict=True):
+            print(f"  {c}: {runs_text(values, m)}")
+    verdicts = [p.verdict for p in result.points if p.verdict]
+    first = args.transient + args.periods
+    longer = sum((v.get("periods_run") or 0) > first for v in verdicts)
+    looked = sum("reexamined" in v for v in verdicts)
+    chaos = sum("transient_chaos" in v.get("evidence", v) for v in verdicts)
+    print(
+        f"  verdicts: {longer} of {len(verdicts)} points run on past the first {first} "
+        f"periods, {looked} re-examined at a border with the long budget"
+        + (f", {chaos} after a chaotic transient" if chaos else "")
+    )
     if failed:
         print(
             f"  {len(failed)} point(s) did not finish normally (status in sweep.json): "

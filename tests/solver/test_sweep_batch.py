@@ -133,7 +133,8 @@ def test_cli_sweep_of_independent_points(tmp_path, capsys):
     assert all(p["status"] == "ok" for p in data["points"])
     assert all("multipliers" in p["lyapunov"]["method"] for p in data["points"])
     assert (out / "bifurcation.png").stat().st_size > 0
-    assert "u: period-1 on [0, 1]" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "attractor: period-1 on [0, 1]" in out and "verdicts: 0 of 8 points" in out
 
 
 def test_cli_sweep_errors_are_one_line(tmp_path, capsys):
