@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["CASES", "RESOLUTIONS", "TOLERANCES", "Resolution"]
+__all__ = ["CASES", "DEAD_ZONE", "RESOLUTIONS", "TOLERANCES", "Resolution"]
 
 
 @dataclass(frozen=True)
@@ -23,4 +23,6 @@ RESOLUTIONS = {
 }
 
 CASES = (("light", "reference_light", 0.1), ("heavy", "reference_heavy", 0.5))
+# the exact dead zone the polynomial approximates (the light scene; f1 set per case)
+DEAD_ZONE = "reference_dead_zone"
 TOLERANCES = {"rtol": 1e-8, "atol": 1e-10}

@@ -26,8 +26,10 @@ from gearsym.solver.sweep import Progress, SweepJob, map_tasks, sweep_many
 from gearsym.solver.system import System
 
 from .bearings import bearing_jobs, bearings_section
-from .cases import CASES, RESOLUTIONS, TOLERANCES
+from .cases import CASES, DEAD_ZONE, RESOLUTIONS, TOLERANCES
+from .claims import Bundle
 from .figures import figure_list
+from .long_runs import LONG_BUDGET, lengthen_sweeps
 from .report import FIGURES_MARK, report
 
 __all__ = ["reproduce"]
@@ -62,33 +64,65 @@ def reproduce(
     )
     lam = np.round(np.linspace(0.0, 1.0, res.points), 10)
     systems = {case: System.load(module) for case, module, _ in CASES}
-
-    jobs = []
-    for case, _, _ in CASES:
-        for backward in (False, True):
-            jobs.append(
-                SweepJob(systems[case], "lambda", lam, backward=backward, settings=settings)
-            )
+    # the exact dead zone the study's polynomial approximates, at each case's load
+    dead = {case: System.load(DEAD_ZONE).with_values(f1=f1) for case, _, f1 in CASES}
     map_lam = np.round(np.linspace(0.0, 1.0, res.map_points), 10)
-    for f1 in res.map_f1:
-        jobs.append(
-            SweepJob(systems["light"].with_values(f1=f1), "lambda", map_lam, settings=settings)
-        )
-    on_bearings = bearing_jobs(lam, settings)  # the same sweeps on bearings (issue 15)
-    jobs += on_bearings
+
+    def case_jobs(models):
+        return [
+            SweepJob(models[case], "lambda", lam, backward=backward, settings=settings)
+            for case, _, _ in CASES
+            for backward in (False, True)
+        ]
+
+    def map_jobs(model):
+        return [
+            SweepJob(model.with_values(f1=f1), "lambda", map_lam, settings=settings)
+            for f1 in res.map_f1
+        ]
+
+    groups = {
+        "cases": case_jobs(systems),
+        "maps": map_jobs(systems["light"]),
+        "bearings": bearing_jobs(lam, settings),  # the same sweeps on bearings (issue 15)
+        "dead cases": case_jobs(dead),
+        "dead maps": map_jobs(dead["light"]),
+    }
     # Each sweep keeps its finished points under out/store, in a folder named by what
     # defines it (model, values, settings): a run stopped by Ctrl-C resumes from them,
     # and a run with other settings or another model starts a folder of its own.
-    jobs = [replace(job, store=out / "store" / f"sweep_{_job_key(job)}") for job in jobs]
+    jobs = [
+        replace(job, store=out / "store" / f"sweep_{_job_key(job)}")
+        for group in groups.values()
+        for job in group
+    ]
     bar = Progress(sum(len(j.values) for j in jobs), "sweeps", enabled=progress)
-    sweeps = sweep_many(jobs, executor=executor, workers=workers, progress=bar)
-    by_case = {case: sweeps[2 * k : 2 * k + 2] for k, (case, _, _) in enumerate(CASES)}
-    bearing_sweeps = sweeps[len(sweeps) - len(on_bearings) :]
-    maps = sweeps[2 * len(CASES) : len(sweeps) - len(on_bearings)]
-    for sw in sweeps:
+    done = iter(sweep_many(jobs, executor=executor, workers=workers, progress=bar))
+    got = {name: [next(done) for _ in group] for name, group in groups.items()}
+    stage("sweeps done; the runs the claims rest on, with the long budget")
+    got = _lengthen_claims(got, groups, settings, executor, workers)
+    by_case = {case: got["cases"][2 * k : 2 * k + 2] for k, (case, _, _) in enumerate(CASES)}
+    dead_case = {case: got["dead cases"][2 * k : 2 * k + 2] for k, (case, _, _) in enumerate(CASES)}
+    bearing_sweeps, maps = got["bearings"], got["maps"]
+    files = {"polynomial": {"sweep": {}, "point": {}, "bifurcation": {}}}
+    files["dead zone"] = {"sweep": {}, "point": {}, "bifurcation": {}}
+    for sw in got["cases"] + maps + bearing_sweeps:
         tag = f"{sw.model}_{sw.direction}_f1_{sw.base_values.get('f1', 'scene')}"
         sw.save(out / "data" / f"sweep_{tag}.json")
-
+    for case, _, _ in CASES:
+        files["polynomial"]["sweep"][case] = tuple(
+            f"data/sweep_{sw.model}_{sw.direction}_f1_scene.json" for sw in by_case[case]
+        )
+        files["dead zone"]["sweep"][case] = tuple(
+            f"data/sweep_{sw.model}_{sw.direction}_{case}.json" for sw in dead_case[case]
+        )
+        for sw, name in zip(dead_case[case], files["dead zone"]["sweep"][case], strict=True):
+            sw.save(out / name)
+    files["polynomial"]["map"] = "map_f1_lambda.png"
+    files["dead zone"]["map"] = f"data/sweep_{DEAD_ZONE}_map_f1_*.json"
+    for sw, f1 in zip(got["dead maps"], res.map_f1, strict=True):
+        sw.save(out / "data" / f"sweep_{DEAD_ZONE}_map_f1_{f1}.json")
+    files["dead zone"]["model_hash"] = dead["light"].model_hash
     from gearsym.solver import plots
 
     stage("sweeps done; figures")
@@ -108,30 +142,16 @@ def reproduce(
     backlash_figure(systems["light"], out / "backlash.png", plain)
     stiffness_figure(systems["light"], out / "stiffness.png", plain)
 
-    stage("operating points lambda = 0.1, 0.8")
-    points = {}
-    for case, _, f1 in CASES:
-        plots.bifurcation_diagram(
-            by_case[case],
-            ["u", "v"],
-            out / f"bifurcation_{case}.png",
-            title=f"{case} load, f1 = {f1}: Poincaré points against lambda",
-            system=systems[case],
-        )
-        for value in (0.1, 0.8):
-            forward = by_case[case][0]
-            k = int(np.argmin(np.abs(forward.values - value)))
-            x0 = forward.points[k - 1].x_final if k > 0 else None
-            result = analyse_point(systems[case].with_values(**{"lambda": value}), x0, **settings)
-            points[(case, value)] = result
-            plots.point_figure(
-                result,
-                out / f"point_{case}_lambda_{value}.png",
-                title=f"{case} load (f1 = {f1}), lambda = {value}",
-            )
-            (out / "data" / f"point_{case}_lambda_{value}.json").write_text(
-                dumps(result.describe()), encoding="utf-8"
-            )
+    stage("operating points lambda = 0.1, 0.8, both models")
+    points = _operating_points(by_case, systems, settings, out, "", files["polynomial"])
+    dead_points = _operating_points(dead_case, dead, settings, out, "deadzone_", files["dead zone"])
+    stage("the operating points from rest")
+    from .mechanisms import from_rest, mechanisms_section
+
+    starts = {
+        "polynomial": (dict(points), from_rest(points, systems, settings, LONG_BUDGET)),
+        "dead zone": (dead_points, from_rest(dead_points, dead, settings, LONG_BUDGET)),
+    }
     points.update(_chaotic_points(by_case, systems, settings, out))
     max_u = [sw.maxima("u") for sw in maps]
     min_v = [sw.minima("v") for sw in maps]
@@ -181,15 +201,25 @@ def reproduce(
     scales = physical_scales(SCENES["light"][0])
     section = sensitivity_section(rows, scales, {c: f1 for c, (_, f1) in SCENES.items()}, points)
     elapsed = time.perf_counter() - started
-    text = report(
-        res, lam, by_case, points, maps, map_lam, elapsed, quick, systems, branches, method
-    )
+    bundles = {
+        "polynomial": Bundle("polynomial", by_case, points, maps, res.map_f1, files["polynomial"]),
+        "dead zone": Bundle(
+            "dead zone", dead_case, dead_points, got["dead maps"], res.map_f1, files["dead zone"]
+        ),
+    }
+    text = report(res, lam, bundles, elapsed, quick, systems, branches, method)
     head, sep, tail = text.partition("## Figures")
     stage("the lambda sweeps on bearings: report")
     forward = [by_case[case][0] for case, _, _ in CASES]
     bearings = bearings_section(forward, bearing_sweeps, out)
+    from .model_check import model_check_section
+
     text = (
         head
+        + model_check_section(systems, {case: f1 for case, _, f1 in CASES})
+        + "\n"
+        + mechanisms_section(starts)
+        + "\n"
         + response_section(response_rows)
         + "\n"
         + section
@@ -203,6 +233,65 @@ def reproduce(
     path = out / "report.md"
     path.write_text(text, encoding="utf-8")
     return path
+
+
+def _operating_points(by_case, models, settings, out, tag: str, files: dict) -> dict:
+    """lambda = 0.1 and 0.8 of each case, each from the end state of the forward sweep's
+    run before it and with the long budget (the claims rest on them): figures and data
+    named ``point_<tag><case>_lambda_<value>``, their names in ``files``."""
+    from gearsym.solver import plots
+
+    found = {}
+    for case, _, f1 in CASES:
+        name = f"bifurcation_{tag}{case}.png"
+        files["bifurcation"][case] = name
+        model = "the exact dead zone" if tag else "the polynomial"
+        plots.bifurcation_diagram(
+            by_case[case],
+            ["u", "v"],
+            out / name,
+            title=f"{case} load, f1 = {f1}, {model}: Poincaré points against lambda",
+            system=models[case],
+        )
+        forward = by_case[case][0]
+        for value in (0.1, 0.8):
+            k = int(np.argmin(np.abs(forward.values - value)))
+            x0 = forward.points[k - 1].x_final if k > 0 else None
+            at = models[case].with_values(**{"lambda": value})
+            result = analyse_point(at, x0, budget=LONG_BUDGET, **settings)
+            found[(case, value)] = result
+            stem = f"point_{tag}{case}_lambda_{value}"
+            plots.point_figure(
+                result,
+                out / f"{stem}.png",
+                title=f"{case} load (f1 = {f1}), {model}, lambda = {value}",
+            )
+            (out / "data" / f"{stem}.json").write_text(dumps(result.describe()), encoding="utf-8")
+            files["point"][(case, value)] = (f"{stem}.png", f"data/{stem}.json")
+    return found
+
+
+def _lengthen_claims(got: dict, groups: dict, settings, executor, workers) -> dict:
+    """The sweeps with every run a claim may rest on continued with the long budget:
+    the forward case sweeps' non-periodic runs in the study's low-lambda ranges (u
+    quasi-periodic up to 0.57 light, 0.13 heavy; v chaotic up to 0.3) and the maps'
+    non-periodic runs (the trend of Min(v) over chaotic points)."""
+    low = {0.1: 0.57, 0.5: 0.3}  # f1 -> the largest lambda of a low-lambda claim
+
+    def on_cases(sw, value, r):
+        f1 = float(sw.base_values.get("f1", 0.1 if "light" in sw.model else 0.5))
+        return sw.direction == "forward" and value <= low.get(f1, 0.57) + 1e-9
+
+    def on_maps(sw, value, r):
+        return True
+
+    out = dict(got)
+    for names, select in ((("cases", "dead cases"), on_cases), (("maps", "dead maps"), on_maps)):
+        items = [(sw, job.system) for n in names for sw, job in zip(got[n], groups[n], strict=True)]
+        longer = iter(lengthen_sweeps(items, select, settings, executor=executor, workers=workers))
+        for n in names:
+            out[n] = [next(longer) for _ in got[n]]
+    return out
 
 
 def _chaotic_points(by_case, systems, settings, out) -> dict:

@@ -10,7 +10,7 @@ before any run.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -68,6 +68,7 @@ class Sensitivity:
     failed: int  # attractor records whose runs failed (e.g. left the valid range)
     figures: list
     reading: str = "q-braking"
+    carriers: dict = field(default_factory=dict)  # finding -> (runs, "run a to b periods")
 
 
 def _matches(motion: str, test: str) -> bool:
@@ -166,6 +167,10 @@ def run_sensitivity(out: Path, res, settings: dict, *, quick, executor, workers,
                     progress=progress,
                     resolve=_resolver(scene, f1, reading, key, values),
                 )
+                resolve = _resolver(scene, f1, reading, key, values)
+                m, carriers = _lengthen_carriers(
+                    m, FINDINGS[case], key, resolve, settings, executor, workers
+                )
                 m.save(out / "data" / f"sensitivity_{name}.json")
                 figs = map_figures(
                     m,
@@ -200,9 +205,51 @@ def run_sensitivity(out: Path, res, settings: dict, *, quick, executor, workers,
                         sum(r["status"] != "ok" for r in records),
                         figs,
                         reading,
+                        carriers,
                     )
                 )
     return rows
+
+
+def _lengthen_carriers(m, findings, key, resolve, settings, executor, workers):
+    """The map with every attractor that carries a finding (inside the finding's lambda
+    range, with its motion) continued with the long budget (``long_runs``), and per
+    finding the runs that still carry it: (count, the periods they were run)."""
+    from .long_runs import lengthen, periods_run
+
+    def carries(run, coord, test, lo, hi):
+        return lo <= run.values["lambda"] <= hi and run.ok and _matches(run.motion(coord), test)
+
+    where = [
+        (ix, iy, k)
+        for ix, column in enumerate(m.cells)
+        for iy, cell in enumerate(column)
+        for k, a in enumerate(cell.attractors)
+        if any(carries(a.run, c, t, lo, hi) for _, c, t, (lo, hi) in findings)
+    ]
+    runs = [m.cells[ix][iy].attractors[k].run for ix, iy, k in where]
+    pairs = [(resolve(dict(r.values)), r) for r in runs]
+    longer = lengthen(pairs, settings, executor=executor, workers=workers)
+    longer = dict(zip(where, longer, strict=True))
+    cells = tuple(
+        tuple(
+            replace(
+                cell,
+                attractors=tuple(
+                    replace(a, run=longer.get((ix, iy, k), a.run))
+                    for k, a in enumerate(cell.attractors)
+                ),
+            )
+            for iy, cell in enumerate(column)
+        )
+        for ix, column in enumerate(m.cells)
+    )
+    m = replace(m, cells=cells)
+    carriers = {}
+    for finding, coord, test, (lo, hi) in findings:
+        held = [r for r in longer.values() if carries(r, coord, test, lo, hi)]
+        carriers[finding] = (len(held), periods_run(held))
+    return m, carriers
 
 
 def physical_scales(scene: str) -> dict:
