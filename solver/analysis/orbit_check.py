@@ -96,7 +96,7 @@ class OrbitCheck:
 def _flows(system: System, X: np.ndarray, n: int, t0: float, spec: RunSpec) -> np.ndarray:
     """``phi_{mT}`` of every row of ``X`` (J, N) for m = 0..n: shape (J, n + 1, N)."""
     batch = Batch.of(system.module, np.repeat(system.p[None, :], X.shape[0], axis=0))
-    res = integrate(batch, X, spec.with_(t0=t0, periods=n))
+    res = integrate(batch, X, spec.with_(t0=t0, periods=n, lyapunov_periods=n))
     bad = [s for s in res.status if s != "ok"]
     if bad:
         raise FloatingPointError(f"the flow stopped: {bad[0]}")
@@ -128,6 +128,11 @@ def check_orbit(
         periods=n,
         valid_range="ignore",
         bound=1e6,
+        # the library with the variational equations, whose tangent is not used: it is
+        # the one a map's runs and the continued windows build, so a model is compiled
+        # once (the plain library would double the compilations of a sensitivity study)
+        collect=("samples", "exponent"),
+        lyapunov_periods=n,
     )
     residual = float("inf")
     for it in range(max_iter + 1):

@@ -62,6 +62,8 @@ def two_trajectory(
         periods=chunk,
         valid_range="ignore",
         bound=1e6,
+        collect=("samples", "exponent"),  # the variational library: see orbit_check.py
+        lyapunov_periods=chunk,
     )
     rates, t = [], t0
     for _ in range(n_chunks):
