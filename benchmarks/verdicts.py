@@ -1,15 +1,18 @@
 """The verdict benchmark of issue 27: map verdicts at default settings against long runs.
 
-Cells.  A regime map over lambda (0 to 1) by f1 (0.1, light load, to 0.5, heavy load) at
-the default settings of ``regime_map`` (300 + 100 periods, the exponent over the last 200,
-the verdict's budget of 3,000 periods), from the forward and backward starts, for each
-model of :data:`MAPS`: the polynomial backlash in both readings of the loads, the
-polynomial with the sensitivity study's 50 um transmission error, and the exact dead
-zone in both readings.  Every attractor of a grid point is a candidate cell (its run's
-start state is recorded); a cell is on a **border** when its grid point's labels differ
-from a neighbour's (in lambda or f1) or the grid point holds attractors of different
-labels.  All border cells are taken (evenly thinned if they would fill more than 60 %),
-then interior cells evenly spread over the maps, up to :data:`CELLS`.
+Cells.  A regime map over lambda by f1 at the default settings of ``regime_map`` (300 +
+100 periods, the exponent over the last 200, the verdict's budget of 3,000 periods), from
+the forward and backward starts, for each row of :data:`MAPS` (its model, its lambda
+range in 21 values, its f1 values; the reference maps run lambda 0 to 1 by f1 0.1, light
+load, to 0.5, heavy load): the polynomial backlash in both readings of the loads, the
+polynomial with the sensitivity study's 50 um transmission error, the exact dead zone in
+both readings, and five maps over the sensitivity study's open values (``OPEN_SPREAD``)
+where a coarse scan found the motion types changing (each row says why it was chosen).
+Every attractor of a grid point is a candidate cell (its run's start state is recorded);
+a cell is on a **border** when its grid point's labels differ from a neighbour's (in
+lambda or f1) or the grid point holds attractors of different labels.  All border cells
+are taken (evenly thinned if they would fill more than 60 %), then interior cells evenly
+spread over the maps, up to :data:`CELLS`.
 
 Default verdict: the map run's own (``RunRecord.verdict``: motion, periods run, why).
 Reference: ``_verdicts_reference.reference_label``, a 10,000-period run from the same
@@ -18,9 +21,12 @@ a default label that is neither the reference's nor ``undetermined``; cells whos
 reference is ``unresolved`` are listed and not counted.  The floor (issue 27): no wrong
 label, ``undetermined`` at most 10 %.
 
-Writes ``docs/verdicts.md`` and ``docs/verdicts.json`` (``--quick``: 20 cells of smaller
-maps, ``verdicts-quick.*``).  Run from a checkout: ``python benchmarks/verdicts.py``
-(``--workers`` at most 2; ``--store DIR`` keeps the maps' runs to resume).
+Writes ``docs/verdicts.md`` (``_verdicts_report.py``: the maps, the confusion table, the
+cost, every wrong, undetermined or unresolved cell with both verdicts' evidence, and the
+undetermined candidates) and ``docs/verdicts.json`` (``--quick``: 20 cells of smaller
+maps, ``verdicts-quick.*``), stamped with the checkout's commit.  Run from a checkout:
+``python benchmarks/verdicts.py`` (``--workers`` at most 2; ``--store DIR`` keeps the
+maps' runs to resume: a store made on another commit of the engine holds its verdicts).
 """
 
 from __future__ import annotations
@@ -30,51 +36,119 @@ import json
 import sys
 import time
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 from gearsym.benchmarks._output import checkout_docs, output_folder, run_script
-from gearsym.benchmarks._verdicts_reference import K_CHAOS, QP_BAND, REPEAT
+from gearsym.benchmarks._verdicts_report import default_label as _label
+from gearsym.benchmarks._verdicts_report import markdown
 
-__all__ = ["MAPS", "main", "pick", "run_maps", "summarise"]
+__all__ = ["MAPS", "MapRow", "main", "pick", "run_maps", "summarise"]
 
-# (name, scene, open values): the reference maps of the benchmark
+
+class MapRow(NamedTuple):
+    """One map of the benchmark: its model (a scene and open values), its lambda range
+    (``POINTS`` values from ``lam[0]`` to ``lam[1]``), its f1 values, and why it is here."""
+
+    name: str
+    scene: str
+    open_values: dict
+    lam: tuple = (0.0, 1.0)
+    f1: tuple = (0.1, 0.2, 0.3, 0.4, 0.5)
+    why: str = "a reference map"
+
+
+LOW_LAMBDA = (0.0, 0.25)
+HEAVY = (0.6, 0.7, 0.8)  # beyond the reference maps' heavy load, f1 0.5
+# The last five rows were chosen by a coarse scan (lambda 0 to 1 in 11 values by three or
+# four f1, then lambda 0 to 0.2 in 9 values by f1 0.1 to 0.5, both starts, default
+# settings) over the open values of app/studies/sensitivity.py: te_amplitude_um 20,
+# te_phase_deg_qg 90 and 180, flywheel_inertia_kg_m2 1 and 100, layout_angle_deg 0 and
+# 60, stiffness_harmonic_scale 2 and f1 0.5 to 0.8, on the polynomial and the dead zone.
+# On the polynomial every one of them is period-1 over the whole map (one period-3 at
+# phase 90), so only its heavy-load range with the 50 um error, where period doubling
+# moves with f1, is kept; on the dead zone the motion types change below lambda 0.2, so
+# those maps zoom there.  No verdict of the scan was quasi-periodic.
 MAPS = (
-    ("polynomial, q braking", "reference-light", {}),
-    ("polynomial, both driving", "reference-light-both-driving", {}),
-    ("polynomial, q braking, TE 50 µm", "reference-light", {"te_amplitude_um": 50.0}),
-    ("dead zone, q braking", "reference-dead-zone", {}),
-    ("dead zone, both driving", "reference-dead-zone", {"load_reading": "both-driving"}),
+    MapRow("polynomial, q braking", "reference-light", {}),
+    MapRow("polynomial, both driving", "reference-light-both-driving", {}),
+    MapRow("polynomial, q braking, TE 50 µm", "reference-light", {"te_amplitude_um": 50.0}),
+    MapRow("dead zone, q braking", "reference-dead-zone", {}),
+    MapRow("dead zone, both driving", "reference-dead-zone", {"load_reading": "both-driving"}),
+    MapRow(
+        "dead zone, q braking, TE phase 90°",
+        "reference-dead-zone",
+        {"te_phase_deg_qg": 90.0},
+        LOW_LAMBDA,
+        why="chaos, period 1 to 6 and an undetermined verdict (exponent near zero at f1 0.5, "
+        "lambda 0) side by side below lambda 0.2",
+    ),
+    MapRow(
+        "dead zone, q braking, flywheel 100 kg m²",
+        "reference-dead-zone",
+        {"flywheel_inertia_kg_m2": 100.0},
+        LOW_LAMBDA,
+        why="the widest chaotic region of the scan, left through period 4 and 2 and with "
+        "chaos beside period 2 at one grid point",
+    ),
+    MapRow(
+        "dead zone, q braking, harmonics ×2",
+        "reference-dead-zone",
+        {"stiffness_harmonic_scale": 2.0},
+        LOW_LAMBDA,
+        why="the most period multiples of the scan (2, 3, 4, 5, 6, 8) between chaotic "
+        "points: periodic windows",
+    ),
+    MapRow(
+        "dead zone, q braking, TE 20 µm",
+        "reference-dead-zone",
+        {"te_amplitude_um": 20.0},
+        why="period-1 everywhere but one undetermined attractor beside a period-1 one at "
+        "f1 0.5, lambda 0.4: a border far from low lambda",
+    ),
+    MapRow(
+        "polynomial, q braking, TE 50 µm, heavy",
+        "reference-light",
+        {"te_amplitude_um": 50.0},
+        f1=HEAVY,
+        why="the heavy-load f1 range: period 1 to 2 to 4 and back, the doubling moving "
+        "to lower lambda as f1 grows",
+    ),
 )
-GRID = {"full": (21, (0.1, 0.2, 0.3, 0.4, 0.5)), "quick": (6, (0.1, 0.5))}
-CELLS = {"full": 120, "quick": 20}
+POINTS = {"full": 21, "quick": 6}
+CELLS = {"full": 200, "quick": 20}
 BORDER_SHARE = 0.6
 
 
-def _label(verdict: dict) -> str:
-    return verdict.get("motion") or "undetermined"
+def _axes(row: MapRow, quick: bool) -> tuple[np.ndarray, np.ndarray]:
+    """The row's lambda values and f1 values (quick: 6 lambda, the first and last f1)."""
+    lam = np.round(np.linspace(*row.lam, POINTS["quick" if quick else "full"]), 10)
+    return lam, np.array(row.f1[:: len(row.f1) - 1] if quick else row.f1, float)
 
 
-def run_maps(quick: bool, workers: int, store: Path | None) -> list[dict]:
+def run_maps(quick: bool, workers: int, store: Path | None) -> tuple[list[dict], dict]:
     """Every map of :data:`MAPS`: its candidate cells (one per attractor of a grid
-    point) with the default verdict, start state and border flag."""
+    point) with the default verdict, start state and border flag; and each map's
+    seconds."""
     from gearsym.resolve import load
     from gearsym.solver.sweep.atlas import regime_map
 
-    points, f1 = GRID["quick" if quick else "full"]
-    lam = np.round(np.linspace(0.0, 1.0, points), 10)
-    cells = []
-    for name, scene, open_values in MAPS:
+    cells, seconds = [], {}
+    for row in MAPS:
+        name, scene, open_values = row.name, row.scene, row.open_values
+        lam, f1 = _axes(row, quick)
         started = time.perf_counter()
         slug = "".join(ch if ch.isalnum() else "-" for ch in name)
         m = regime_map(
             load(scene, **open_values),
             ("lambda", lam),
-            ("f1", np.array(f1)),
+            ("f1", f1),
             initial_states=2,
             workers=workers,
-            store=None if store is None else store / f"{slug}-{points}",
+            store=None if store is None else store / f"{slug}-{lam.size}",
         )
-        print(f"map {name}: {time.perf_counter() - started:.0f} s", file=sys.stderr)
+        seconds[name] = time.perf_counter() - started
+        print(f"map {name}: {seconds[name]:.0f} s", file=sys.stderr)
         labels = [[{_label(a.run.verdict) for a in c.attractors} for c in col] for col in m.cells]
         for ix, col in enumerate(m.cells):
             for iy, cell in enumerate(col):
@@ -99,7 +173,7 @@ def run_maps(quick: bool, workers: int, store: Path | None) -> list[dict]:
                             "default": {k: v for k, v in r.verdict.items() if k != "windows"},
                         }
                     )
-    return cells
+    return cells, seconds
 
 
 def _spread(items: list, k: int) -> list:
@@ -172,94 +246,34 @@ def summarise(cells: list[dict]) -> dict:
     }
 
 
-def _order(label: str) -> tuple:
-    if label.startswith("period-"):
-        return (0, int(label.split("-")[1]))
-    rank = ("quasi-periodic", "chaotic", "divergent", "undetermined", "unresolved")
-    return (1, rank.index(label) if label in rank else len(rank))
-
-
-def _evidence(ref: dict) -> str:
-    """The reference's evidence in one line."""
-    parts = []
-    per = ref.get("periodic")
-    if per and per.get("ok"):
-        mu = per["shooting"]["largest_multiplier"]
-        conv = ", converging" if per["converging"] else ""
-        parts.append(f"repeats after {per['n']} (gap {per['repeat_gap']:.1e}{conv}), |μ| {mu:.4f}")
-        parts.append(f"settled by period {ref.get('settled_by_period')}")
-    if "exponent" in ref:
-        e = ref["exponent"]
-        parts.append(f"λ {e['lambda']:.2e} ± {e['uncertainty']:.1e}")
-    if "zero_one" in ref:
-        parts.append(f"K {ref['zero_one']['K']:.2f}")
-    if "curve" in ref:
-        parts.append(f"curve {ref['curve']['agreeing']:.2f}")
-    if "why" in ref:
-        parts.append(ref["why"])
-    return "; ".join(parts)
-
-
-def _markdown(summary: dict, cells: list[dict], command: str, wall: float, quick: bool) -> str:
-    s = summary
-    refs = sorted(s["confusion"], key=_order)
-    cols = sorted(
-        {k for row in s["confusion"].values() for k in row} | {"undetermined"}, key=_order
-    )
-    points, f1 = GRID["quick" if quick else "full"]
-    lines = [
-        "# Verdict benchmark: map verdicts against 10,000-period reference runs",
-        "",
-        f"Written by `{command}` in {wall / 60:.1f} min (issue 27, Floors). "
-        f"Maps: λ 0 to 1 in {points} values by f1 {', '.join(map(str, f1))} (0.1 light, "
-        "0.5 heavy load), forward and backward starts, `regime_map`'s default settings "
-        "(300 + 100 periods, exponent over 200, verdict budget 3,000 periods), one per "
-        f"model: {'; '.join(n for n, _, _ in MAPS)}. Cells: {s['cells']} attractors of the "
-        f"maps, {s['border_cells']} on borders (labels differ from a neighbour's, or "
-        "coexisting attractors with different labels), the rest spread over the interiors. "
-        "Reference: a 10,000-period run from the cell's start state (DOP853, rtol 1e-10), "
-        "its last 5,000 periods classified by the benchmark's own code "
-        f"(`benchmarks/_verdicts_reference.py`: repetition within {REPEAT:g} of the extent "
-        "and `shoot` with |μ| < 1 at the minimal period; chaos: λ − U > 0 over the tail "
-        f"and its own 0–1 test K ≥ {K_CHAOS}; a torus: |λ| + U ≤ {QP_BAND:g} and a closed "
-        "curve the map rotates).",
-        "",
-        f"**Wrong labels: {s['wrong']}** (floor: 0). **Undetermined: {s['undetermined']} of "
-        f"{s['cells']} = {100 * s['undetermined_share']:.1f} %** (floor: at most 10 %). "
-        f"Reference unresolved (not counted): {s['unresolved_references']}.",
-        "",
-        "## Confusion table (rows: reference, columns: default verdict)",
-        "",
-        "| reference \\ default | " + " | ".join(cols) + " |",
-        "|---|" + "---:|" * len(cols),
+def _candidates(candidates: list[dict]) -> dict:
+    """The default labels of every candidate (judged cells or not): counts, and the
+    undetermined ones with their reason (no reference run: not in the floors)."""
+    counts: dict = {}
+    for c in candidates:
+        counts[_label(c["default"])] = counts.get(_label(c["default"]), 0) + 1
+    keys = ("map", "lambda", "f1", "start")
+    undetermined = [
+        {k: c[k] for k in keys} | {"why": c["default"].get("why")}
+        for c in candidates
+        if _label(c["default"]) == "undetermined"
     ]
-    for r in refs:
-        row = s["confusion"][r]
-        lines.append(f"| {r} | " + " | ".join(str(row.get(k, "")) for k in cols) + " |")
-    lines += ["", "Median periods run by the default verdict, per label: "]
-    lines[-1] += ", ".join(f"{k} {v:.0f}" for k, v in s["median_periods_run"].items()) + "."
-    listed = [c for c in cells if c["wrong"] or _label(c["default"]) == "undetermined"]
-    listed += [c for c in cells if c["reference"]["label"] == "unresolved" and c not in listed]
-    lines += [
-        "",
-        "## Wrong, undetermined and unresolved cells",
-        "",
-        "| map | λ | f1 | start | default (periods) | default's why | reference | evidence |",
-        "|---|---:|---:|---|---|---|---|---|",
-    ]
-    for c in listed:
-        d = c["default"]
-        mark = "**wrong** " if c["wrong"] else ""
-        why = (d.get("why") or "").replace("|", "/")
-        lines.append(
-            f"| {c['map']} | {c['lambda']:g} | {c['f1']:g} | {c['start']} | {mark}"
-            f"{_label(d)} ({d.get('periods_run')}) | {why} | {c['reference']['label']} | "
-            f"{_evidence(c['reference']).replace('|', '/')} |"
-        )
-    if not listed:
-        lines.append("| (none) | | | | | | | |")
-    lines += ["", "Every cell, its start state and both verdicts' evidence: `verdicts.json`."]
-    return "\n".join(lines) + "\n"
+    return {"count": len(candidates), "labels": counts, "undetermined": undetermined}
+
+
+def _engine() -> str:
+    """The last commit that changed ``solver/`` (the engine whose verdicts these are),
+    marked when ``solver/`` has local changes; taken before the first run."""
+    import subprocess
+
+    from gearsym.derive.build import project_root
+
+    def git(*a: str) -> str:
+        run = subprocess.run(["git", *a], cwd=project_root(), capture_output=True, text=True)
+        return run.stdout.strip() if run.returncode == 0 else ""
+
+    head = git("log", "-1", "--format=%h", "--", "solver") or "unknown"
+    return head + (" + local changes in solver/" if git("status", "--porcelain", "solver") else "")
 
 
 def _plain(x):
@@ -281,8 +295,8 @@ def main(argv=None) -> int:
     names = (f"{stem}.md", f"{stem}.json")
     out = output_folder(args.out or checkout_docs(), names)
     command = "python benchmarks/verdicts.py" + (" --quick" if args.quick else "")
-    started = time.perf_counter()
-    candidates = run_maps(args.quick, args.workers, args.store)
+    started, engine = time.perf_counter(), _engine()
+    candidates, map_seconds = run_maps(args.quick, args.workers, args.store)
     cells = pick(candidates, CELLS["quick" if args.quick else "full"])
     print(f"{len(cells)} cells of {len(candidates)}; reference runs", file=sys.stderr)
     from gearsym.solver.executor import map_tasks
@@ -293,7 +307,29 @@ def main(argv=None) -> int:
         c["reference"] = r
     summary = summarise(cells)
     wall = time.perf_counter() - started
-    text = _markdown(summary, cells, command, wall, args.quick)
+    seconds = [c["reference"]["seconds"] for c in cells]
+    summary["maps"] = {}
+    for row in MAPS:
+        lam, f1 = _axes(row, args.quick)
+        summary["maps"][row.name] = {
+            "lambda": lam,
+            "f1": f1,
+            "why": row.why,
+            "candidates": sum(c["map"] == row.name for c in candidates),
+            "cells": sum(c["map"] == row.name for c in cells),
+            "seconds": map_seconds[row.name],
+        }
+    summary["cost"] = {
+        "maps_seconds": sum(map_seconds.values()),
+        "reference_seconds": float(np.sum(seconds)),
+        "reference_median_seconds": float(np.median(seconds)),
+        "reference_max_seconds": float(np.max(seconds)),
+        "workers": args.workers,
+        "wall_seconds": wall,
+    }
+    summary["candidates"] = _candidates(candidates)
+    summary["engine"] = engine
+    text = markdown(summary, cells, command, wall)
     (out / names[0]).write_text(text, encoding="utf-8")
     doc = {"command": command, "wall_seconds": wall, "summary": summary, "cells": cells}
     (out / names[1]).write_text(json.dumps(doc, indent=1, default=_plain), encoding="utf-8")

@@ -88,7 +88,12 @@ def test_sweep_refuses_a_bad_range(capsys):
 def test_reproduce_quick_writes_the_report(tmp_path, capsys):
     assert main(["reproduce", "--quick", "--out", str(tmp_path), "--quiet"]) == 0
     report = (tmp_path / "report.md").read_text()
-    assert "| study | toolkit | verdict | evidence |" in report
+    head = "| study | found with the polynomial | found with the dead zone | verdict | why |"
+    assert head in report and "nan" not in report.lower().split()
+    # the figure list names exactly the figures written
+    listed = {w.strip("`") for w in report.split() if w.startswith("`") and w.endswith(".png`")}
+    for name in listed:
+        assert "*" in name or "<" in name or (tmp_path / name).exists(), name
     for name in (
         "bifurcation_light.png",
         "bifurcation_heavy.png",

@@ -131,3 +131,20 @@ def test_two_trajectory_exponent_against_the_closed_form_and_benettin():
     a, b = pair["interval"]
     c, d = last["exponent"]["interval"]
     assert a > 0 and max(a, c) <= min(b, d)
+
+
+def test_shooting_check_on_a_dead_zone_orbit_against_the_located_monodromy():
+    # Reference: shooting.shoot on the dead zone, whose monodromy integrates the
+    # variational equations with the kinks located (an independent route to the
+    # central differences of the check).  At lambda = 0 the attractor is a period-6
+    # orbit with a multiplier near 0.97 (slow convergence: the stated error matters).
+    from gearsym.resolve import load
+
+    system = load("reference-dead-zone").with_values(**{"lambda": 0.0})
+    r = analyse_point(system)
+    assert r.verdict.period is not None
+    o = r.settled.orbit
+    ref = shoot(system, o.x, r.verdict.period)
+    np.testing.assert_allclose(
+        np.sort(np.abs(o.multipliers)), np.sort(np.abs(ref.floquet.multipliers)), atol=1e-6
+    )
