@@ -170,6 +170,9 @@ ENGINES = {
         {"integrate_located", "LocatedRun"},
     ),
     "the explicit Runge-Kutta step": ("integrate/tableau.py", {"rk_step", "ButcherTableau"}),
+    "the verdict of a run": ("analysis/settle.py", {"settle", "Settled"}),
+    "the labels and their evidence": ("analysis/verdict.py", {"Verdict", "judge"}),
+    "the shooting check": ("analysis/orbit_check.py", {"check_orbit", "OrbitCheck"}),
 }
 
 
