@@ -150,6 +150,12 @@ def _verdict_text(point, coordinates) -> str:
         )
     if "zero_one_K" in s:
         parts.append(f"0-1 test K = {s['zero_one_K']:.2f}")
+    if "two_trajectory_interval" in s:
+        lo, hi = s["two_trajectory_interval"]
+        agrees = " (the second test that agrees)" * (
+            s.get("second_test") == "two-trajectory exponent"
+        )
+        parts.append(f"two-trajectory exponent in [{lo:+.4f}, {hi:+.4f}]{agrees}")
     if "transient_chaos" in s:
         parts.append(str(s["transient_chaos"].get("text", "chaotic transient")))
     if "why" in s:

@@ -149,6 +149,11 @@ def _cmd_simulate(args) -> int:
                 f"      Poincaré cloud: extent {num(sp['displacement'], '.2e')} in {c}, "
                 f"{num(sp['velocity'], '.2e')} in its velocity, {num(sp['share'], '.2f')} of "
                 "the widest coordinate's"
+                + (
+                    "; slaved to the widest through the coupling"
+                    if (sp["share"] or 1) < 0.05
+                    else ""
+                )
             )
     if tr.left_valid_range is not None:
         t, c, v = tr.left_valid_range
@@ -290,6 +295,9 @@ def verdict_lines(v) -> list[str]:
             parts.append(f"exponent {e['exponent']:.5f} per tau in [{lo:.5f}, {hi:.5f}]")
         if "zero_one" in w:
             parts.append(f"0-1 test K = {w['zero_one']['K']:.2f}")
+        if "interval" in w.get("two_trajectory", {}):
+            lo, hi = w["two_trajectory"]["interval"]
+            parts.append(f"two-trajectory exponent in [{lo:.5f}, {hi:.5f}]")
         if "rotation_number" in w:
             parts.append(f"rotation number {w['rotation_number']:.5f}")
         lines.append("      " + ", ".join(parts))

@@ -96,6 +96,10 @@ class Verdict:
                 out["zero_one_K"] = last["zero_one"]["K"]
             if "rotation_number" in last:
                 out["rotation_number"] = last["rotation_number"]
+            if "second_test" in last:
+                out["second_test"] = last["second_test"]
+            if "interval" in last.get("two_trajectory", {}):
+                out["two_trajectory_interval"] = last["two_trajectory"]["interval"]
         for key in ("why", "transient_chaos"):
             if key in ev:
                 out[key] = ev[key]
