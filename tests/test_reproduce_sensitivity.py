@@ -90,22 +90,6 @@ def test_text_values_are_named_in_records_and_table():
     assert "reproduced with `damping_normalisation` = modal (both driving)." in text
 
 
-@pytest.mark.slow
-def test_reproduce_quick_has_the_sensitivity_table(tmp_path):
-    from gearsym.cli import main
-
-    assert main(["reproduce", "--quick", "--out", str(tmp_path), "--quiet"]) == 0
-    report = (tmp_path / "report.md").read_text()
-    assert "## Sensitivity to the values the study leaves open" in report
-    assert "| light (f1 = 0.1) | q braking | `te_amplitude_um` (µm) |" in report
-    assert "| heavy (f1 = 0.5) | both driving | `te_amplitude_um` (µm) |" in report
-    assert "## Frequency response around the study's operating point" in report
-    assert (tmp_path / "response_heavy.png").stat().st_size > 1000
-    assert "### Physical scales" in report
-    figure = tmp_path / "sensitivity" / "heavy-both-driving-te_amplitude_um-motion.png"
-    assert figure.stat().st_size > 1000
-
-
 def test_response_section_counts_the_solutions_at_the_operating_frequency():
     from types import SimpleNamespace
 

@@ -99,8 +99,17 @@ def test_reproduce_quick_writes_the_report(tmp_path, capsys):
         "bifurcation_heavy.png",
         "map_f1_lambda.png",
         "point_heavy_lambda_0.8.png",
+        "response_heavy.png",
+        "sensitivity/heavy-both-driving-te_amplitude_um-motion.png",
     ):
         assert (tmp_path / name).stat().st_size > 1000
+    # the sections of the sensitivity study and the frequency response (one reproduce
+    # run serves both: it is the suite's longest command)
+    assert "## Sensitivity to the values the study leaves open" in report
+    assert "| light (f1 = 0.1) | q braking | `te_amplitude_um` (µm) |" in report
+    assert "| heavy (f1 = 0.5) | both driving | `te_amplitude_um` (µm) |" in report
+    assert "## Frequency response around the study's operating point" in report
+    assert "### Physical scales" in report
 
 
 BAD_COMMANDS = [
