@@ -98,6 +98,22 @@ class LyapunovEstimate:
     integrator: str = "CVODES"
     period: float | None = None  # the forcing period T the running estimate is sampled at
 
+    @classmethod
+    def from_running(cls, running, rtol, atol, integrator, period) -> LyapunovEstimate:
+        """The estimate of a running exponent (one value per period, per unit tau)."""
+        running = np.asarray(running, dtype=float)
+        half = running[running.size // 2 :]
+        return cls(
+            float(running[-1]),
+            running,
+            running.size,
+            float(np.ptp(half)),
+            rtol,
+            atol,
+            integrator,
+            period,
+        )
+
     @property
     def parts(self) -> dict:
         """The uncertainty and its parts (see :func:`uncertainty`)."""

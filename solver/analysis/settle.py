@@ -84,17 +84,8 @@ def _extend(system, x, t, periods: int, run: dict, exponent: bool):
         status, X = res.status[0], res.x[0]
         lyap = None
         if exponent and status == "ok":
-            running = res.exponent[0]
-            half = running[periods // 2 :]
-            lyap = LyapunovEstimate(
-                float(running[-1]),
-                running,
-                periods,
-                float(np.ptp(half)),
-                run["rtol"],
-                run["atol"],
-                res.label,
-                system.period,
+            lyap = LyapunovEstimate.from_running(
+                res.exponent[0], run["rtol"], run["atol"], res.label, system.period
             )
         return X[:periods].T, X[-1].copy(), status, lyap, (res.xmin[0], res.xmax[0])
     tr = simulate(

@@ -83,17 +83,7 @@ def outcome(
         )
     lyap = None
     if running is not None and np.all(np.isfinite(running)):
-        half = running[len(running) // 2 :]
-        lyap = LyapunovEstimate(
-            float(running[-1]),
-            running,
-            len(running),
-            float(half.max() - half.min()),
-            rtol,
-            atol,
-            engine,
-            system.period,
-        )
+        lyap = LyapunovEstimate.from_running(running, rtol, atol, engine, system.period)
     K = poincare.shape[0] - 1
     st = settle(
         system,
