@@ -53,6 +53,12 @@ class System:
         if not self.p[names.index(omega)] > 0:
             raise ValueError(f"{omega} (the excitation frequency) must be > 0")
 
+    def __reduce__(self):
+        # A module cannot be pickled: a System goes to (and comes back from) a worker
+        # process as its generated module's file and its values, the file loaded there
+        # (and verified) by ``load_generated``.
+        return (_rebuild, (self.module.__file__, self.p, self.values))
+
     @classmethod
     def load(cls, name_or_module, **values) -> System:
         """The model of a generated module (a module, its name or its file) with ``values``
@@ -159,3 +165,8 @@ class System:
         }
 
     to_dict = describe
+
+
+def _rebuild(source: str, p, values: dict) -> System:
+    """A pickled :class:`System` again (``System.__reduce__``)."""
+    return System(load_generated(source), np.asarray(p, float), dict(values))

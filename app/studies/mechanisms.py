@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["SLAVED", "from_rest", "mechanisms_section"]
+__all__ = ["SLAVED", "mechanisms_section"]
 
 SLAVED = 0.05  # a coordinate's share of the widest Poincare cloud below which it is slaved
 POWERS = (1, 3, 5, 7)
@@ -78,19 +78,6 @@ def mechanisms(result) -> list[str]:
 
 def _other(system, c: str) -> str:
     return next(o for o in system.coordinates if o != c)
-
-
-def from_rest(points: dict, models: dict, settings: dict, budget: int) -> dict:
-    """(case, lambda) -> ``PointResult`` of the operating point started from the loaded
-    rest state (the module's default), with the same settings and budget."""
-    from gearsym.solver.analysis import analyse_point
-
-    return {
-        (case, value): analyse_point(
-            models[case].with_values(**{"lambda": value}), None, budget=budget, **settings
-        )
-        for case, value in points
-    }
 
 
 def _label(result) -> str:

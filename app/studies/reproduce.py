@@ -19,17 +19,16 @@ from pathlib import Path
 
 import numpy as np
 from gearsym.solver._json import dumps
-from gearsym.solver.analysis import analyse_point
 from gearsym.solver.integrate import fastest_method
-from gearsym.solver.periodic import ShootingError, continue_orbit
-from gearsym.solver.sweep import Progress, SweepJob, map_tasks, sweep_many
+from gearsym.solver.sweep import Progress, SweepJob, sweep_many
 from gearsym.solver.system import System
 
 from .bearings import bearing_jobs, bearings_section
 from .cases import CASES, DEAD_ZONE, RESOLUTIONS, TOLERANCES
 from .claims import Bundle
 from .figures import figure_list
-from .long_runs import LONG_BUDGET, lengthen_sweeps
+from .long_runs import lengthen_sweeps
+from .points import analyse_all, pick
 from .report import FIGURES_MARK, report
 
 __all__ = ["reproduce"]
@@ -142,17 +141,23 @@ def reproduce(
     backlash_figure(systems["light"], out / "backlash.png", plain)
     stiffness_figure(systems["light"], out / "stiffness.png", plain)
 
-    stage("operating points lambda = 0.1, 0.8, both models")
-    points = _operating_points(by_case, systems, settings, out, "", files["polynomial"])
-    dead_points = _operating_points(dead_case, dead, settings, out, "deadzone_", files["dead zone"])
-    stage("the operating points from rest")
-    from .mechanisms import from_rest, mechanisms_section
+    stage(
+        "operating points lambda = 0.1, 0.8 (both models, from the sweep and from rest), "
+        "chaotic points, periodic branches and frequency responses, as one batch"
+    )
+    sweeps = {"polynomial": by_case, "dead zone": dead_case}
+    models = {"polynomial": systems, "dead zone": dead}
+    done = analyse_all(
+        sweeps, models, settings, out, files, quick=quick, executor=executor, workers=workers
+    )
+    from .mechanisms import mechanisms_section
 
+    points, dead_points = pick(done, "polynomial", "sweep"), pick(done, "dead zone", "sweep")
     starts = {
-        "polynomial": (dict(points), from_rest(points, systems, settings, LONG_BUDGET)),
-        "dead zone": (dead_points, from_rest(dead_points, dead, settings, LONG_BUDGET)),
+        "polynomial": (dict(points), pick(done, "polynomial", "rest")),
+        "dead zone": (dead_points, pick(done, "dead zone", "rest")),
     }
-    points.update(_chaotic_points(by_case, systems, settings, out))
+    points.update(pick(done, "polynomial", "chaotic"))
     max_u = [sw.maxima("u") for sw in maps]
     min_v = [sw.minima("v") for sw in maps]
     motion_v = [sw.motion("v") for sw in maps]
@@ -166,8 +171,7 @@ def reproduce(
         title="light-load scene with f1 varied",
         names=("f1", "lambda", "u", "v"),
     )
-    stage("continuation of the periodic branches")
-    branches = _continue_cases(systems, by_case, quick, executor, workers)
+    branches = {case: done[("branches", case)] for case, _, _ in CASES}
     for case, _, f1 in CASES:
         plots.branch_figure(
             branches[case],
@@ -189,8 +193,9 @@ def reproduce(
         )
     from .response import response_section, run_response
 
-    stage("frequency response around omega = 0.5 (harmonic balance)")
-    response_rows = run_response(out, systems, CASES, points, quick=quick)
+    stage("frequency response around omega = 0.5: report")
+    responses = {k[1:]: r for k, r in done.items() if k[0] == "response"}
+    response_rows = run_response(out, systems, CASES, points, quick=quick, done=responses)
     from .report_sensitivity import sensitivity_section
     from .sensitivity import SCENES, physical_scales, run_sensitivity
 
@@ -235,42 +240,6 @@ def reproduce(
     return path
 
 
-def _operating_points(by_case, models, settings, out, tag: str, files: dict) -> dict:
-    """lambda = 0.1 and 0.8 of each case, each from the end state of the forward sweep's
-    run before it and with the long budget (the claims rest on them): figures and data
-    named ``point_<tag><case>_lambda_<value>``, their names in ``files``."""
-    from gearsym.solver import plots
-
-    found = {}
-    for case, _, f1 in CASES:
-        name = f"bifurcation_{tag}{case}.png"
-        files["bifurcation"][case] = name
-        model = "the exact dead zone" if tag else "the polynomial"
-        plots.bifurcation_diagram(
-            by_case[case],
-            ["u", "v"],
-            out / name,
-            title=f"{case} load, f1 = {f1}, {model}: Poincaré points against lambda",
-            system=models[case],
-        )
-        forward = by_case[case][0]
-        for value in (0.1, 0.8):
-            k = int(np.argmin(np.abs(forward.values - value)))
-            x0 = forward.points[k - 1].x_final if k > 0 else None
-            at = models[case].with_values(**{"lambda": value})
-            result = analyse_point(at, x0, budget=LONG_BUDGET, **settings)
-            found[(case, value)] = result
-            stem = f"point_{tag}{case}_lambda_{value}"
-            plots.point_figure(
-                result,
-                out / f"{stem}.png",
-                title=f"{case} load (f1 = {f1}), {model}, lambda = {value}",
-            )
-            (out / "data" / f"{stem}.json").write_text(dumps(result.describe()), encoding="utf-8")
-            files["point"][(case, value)] = (f"{stem}.png", f"data/{stem}.json")
-    return found
-
-
 def _lengthen_claims(got: dict, groups: dict, settings, executor, workers) -> dict:
     """The sweeps with every run a claim may rest on continued with the long budget:
     the forward case sweeps' non-periodic runs in the study's low-lambda ranges (u
@@ -294,55 +263,6 @@ def _lengthen_claims(got: dict, groups: dict, settings, executor, workers) -> di
     return out
 
 
-def _chaotic_points(by_case, systems, settings, out) -> dict:
-    """The first point of each case's sweeps judged chaotic, analysed again from where its
-    sweep run ended and drawn (``point_chaotic_<case>_lambda_<value>.png``)."""
-    from gearsym.solver import plots
-
-    found = {}
-    for case, sweeps in by_case.items():
-        hit = next((p for sw in sweeps for p in sw.points if p.motion("u") == "chaotic"), None)
-        if hit is None:
-            continue
-        value = hit.values["lambda"]
-        result = analyse_point(
-            systems[case].with_values(**{"lambda": value}), hit.x_final, **settings
-        )
-        found[(case, value)] = result
-        plots.point_figure(
-            result,
-            out / f"point_chaotic_{case}_lambda_{value:.4g}.png",
-            title=f"{case} load, lambda = {value:.4g}: a point the sweep judged chaotic",
-        )
-    return found
-
-
-def _continue_case(args):
-    """Worker: continue every periodic branch the forward sweep visits, over [0, 1]."""
-    module, sweep_points, n_values, step = args
-    system = System.load(module)
-    branches, seen = [], set()
-    for value, point in zip(n_values, sweep_points, strict=True):
-        motion = point.motion("u")
-        if not motion.startswith("period-") or motion in seen:
-            continue
-        seen.add(motion)
-        n = point.period("u")
-        x0 = point.poincare_state(system.states)
-        for target in (1.0, 0.0):  # both ways from where the sweep found it
-            if target == float(value):
-                continue  # no branch of zero length
-            try:
-                br = continue_orbit(
-                    system, "lambda", float(value), target, x0, n=n, ds=step, ds_max=4 * step
-                )
-            except ShootingError:
-                continue
-            if len(br.values) > 1:
-                branches.append(br)
-    return branches
-
-
 def _job_key(job: SweepJob) -> str:
     """16 hex digits of the sha256 of everything that defines a sweep job."""
     defining = {
@@ -354,13 +274,3 @@ def _job_key(job: SweepJob) -> str:
         "settings": job.settings,
     }
     return hashlib.sha256(dumps(defining, sort_keys=True).encode()).hexdigest()[:16]
-
-
-def _continue_cases(systems, by_case, quick, executor, workers):
-    step = 0.05 if quick else 0.02
-    tasks = [
-        (module, by_case[case][0].points, list(by_case[case][0].values), step)
-        for case, module, _ in CASES
-    ]
-    results = map_tasks(_continue_case, tasks, executor=executor, workers=workers or len(tasks))
-    return {case: r for (case, _, _), r in zip(CASES, results, strict=True)}

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["OMEGA", "RANGE", "ResponseCase", "response_section", "run_response"]
+__all__ = ["OMEGA", "RANGE", "ResponseCase", "resolution", "response_section", "run_response"]
 
 OMEGA = 0.5  # the study's forcing frequency
 RANGE = (0.3, 0.9)  # around it: the primary resonances of both meshes lie inside
@@ -84,13 +84,23 @@ def _attractor(result, solutions, coords) -> dict | None:
     return {"amplitude": amp, "motion": motion, "nearest": best, "gap": gap}
 
 
-def run_response(out: Path, systems: dict, cases, points: dict, *, quick: bool) -> list:
-    """The frequency responses (figures and data under ``out``), one per (case, lambda)."""
+def resolution(quick: bool) -> tuple[int, int]:
+    """(points, harmonics) of the frequency responses."""
+    return (80, 10) if quick else (400, 15)
+
+
+def run_response(
+    out: Path, systems: dict, cases, points: dict, *, quick: bool, done: dict | None = None
+) -> list:
+    """The frequency responses (figures and data under ``out``), one per (case, lambda);
+    ``done``: ``(case, lambda) -> FrequencyResponse`` already computed (the rest are
+    computed here)."""
     from gearsym.solver.sweep.frequency import frequency_response
 
     from .figures import response_figure
 
-    num, harmonics = (80, 10) if quick else (400, 15)
+    num, harmonics = resolution(quick)
+    done = done or {}
     rows = []
     for case, _, f1 in cases:
         system = systems[case]
@@ -98,7 +108,9 @@ def run_response(out: Path, systems: dict, cases, points: dict, *, quick: bool) 
         per_lambda = {}
         for lam in LAMBDAS:
             s = system.with_values(**{"lambda": lam})
-            resp = frequency_response(s, "omega", *RANGE, points=num, harmonics=harmonics)
+            resp = done.get((case, lam))
+            if resp is None:
+                resp = frequency_response(s, "omega", *RANGE, points=num, harmonics=harmonics)
             resp.save(out / "data" / f"response_{case}_lambda_{lam}.json")
             sols = _at(resp.curves[0], OMEGA, coords)
             att = _attractor(points.get((case, lam)), sols, coords)

@@ -10,6 +10,7 @@ before any run.
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -79,11 +80,33 @@ def is_text(values) -> bool:
     return any(isinstance(v, str) for v in values)
 
 
+def _load_value(scene: str, f1: float, reading: str, key: str, value):
+    """The System of ``scene`` in ``reading`` with the open value ``key`` = ``value``
+    (one derivation, cached)."""
+    from gearsym.resolve import load
+
+    if key == "backlash":
+        return load(BACKLASH_SCENES[value] or scene, load_reading=reading, f1=f1)
+    return load(scene, load_reading=reading, **{key: value})
+
+
+def _prepare(args: tuple) -> None:
+    """Worker: derive one model of the sensitivity maps and compile its library (with the
+    variational system the exponent needs) into the caches, so that the maps find both
+    there.  A missing compiler is left to the map, which decides and warns once."""
+    from gearsym.solver.integrate.native.build import NativeUnavailable, library, single_point
+
+    module = _load_value(*args).module
+    try:  # the map's check, and the one-point runs of its re-examinations
+        library(module, variational=True)
+        library(module, variational=True, shared=single_point(module))
+    except NativeUnavailable:
+        pass
+
+
 def _resolver(scene: str, f1: float, reading: str, key: str, values: tuple):
     """The System of one map point: one derivation per value of ``key`` (cached), in
     ``reading``; a text value arrives as its index in ``values``."""
-    from gearsym.resolve import load
-
     memo: dict = {}
     text = is_text(values)
 
@@ -91,11 +114,7 @@ def _resolver(scene: str, f1: float, reading: str, key: str, values: tuple):
         v = point[key]
         if v not in memo:
             value = values[int(round(v))] if text else v
-            if key == "backlash":
-                target = BACKLASH_SCENES[value] or scene
-                memo[v] = load(target, load_reading=reading, f1=f1)
-            else:
-                memo[v] = load(scene, load_reading=reading, **{key: value})
+            memo[v] = _load_value(scene, f1, reading, key, value)
         return memo[v].with_values(**{k: x for k, x in point.items() if k != key})
 
     return resolve
@@ -127,21 +146,32 @@ def run_sensitivity(out: Path, res, settings: dict, *, quick, executor, workers,
     """Regime maps over lambda by each open value at both loads, in both load readings;
     figures and data under ``out``; a list of :class:`Sensitivity` rows."""
     from gearsym.resolve import load
-    from gearsym.solver.plots_maps import map_figures
+    from gearsym.solver.sweep import map_tasks
     from gearsym.solver.sweep.atlas import regime_map
 
     spread = QUICK_SPREAD if quick else OPEN_SPREAD
     lam = np.round(np.linspace(0.0, 1.0, 6 if quick else 11), 10)
     folder = out / "sensitivity"
     folder.mkdir(parents=True, exist_ok=True)
-    rows = []
+    # Every model of every map derived and compiled first, by the workers: one at a time
+    # in this process, the derivations and compilations kept the workers idle for about
+    # half of the stage.
+    every = dict.fromkeys(
+        (scene, f1, reading, key, value)
+        for case, (scene, f1) in SCENES.items()
+        for reading in READINGS
+        for key, (values, _, _) in spread.items()
+        for value in values
+    )
+    if progress:
+        print(f"sensitivity: deriving and compiling {len(every)} models", file=sys.stderr)
+    map_tasks(_prepare, list(every), executor=executor, workers=workers)
+    rows, drawings = [], []
     for case, (scene, f1) in SCENES.items():
         for reading in READINGS:
             base = load(scene, load_reading=reading)
             for key, (values, stated, unit) in spread.items():
                 if progress:
-                    import sys
-
                     print(
                         f"sensitivity: {case} load, {reading}, {key} = {list(values)}",
                         file=sys.stderr,
@@ -172,14 +202,16 @@ def run_sensitivity(out: Path, res, settings: dict, *, quick, executor, workers,
                     m, FINDINGS[case], key, resolve, settings, executor, workers
                 )
                 m.save(out / "data" / f"sensitivity_{name}.json")
-                figs = map_figures(
-                    m,
-                    folder,
-                    f"{case}-{reading}-{key}",
-                    ticks={key: list(values)} if text else None,
-                    title=f"{scene} (f1 = {f1}), load reading {reading}, {key} as on the "
-                    "y axis, all else as stated",
-                    kinds=("motion", "lyapunov", "attractors", "meshing"),
+                drawings.append(
+                    (
+                        m,
+                        folder,
+                        f"{case}-{reading}-{key}",
+                        {key: list(values)} if text else None,
+                        f"{scene} (f1 = {f1}), load reading {reading}, {key} as on the "
+                        "y axis, all else as stated",
+                        ("motion", "lyapunov", "attractors", "meshing"),
+                    )
                 )
                 records = _named(m.records(), key, values)
                 motions, critical = {}, {}
@@ -203,12 +235,24 @@ def run_sensitivity(out: Path, res, settings: dict, *, quick, executor, workers,
                         critical,
                         reproduced,
                         sum(r["status"] != "ok" for r in records),
-                        figs,
+                        [],  # the figures, drawn below
                         reading,
                         carriers,
                     )
                 )
+    # the figures drawn by the workers, after every map (in this process they took a
+    # tenth of the stage)
+    drawn = map_tasks(_draw, drawings, executor=executor, workers=workers)
+    for row, figs in zip(rows, drawn, strict=True):
+        row.figures = figs
     return rows
+
+
+def _draw(args: tuple) -> list:
+    """Worker: the figures of one sensitivity map (``map_figures``' arguments); paths."""
+    from gearsym.solver.plots_maps import map_figures
+
+    return map_figures(*args)
 
 
 def _lengthen_carriers(m, findings, key, resolve, settings, executor, workers):

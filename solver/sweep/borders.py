@@ -30,7 +30,8 @@ __all__ = [
     "border_indices",
     "map_looks",
     "reexamine",
-    "reexamine_sweep",
+    "run_look",
+    "sweep_looks",
 ]
 
 BORDER_BUDGET = 8000  # periods a border run's verdict may take, from the run's start
@@ -120,31 +121,32 @@ def reexamine(
     return replace(r, **changes)
 
 
-def reexamine_sweep(
+def sweep_looks(
     system: System, parameter: str, runs: list[RunRecord], settings: dict
-) -> list[RunRecord]:
-    """A sweep's runs with its border runs re-examined (none when the sweep's ``budget``
-    setting is 0: no run may be continued)."""
+) -> list[tuple[int, Look]]:
+    """The re-examinations a sweep needs: (index, :class:`Look`) for every border run
+    that is not on a confirmed orbit (none when the sweep's ``budget`` setting is 0: no
+    run may be continued).  ``system`` is the sweep's model at its base values."""
     from ..analysis.point import classification_tolerance
     from ..integrate import fastest_method
 
     if settings.get("budget", BUDGET) == 0:
-        return runs
+        return []
     rtol = settings.get("rtol", 1e-8)
     method = settings.get("method") or fastest_method(rtol)
-    tol = classification_tolerance(method, rtol)
-    out = list(runs)
+    options = {
+        "tol": classification_tolerance(method, rtol),
+        "method": method,
+        "rtol": rtol,
+        "atol": settings.get("atol", 1e-10),
+        "budget": max(BORDER_BUDGET, settings.get("budget", BUDGET)),
+    }
+    out = []
     for i in border_indices(runs):
         if needs_look(runs[i]):
             at = system.with_values(**{parameter: runs[i].values[parameter]})
-            out[i] = reexamine(
-                at,
-                runs[i],
-                tol=tol,
-                method=method,
-                rtol=rtol,
-                atol=settings.get("atol", 1e-10),
-                budget=max(BORDER_BUDGET, settings.get("budget", BUDGET)),
+            out.append(
+                (i, Look(str(at.module.__file__), tuple(map(float, at.p)), runs[i], options))
             )
     return out
 

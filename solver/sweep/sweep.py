@@ -27,7 +27,7 @@ from .._json import dumps
 from ..analysis.record import RunRecord
 from ..executor import EXECUTORS, map_tasks
 from ..system import System
-from .borders import reexamine_sweep
+from .borders import run_look, sweep_looks
 from .chains import Chain, ChainDone, checked_values, module_ref, plan, run_chain
 from .progress import Progress
 from .result import SweepResult
@@ -68,30 +68,42 @@ def _execute(
         for point in done.points:
             tick(point)
 
-    _decide_native(chains)
+    _decide_native(chains, executor, workers)
 
     return map_tasks(
         run_chain, chains, executor=executor, workers=workers, scheduler=scheduler, on_result=ticks
     )
 
 
-def _decide_native(chains: list[Chain]) -> None:
-    """Build the compiled libraries of every model the chains run in this process before
-    the workers start (they find them cached), and say here, once per reason, when one
-    cannot be built: workers ignore that warning."""
+def _decide_native(chains: list[Chain], executor: str, workers: int | None) -> None:
+    """Build the compiled libraries of every model the chains run before the workers
+    start (they find them cached; the workers build them side by side), and say here,
+    once per reason, when one cannot be built: workers ignore that warning."""
     from ..integrate.methods import get_method
+    from ..integrate.native.build import prebuild, single_point
     from ..integrate.native.maps import map_backend
     from ..integrate.simulate import fastest_method
 
-    seen = set()
+    seen = {}
     for chain in chains:
         settings = chain.settings
         method = settings.get("method") or fastest_method(settings.get("rtol", 1e-8))
         tangent = bool(settings.get("lyapunov_periods", 0))
         if get_method(method).family != "native" or (chain.module, tangent) in seen:
             continue
-        seen.add((chain.module, tangent))
-        module = System.load(chain.module, **chain.base_values).module
+        seen[(chain.module, tangent)] = System.load(chain.module, **chain.base_values).module
+    # the libraries of the check below and those of the chains' one-point runs
+    prebuild(
+        [
+            (module.__file__, v, shared)
+            for (_, tangent), module in seen.items()
+            for v in (False, True)[: 1 + tangent]
+            for shared in ((), single_point(module))
+        ],
+        executor=executor,
+        workers=workers,
+    )
+    for (_, tangent), module in seen.items():
         if map_backend(module, lyapunov=False) == "native" and tangent:
             map_backend(module, lyapunov=True)
 
@@ -140,9 +152,29 @@ def sweep(
             for _ in run.done:
                 progress.step("(stored)")
         ran = _execute(run.chains, executor, workers, progress, scheduler)
-        return run.result(ran)
+        points, stored = run.ordered(ran)
+        looked = _looked([run], [points], executor, workers, scheduler)[0]
+        return run.result(points, stored, looked)
     finally:
         run.close()
+
+
+def _looked(runs: list, points: list[list], executor, workers, scheduler) -> list[list]:
+    """Each sweep's runs with its border runs re-examined (``borders``), all sweeps' in
+    one batch of the executor (one at a time in this process, the long re-examinations of
+    a chaotic region left the workers idle)."""
+    looks, where = [], []
+    for k, (run, pts) in enumerate(zip(runs, points, strict=True)):
+        for i, look in sweep_looks(run.system, run.parameter, pts, run.settings):
+            looks.append(look)
+            where.append((k, i))
+    out = [list(pts) for pts in points]
+    if not looks:
+        return out
+    done = map_tasks(run_look, looks, executor=executor, workers=workers, scheduler=scheduler)
+    for (k, i), r in zip(where, done, strict=True):
+        out[k][i] = r
+    return out
 
 
 def _direction(continuation: bool, backward: bool) -> str:
@@ -217,16 +249,19 @@ class _Planned:
             texts,
         )
 
-    def result(self, ran: list[ChainDone]) -> SweepResult:
+    def ordered(self, ran: list[ChainDone]) -> tuple[list, list]:
+        """The sweep's runs in its order, and their stored texts (None: not stored)."""
         found, texts = dict(self.done), dict(self.texts)
         for chain, done in zip(self.chains, ran, strict=True):
             found.update(zip(chain.indices, done.points, strict=True))
             texts.update(zip(chain.indices, done.texts, strict=True))
         order = range(self.values.size)
         order = order[::-1] if self.backward else order
-        points = [found[i] for i in order]
-        stored = [texts.get(i) for i in order]
-        looked = reexamine_sweep(self.system, self.parameter, points, self.settings)
+        return [found[i] for i in order], [texts.get(i) for i in order]
+
+    def result(self, points: list, stored: list, looked: list) -> SweepResult:
+        """The sweep's result from its runs in order (``ordered``) and the same runs with
+        its border runs re-examined (``looked``)."""
         if any(a is not b for a, b in zip(looked, points, strict=True)):
             points, stored = looked, [None]  # re-examined points: their stored text is old
         settings = dict(self.settings, x0=self.x0)
@@ -302,7 +337,9 @@ def sweep_many(
         by_run: dict[int, list[ChainDone]] = {k: [] for k in range(len(runs))}
         for (k, _), done in zip(pending, ran, strict=True):
             by_run[k].append(done)
-        return [run.result(by_run[k]) for k, run in enumerate(runs)]
+        ordered = [run.ordered(by_run[k]) for k, run in enumerate(runs)]
+        looked = _looked(runs, [p for p, _ in ordered], executor, workers, scheduler)
+        return [run.result(p, s, lk) for run, (p, s), lk in zip(runs, ordered, looked, strict=True)]
     finally:
         for run in runs:
             run.close()

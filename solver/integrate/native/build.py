@@ -30,7 +30,15 @@ from ...cache import cache_root
 from ..tableau import RK4, c_tables
 from . import abi
 
-__all__ = ["NativeUnavailable", "cache_dir", "compiler", "library", "source"]
+__all__ = [
+    "NativeUnavailable",
+    "cache_dir",
+    "compiler",
+    "library",
+    "prebuild",
+    "single_point",
+    "source",
+]
 
 _FLAGS = (
     "-O3",
@@ -201,6 +209,36 @@ def _shared_flags(module, shared) -> list[str]:
     if ks and (ks[0] < 0 or (n_p is not None and ks[-1] >= n_p)):
         raise ValueError(f"shared parameter indices {ks} must lie in [0, {n_p})")
     return [f"-DGS_SHARED_{k}=1" for k in ks]
+
+
+def single_point(module) -> tuple[int, ...]:
+    """``shared`` of a batch of one point (every parameter equal across it): the library
+    a sweep's runs, a re-examined run and a shooting check use."""
+    return tuple(range(len(module.CONTRACT["parameters"])))
+
+
+def prebuild(items, *, executor: str = "serial", workers: int | None = None) -> None:
+    """Compile the libraries ``items`` name side by side into the cache before a batch of
+    runs needs them (one at a time in the main process, the compilations kept the workers
+    idle).  Each item is ``(generated module file, variational, shared)`` as
+    :func:`library` takes them.  Only with the ``processes`` executor (a cluster's workers
+    build their own); a library that cannot be built is left to the caller's own
+    :func:`library` call, which says why, once."""
+    from ...executor import map_tasks
+
+    todo = list(dict.fromkeys((str(f), bool(v), tuple(sh)) for f, v, sh in items))
+    if executor == "processes" and len(todo) > 1 and compiler() is not None:
+        map_tasks(_prebuild_one, todo, executor=executor, workers=workers)
+
+
+def _prebuild_one(item: tuple) -> None:
+    from ...contract import load_generated
+
+    source, variational, shared = item
+    try:
+        library(load_generated(source), variational=variational, shared=shared)
+    except NativeUnavailable:
+        pass
 
 
 def library(module, variational: bool = False, shared=()) -> tuple[ctypes.CDLL, dict]:
