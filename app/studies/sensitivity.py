@@ -164,7 +164,11 @@ def run_sensitivity(out: Path, res, settings: dict, *, quick, executor, workers,
         for value in values
     )
     if progress:
-        print(f"sensitivity: deriving and compiling {len(every)} models", file=sys.stderr)
+        print(
+            f"sensitivity: the models of {len(every)} open values, derived and compiled "
+            "side by side",
+            file=sys.stderr,
+        )
     map_tasks(_prepare, list(every), executor=executor, workers=workers)
     rows, drawings = [], []
     for case, (scene, f1) in SCENES.items():
