@@ -218,10 +218,11 @@ def point_figure(point, path: Path, title: str = "", periods_shown: int = 20) ->
         _spectrum_panel(axes[row, 2], tr, c)
     fig.suptitle(_title(tr, result, title), fontsize=10)
     fig.tight_layout()
-    handles = {}
-    for ax in axes[0]:
-        for h, label in zip(*ax.get_legend_handles_labels(), strict=True):
-            handles.setdefault(label.replace(f" {coords[0]} = ", " = "), h)
+    handles = {}  # every panel's entries once (a band may be drawn in one row only)
+    for row, c in enumerate(coords):
+        for ax in axes[row]:
+            for h, label in zip(*ax.get_legend_handles_labels(), strict=True):
+                handles.setdefault(label.replace(f" {c} = ", " = "), h)
     fig.legend(
         handles.values(),
         handles.keys(),
@@ -242,9 +243,10 @@ def _spectrum_panel(ax, tr: Trajectory, c: str) -> None:
     ax.set_xlim(0, top)
     if np.any(keep):  # what the integration's relative tolerance cannot resolve
         level = tr.rtol * float(sp.amplitude[keep].max())
-        bottom = min(ax.get_ylim()[0], level)
-        ax.axhspan(bottom, level, color="0.9", zorder=0, label="below rtol × the largest peak")
-        ax.set_ylim(bottom=bottom)
+        bottom = ax.get_ylim()[0]
+        if level > bottom:  # else nothing drawn lies below it: no band, no legend entry
+            ax.axhspan(bottom, level, color="0.9", zorder=0, label="below rtol × the largest peak")
+            ax.set_ylim(bottom=bottom)
     ax.set_xlabel("frequency (rad per unit τ)")
     ax.set_ylabel(f"amplitude of {c} (half backlashes)")
     harmonics = ax.secondary_xaxis(

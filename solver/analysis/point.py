@@ -220,8 +220,36 @@ def analyse_trajectory(
         exponent=lyapunov_periods > 0,
     )
     v = st.verdict
+    if v.periods_run > tr.transient + tr.periods:
+        tr = _closing_sample(tr, st, rtol, atol, steps_per_period)
     spectra = {c: spectrum(tr, c) for c in coords}
     verdicts = per_coordinate(
         system, v, {c: {"spectrum_peaks": spectra[c].peaks()} for c in coords}
     )
     return PointResult(tr, st.estimate, verdicts, spectra, v, st)
+
+
+def _closing_sample(tr, st: Settled, rtol: float, atol: float, steps_per_period: int):
+    """A run continued past its first window is shown where its verdict was reached: the
+    time series, spectra and meshing shares of a point are resampled over as many periods
+    as the first window sampled, from where the last continued window ended (a chaotic
+    transient that ended on an orbit shows the orbit; the verdict's own extremes and
+    Poincare points are those of its last window).  The first window's trajectory is kept
+    if the resampling fails."""
+    import warnings
+
+    with warnings.catch_warnings():  # a valid-range exit was said by the first window
+        warnings.simplefilter("ignore")
+        again = simulate(
+            tr.system,
+            st.x_final,
+            method=tr.method,
+            rtol=rtol,
+            atol=atol,
+            transient=0,
+            periods=tr.periods,
+            samples_per_period=tr.samples_per_period,
+            t0=st.t_final,
+            steps_per_period=steps_per_period,
+        )
+    return again if again.status == "ok" else tr
