@@ -219,10 +219,9 @@ def point_figure(point, path: Path, title: str = "", periods_shown: int = 20) ->
     fig.suptitle(_title(tr, result, title), fontsize=10)
     fig.tight_layout()
     handles = {}  # every panel's entries once (a band may be drawn in one row only)
-    for row, c in enumerate(coords):
-        for ax in axes[row]:
-            for h, label in zip(*ax.get_legend_handles_labels(), strict=True):
-                handles.setdefault(label.replace(f" {c} = ", " = "), h)
+    for c, ax in ((c, ax) for c, row in zip(coords, axes, strict=True) for ax in row):
+        for h, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            handles.setdefault(label.replace(f" {c} = ", " = "), h)
     fig.legend(
         handles.values(),
         handles.keys(),
@@ -241,12 +240,11 @@ def _spectrum_panel(ax, tr: Trajectory, c: str) -> None:
     keep = (sp.frequency <= top) & (sp.amplitude > 0)
     ax.semilogy(sp.frequency[keep], sp.amplitude[keep], lw=0.8, color="#1f1f1f")
     ax.set_xlim(0, top)
-    if np.any(keep):  # what the integration's relative tolerance cannot resolve
-        level = tr.rtol * float(sp.amplitude[keep].max())
-        bottom = ax.get_ylim()[0]
-        if level > bottom:  # else nothing drawn lies below it: no band, no legend entry
-            ax.axhspan(bottom, level, color="0.9", zorder=0, label="below rtol × the largest peak")
-            ax.set_ylim(bottom=bottom)
+    # what the integration's relative tolerance cannot resolve, where something lies below
+    level = tr.rtol * float(sp.amplitude[keep].max()) if np.any(keep) else 0.0
+    if level > (bottom := ax.get_ylim()[0]):
+        ax.axhspan(bottom, level, color="0.9", zorder=0, label="below rtol × the largest peak")
+        ax.set_ylim(bottom=bottom)
     ax.set_xlabel("frequency (rad per unit τ)")
     ax.set_ylabel(f"amplitude of {c} (half backlashes)")
     harmonics = ax.secondary_xaxis(
