@@ -120,7 +120,7 @@ def throughput(quick: bool) -> dict:
 
 
 # ---------------------------------------------------------------- 3. Pareto
-ADAPTIVE = ["RK45", "DOP853", "LSODA", "Radau", "cvodes", "dopri5", "dop853"]
+ADAPTIVE = ["RK45", "scipy-dop853", "LSODA", "Radau", "cvodes", "dopri5", "dop853"]
 FIXED = ["rk", "collocation", "rk4"]
 
 

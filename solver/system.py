@@ -130,6 +130,32 @@ class System:
         return self.module.FEATURES["backlash"]
 
     @property
+    def backlash_note(self) -> str | None:
+        """One sentence on a polynomial backlash: where its force is zero (the contract's
+        ``force_sign``) and that it carries load inside the gap; None for other models.
+
+        The study's 7th-order fit is zero at ``x = 0, +-0.770`` half backlashes, not at the
+        gap's edges ``+-1`` (``derive/mesh/force_sign.py``).  The CLI prints it once per
+        model; the API only offers it (a sweep builds thousands of systems).
+        """
+        if self.backlash != "polynomial" or not self.contract.force_sign:
+            return None
+        zeros = {_zeros_text(s.zeros) for s in self.contract.force_sign.values()}
+        where = (
+            zeros.pop()
+            if len(zeros) == 1
+            else "; ".join(
+                f"{c}: {_zeros_text(s.zeros)}" for c, s in self.contract.force_sign.items()
+            )
+        )
+        return (
+            "backlash model 'polynomial' (a polynomial fit of the dead zone, as the study's): "
+            f"its force is zero at x = {where} half backlashes, not at the backlash edge ±1, "
+            "and it carries load inside the backlash; "
+            '`backlash = "dead-zone"` for the exact dead zone'
+        )
+
+    @property
     def model_hash(self) -> str:
         return self.module.INPUTS_SHA256
 
@@ -170,3 +196,16 @@ class System:
 def _rebuild(source: str, p, values: dict) -> System:
     """A pickled :class:`System` again (``System.__reduce__``)."""
     return System(load_generated(source), np.asarray(p, float), dict(values))
+
+
+def _zeros_text(zeros) -> str:
+    """``0, ±0.770``: the zeros to three decimals by size, a pair ``-z, z`` as ``±z``."""
+    out = []
+    for z in sorted(set(zeros), key=lambda z: (abs(z), z)):
+        if z == 0:
+            out.append("0")
+        elif z > 0 and -z in zeros:
+            out.append(f"±{z:.3f}")
+        elif not (z < 0 and -z in zeros):
+            out.append(f"{z:.3f}")
+    return ", ".join(out)

@@ -36,7 +36,8 @@ def test_an_unwritable_cache_falls_back_to_a_temporary_folder_with_one_warning(t
         cwd=tmp_path,
     )
     assert run.returncode == 0, run.stderr
-    lines = [ln for ln in run.stderr.splitlines() if ln.strip()]
+    # the note on the polynomial backlash (issue 25) aside
+    lines = [ln for ln in run.stderr.splitlines() if ln.strip() and "gearsym: note:" not in ln]
     assert len(lines) == 1 and lines[0].startswith("gearsym: warning: the cache"), lines
     assert str(blocker / "cache") in lines[0] and "GEARSYM_CACHE" in lines[0]
 

@@ -169,7 +169,7 @@ def test_a_coordinate_named_like_a_c_word_compiles_and_simulates(u, v, root, tmp
     assert facts["path"]
     options = dict(transient=2, periods=2, samples_per_period=4)
     compiled = simulate(system, method="dop853", **options)
-    reference = simulate(system, method="DOP853", **options)
+    reference = simulate(system, method="scipy-dop853", **options)
     assert compiled.status == "ok" and reference.status == "ok"
     np.testing.assert_allclose(compiled.poincare, reference.poincare, rtol=1e-6, atol=1e-6)
 

@@ -28,7 +28,7 @@ import sys
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-from . import atlas, derive, modes, orbits, point, response, study  # noqa: E402
+from . import _notes, atlas, derive, modes, orbits, point, response, study  # noqa: E402
 from ._common import Fail, OneLineParser, RunFailed, out_folder  # noqa: E402
 
 __all__ = ["main"]
@@ -112,6 +112,7 @@ def _closed_pipe(as_program: bool) -> int:
 def main(argv: list[str] | None = None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
+    _notes.forget()  # a process may run several commands (tests): each has its notes
     if getattr(args, "method", "absent") is None:
         from gearsym.solver.integrate import fastest_method
 
@@ -129,6 +130,7 @@ def _run(args) -> int:
     if args.debug:
         code = args.func(args)
         sys.stdout.flush()
+        _notes.say()
         return code
     import warnings
 
@@ -140,6 +142,7 @@ def _run(args) -> int:
             out_folder(args.out)
         code = args.func(args)
         sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's exit
+        _notes.say()  # a command that ran to its end (not refused, not failed)
         return code
     except (InputError, Fail) as err:
         _say(f"gearsym: error: {err}")

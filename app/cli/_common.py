@@ -15,6 +15,7 @@ __all__ = [
     "LIMITS",
     "MAX_TOTAL_PERIODS",
     "Fail",
+    "DefaultsFormatter",
     "OneLineParser",
     "RunFailed",
     "figure_file",
@@ -39,8 +40,25 @@ class RunFailed(Exception):
     """A run that ended invalid, divergent or failed numerically: one line, exit code 3."""
 
 
+class DefaultsFormatter(argparse.HelpFormatter):
+    """Help that ends each option's text with "(default: X)" when the option takes a
+    value and has a default (not None); a text with ``%(default)s`` of its own is kept."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text, default = action.help or "", action.default
+        takes_value = action.option_strings and action.nargs != 0
+        if takes_value and default not in (None, argparse.SUPPRESS) and "%(" not in text:
+            text += " (default: %(default)s)"
+        return text
+
+
 class OneLineParser(argparse.ArgumentParser):
-    """argparse's parser whose refusals are one line (no usage block), exit code 2."""
+    """argparse's parser whose refusals are one line (no usage block), exit code 2; its
+    help shows every option's default (:class:`DefaultsFormatter`)."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", DefaultsFormatter)
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str):
         import difflib
@@ -162,15 +180,16 @@ def parse_range(text: str, given: str | None = None, negative: str | None = None
 
 
 def system_of(scene_arg: str, sets: dict[str, float]):
-    """The System of a scene (built-in name or path) with ``--set`` values (resolver:
-    ``gearsym.resolve``); a bad scene file raises its own InputError."""
+    """The System of a scene (name or path) with ``--set`` values (``gearsym.resolve``),
+    a polynomial backlash noted once (``_notes``); a bad scene raises its own InputError."""
+    from gearsym.cli._notes import note_backlash
     from gearsym.resolve import module_for, split_open_values
     from gearsym.solver.system import System
 
     opened, rest = split_open_values(sets)
     module = module_for(scene_arg, opened)
     try:
-        return System.load(module, **rest)
+        return note_backlash(System.load(module, **rest))
     except KeyError as err:
         from gearsym.derive.input.open_values import OPEN_VALUE_BASES
         from gearsym.derive.input.reader import nearest
@@ -278,6 +297,15 @@ def analysis_settings(args) -> dict:
     )
 
 
+def method_name(text: str) -> str:
+    """``--method``'s value; an old integrator name is refused naming the new one."""
+    from gearsym.solver.integrate.methods import RENAMED
+
+    if text in RENAMED:
+        raise argparse.ArgumentTypeError(RENAMED[text])
+    return text
+
+
 def analysis_options(sub) -> None:
     from gearsym.solver.integrate import METHODS
 
@@ -289,6 +317,7 @@ def analysis_options(sub) -> None:
     )
     sub.add_argument(
         "--method",
+        type=method_name,
         choices=METHODS,
         default=None,
         help="integrator (default: the fastest that meets --rtol: dop853, or cvodes without a "
@@ -300,13 +329,13 @@ def analysis_options(sub) -> None:
         "--transient",
         type=int,
         default=300,
-        help=f"periods discarded (300; at most {LIMITS['transient']:,})",
+        help=f"periods discarded (at most {LIMITS['transient']:,})",
     )
     sub.add_argument(
         "--periods",
         type=int,
         default=100,
-        help=f"periods sampled (100; at most {LIMITS['periods']:,}, and what memory holds)",
+        help=f"periods sampled (at most {LIMITS['periods']:,}, and what memory holds)",
     )
     sub.add_argument(
         "--on-invalid",
@@ -320,7 +349,7 @@ def analysis_options(sub) -> None:
         type=int,
         default=400,
         help="a run not periodic is continued from its end in windows of this many periods "
-        "(each next one twice as long), each with the largest Lyapunov exponent (400; 0: no "
+        "(each next one twice as long), each with the largest Lyapunov exponent (0: no "
         f"exponent, so only periodic verdicts settle; at most {LIMITS['lyapunov_periods']:,})",
     )
     budget_option(sub)
@@ -333,7 +362,7 @@ def budget_option(sub) -> None:
         "--budget",
         type=int,
         default=BUDGET,
-        help=f"periods a verdict may take in all, from the run's start ({BUDGET:,}; 0: no "
+        help=f"periods a verdict may take in all, from the run's start (0: no "
         "continued windows; borders of sweeps and maps get 8,000; at most "
         f"{LIMITS['budget']:,})",
     )

@@ -50,8 +50,8 @@ def register(sub) -> None:
         type=int,
         default=4,
         metavar="K",
-        help="initial states per grid point: forward, backward, then K - 2 random (default 4, "
-        f"at most {MAX_INITIAL_STATES})",
+        help="initial states per grid point: forward, backward, then K - 2 random (at most "
+        f"{MAX_INITIAL_STATES})",
     )
     mp.add_argument("--seed", type=int, default=0, help="seed of the random initial states")
     budget_option(mp)
@@ -65,29 +65,39 @@ def register(sub) -> None:
     mp.add_argument(
         "--set", action="append", metavar="KEY=VALUE", help="set a scene or model parameter"
     )
-    mp.add_argument("--method", choices=("dop853", "dopri5"), default="dop853")
-    mp.add_argument("--rtol", type=float, default=1e-8)
-    mp.add_argument("--atol", type=float, default=1e-10)
+    mp.add_argument(
+        "--method",
+        choices=("dop853", "dopri5"),
+        default="dop853",
+        help="compiled integrator of the lockstep runs",
+    )
+    mp.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance")
+    mp.add_argument("--atol", type=float, default=1e-10, help="absolute tolerance")
     mp.add_argument(
         "--transient",
         type=int,
         default=300,
-        help=f"periods discarded (300; at most {LIMITS['transient']:,})",
+        help=f"periods discarded (at most {LIMITS['transient']:,})",
     )
     mp.add_argument(
         "--periods",
         type=int,
         default=100,
-        help=f"periods sampled (100; at most {LIMITS['periods']:,})",
+        help=f"periods sampled (at most {LIMITS['periods']:,})",
     )
     mp.add_argument(
         "--lyapunov-periods",
         type=int,
         default=200,
-        help="the exponent is summed over the last N periods of the run (200; 0: none; at "
+        help="the exponent is summed over the last N periods of the run (0: none; at "
         f"most the run's periods and {LIMITS['lyapunov_periods']:,})",
     )
-    mp.add_argument("--executor", choices=("serial", "processes", "dask"), default="processes")
+    mp.add_argument(
+        "--executor",
+        choices=("serial", "processes", "dask"),
+        default="processes",
+        help="serial, local processes or dask.distributed (needs gearsym[dask])",
+    )
     mp.add_argument(
         "--workers",
         type=int,

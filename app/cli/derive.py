@@ -53,13 +53,13 @@ def register(sub) -> None:
         "squares; with the defaults it reproduces the reference study's "
         "7th-order coefficients.",
     )
-    b.add_argument("--order", type=int, default=7, help="odd order, 1 to 31 (default 7)")
+    b.add_argument("--order", type=int, default=7, help="odd order, 1 to 31")
     b.add_argument(
         "--range",
         type=float,
         default=3.0,
         metavar="A",
-        help="fit on [-A, A], 1 < A <= 100 (default 3)",
+        help="fit on [-A, A], 1 < A <= 100",
     )
     b.add_argument(
         "--step",
@@ -90,14 +90,14 @@ def register(sub) -> None:
         type=int,
         default=200,
         metavar="N",
-        help="transverse slices across the face width, 1 to 100000 (default 200)",
+        help="transverse slices across the face width, 1 to 100000",
     )
     st.add_argument(
         "--harmonics",
         type=int,
         default=3,
         metavar="H",
-        help="harmonics in the Fourier fit, 0 to 64 (default 3)",
+        help="harmonics in the Fourier fit, 0 to 64",
     )
     st.add_argument("--json", action="store_true", help="print everything as JSON")
     st.add_argument(

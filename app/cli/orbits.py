@@ -39,8 +39,13 @@ def register(sub) -> None:
         "none has minimal period n, the lower-period orbit is reported as what it is "
         "and the exit status is 1.",
     )
-    sh.add_argument("scene", metavar="SCENE")
-    sh.add_argument("--set", action="append", metavar="KEY=VALUE")
+    sh.add_argument("scene", metavar="SCENE", help="a scene path or built-in name")
+    sh.add_argument(
+        "--set",
+        action="append",
+        metavar="KEY=VALUE",
+        help="set a scene or model parameter (repeatable)",
+    )
     sh.add_argument(
         "--period",
         type=int,
@@ -51,7 +56,7 @@ def register(sub) -> None:
         "--tries",
         type=int,
         default=6,
-        help=f"more guesses when the first leads to a lower period (default 6, at most "
+        help=f"more guesses when the first leads to a lower period (at most "
         f"{MAX_TRIES}; each settles max(--settle, 300) n T)",
     )
     sh.add_argument("--seed", type=int, default=0, help="seed of those guesses' random starts")
@@ -81,7 +86,7 @@ def register(sub) -> None:
         "--from-sweep: their state is the guess as given); the guesses settle at most "
         f"{MAX_SETTLED:,} periods T in all (N x n x (tries + 1))",
     )
-    sh.add_argument("--json", action="store_true")
+    sh.add_argument("--json", action="store_true", help="print the orbit as JSON")
     sh.add_argument("--out", metavar="DIR", help="also write orbit.json and multipliers.png")
     sh.set_defaults(func=_cmd_shoot)
 
@@ -93,7 +98,7 @@ def register(sub) -> None:
         "A branch that reaches the edge of the parameter's valid range stops there and "
         "says so (the points up to there are kept).",
     )
-    co.add_argument("scene", metavar="SCENE")
+    co.add_argument("scene", metavar="SCENE", help="a scene path or built-in name")
     co.add_argument(
         "--param",
         required=True,
@@ -122,10 +127,19 @@ def register(sub) -> None:
         "--settle",
         type=int,
         default=300,
-        help=f"periods n T simulated for the first guess (300; N x n at most {MAX_SETTLED:,})",
+        help=f"periods n T simulated for the first guess (N x n at most {MAX_SETTLED:,})",
     )
-    co.add_argument("--set", action="append", metavar="KEY=VALUE")
-    co.add_argument("--out", metavar="DIR")
+    co.add_argument(
+        "--set",
+        action="append",
+        metavar="KEY=VALUE",
+        help="set a scene or model parameter (repeatable)",
+    )
+    co.add_argument(
+        "--out",
+        metavar="DIR",
+        help="output folder for branches.json and the figures (default continue_<model>_<param>)",
+    )
     co.set_defaults(func=_cmd_continue)
 
 

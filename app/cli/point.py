@@ -49,7 +49,7 @@ def register(sub) -> None:
         "of the final state (forward, or --backward), or --independent points "
         "run in parallel.",
     )
-    sw.add_argument("scene", metavar="SCENE")
+    sw.add_argument("scene", metavar="SCENE", help="a scene path or built-in name")
     sw.add_argument("--param", required=True, help="parameter to sweep, e.g. lambda")
     sw.add_argument(
         "--range",
@@ -70,13 +70,13 @@ def register(sub) -> None:
         "--executor",
         choices=("serial", "processes", "dask"),
         default="processes",
-        help="serial, local processes (default, all cores) or dask.distributed "
+        help="serial, local processes (all cores) or dask.distributed "
         "(needs gearsym[dask]; a LocalCluster unless --scheduler)",
     )
     sw.add_argument(
         "--scheduler", metavar="ADDRESS", help="dask scheduler address, e.g. tcp://head:8786"
     )
-    sw.add_argument("--out", metavar="DIR")
+    sw.add_argument("--out", metavar="DIR", help="output folder (default sweep_<model>_<param>)")
     sw.add_argument("--quiet", action="store_true", help="no progress bar")
     sw.add_argument(
         "--no-figure",

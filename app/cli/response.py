@@ -21,8 +21,8 @@ from ._limits import MAX_PERIOD
 __all__ = ["register"]
 
 # Bounded work (every size that sets the cost; each stated in its option's help).  The
-# harmonic-balance continuation stops after 20,000 points (more NUM only shortens its
-# first step); a shooting point costs a Newton solve with the monodromy (0.1 to 1 s), an
+# harmonic-balance continuation stops after 20,000 points (NUM or a smaller --step set its
+# steps); a shooting point costs a Newton solve with the monodromy (0.1 to 1 s), an
 # integration point a settled run: 2,000 of them is some minutes on the smallest model.
 MAX_POINTS = 20_000
 MAX_POINTS_TIMED = 2_000
@@ -50,10 +50,23 @@ def register(sub) -> None:
         required=True,
         metavar="NAME=START:STOP:NUM",
         help="the parameter (a scene or model parameter; START and STOP inside its valid "
-        "range) and its range; NUM sets the first continuation step (the range over NUM; "
-        f"the step then adapts), for example omega=0.3:1:400; NUM at most {MAX_POINTS:,} "
-        f"({MAX_POINTS_TIMED:,} with shooting or integration). A branch that reaches the edge "
-        "of the parameter's valid range stops there and says so",
+        "range) and its range; NUM is the number of points every method returns, at NUM "
+        "equally spaced values from START to STOP, for example omega=0.3:1:400. hb and "
+        "shooting continue the branch (see --step) and solve it again at those values on "
+        "each monotonic piece: a branch without folds has NUM points, a branch that folds k "
+        "times has k + 1 pieces, each with the values in its span, plus its k turning points; "
+        "integration gives NUM frequencies up and NUM down (less any that failed). NUM at "
+        f"most {MAX_POINTS:,} ({MAX_POINTS_TIMED:,} with shooting or integration). A branch "
+        "that reaches the edge of the parameter's valid range stops there and says so",
+    )
+    fr.add_argument(
+        "--step",
+        type=float,
+        default=None,
+        help="hb and shooting: the continuation's first arclength step (default: the range "
+        "over NUM - 1; hb: also the most the parameter moves per step; shooting: the step "
+        "adapts up to twice this); it sets how finely folds are followed, not the number "
+        "of points",
     )
     fr.add_argument(
         "--set", action="append", metavar="KEY=VALUE", help="set a scene or model parameter"
@@ -63,7 +76,7 @@ def register(sub) -> None:
         type=int,
         default=15,
         metavar="H",
-        help=f"harmonics of omega/n (15; at most {MAX_HARMONICS}, and at most "
+        help=f"harmonics of omega/n (at most {MAX_HARMONICS}, and at most "
         f"{MAX_UNKNOWNS} unknowns: states x (2H + 1))",
     )
     fr.add_argument(
@@ -79,13 +92,13 @@ def register(sub) -> None:
         type=int,
         default=1,
         metavar="N",
-        help=f"period N T (default 1, at most {MAX_PERIOD})",
+        help=f"period N T (at most {MAX_PERIOD})",
     )
     fr.add_argument(
         "--method",
         choices=("hb", "shooting", "integration", "all"),
         default="hb",
-        help="hb (harmonic balance, default), shooting, integration (up and down stepped "
+        help="hb (harmonic balance), shooting, integration (up and down stepped "
         "sweeps in the compiled engine, over the forcing frequency), or all",
     )
     fr.add_argument(
@@ -93,7 +106,7 @@ def register(sub) -> None:
         type=int,
         default=50,
         metavar="N",
-        help=f"integration: periods settled at each frequency before sampling (50, at most "
+        help=f"integration: periods settled at each frequency before sampling (at most "
         f"{MAX_SETTLE:,}; NUM x (N + --sampled) at most {MAX_INTEGRATED:.0e} periods)",
     )
     fr.add_argument(
@@ -101,7 +114,7 @@ def register(sub) -> None:
         type=int,
         default=16,
         metavar="N",
-        help=f"integration: periods sampled at each frequency (16, at most {MAX_SETTLE:,})",
+        help=f"integration: periods sampled at each frequency (at most {MAX_SETTLE:,})",
     )
     fr.add_argument(
         "--physical",
@@ -132,7 +145,7 @@ def _param(text: str):
     return name.strip(), start, stop, num
 
 
-def _bounded(args, system, num: int, methods, cap: int) -> None:
+def _bounded(args, system, num: int, methods, cap: int, span: float) -> None:
     """Refuse a size that would make the run take hours (the limits above)."""
     if args.harmonics > cap:
         raise Fail(
@@ -143,6 +156,15 @@ def _bounded(args, system, num: int, methods, cap: int) -> None:
         )
     at_most(("--period", args.period, MAX_PERIOD))
     timed = [m for m in methods if m != "hb"]
+    if args.step is not None:
+        if not 0 < args.step <= span:
+            raise Fail(f"--step {args.step:g}: give a step in (0, {span:g}], the range")
+        most = MAX_POINTS_TIMED if timed else MAX_POINTS
+        if span / args.step > most:
+            raise Fail(
+                f"--step {args.step:g}: the continuation would take more than {most:,} "
+                f"steps over the range; give a step of at least {span / most:.3g}"
+            )
     if num > MAX_POINTS or (timed and num > MAX_POINTS_TIMED):
         most = MAX_POINTS_TIMED if timed and num > MAX_POINTS_TIMED else MAX_POINTS
         why = f" with --method {args.method}" if most == MAX_POINTS_TIMED else ""
@@ -199,7 +221,7 @@ def _cmd_response(args) -> int:
     if args.settle < 1 or args.sampled < 1:
         raise Fail(f"--settle and --sampled must be >= 1, got {args.settle}, {args.sampled}")
     methods = ("hb", "shooting", "integration") if args.method == "all" else (args.method,)
-    _bounded(args, system, num, methods, harmonics_cap(system))
+    _bounded(args, system, num, methods, harmonics_cap(system), abs(stop - start))
     if "integration" in methods and name != system.contract.forcing_frequency:
         raise Fail(
             f"--method integration sweeps the forcing frequency "
@@ -219,6 +241,7 @@ def _cmd_response(args) -> int:
             settle=args.settle,
             sampled=args.sampled,
             tail=args.tail,
+            step=args.step,
         )
     except (HarmonicBalanceError, ShootingError) as err:
         raise RunFailed(f"frequency-response: {err}") from None

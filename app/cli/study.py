@@ -16,7 +16,12 @@ def register(sub) -> None:
         description="Run the reference study's light- and heavy-load "
         "analyses; write figures, data and report.md.",
     )
-    rp.add_argument("--out", default="reproduce-out", metavar="DIR")
+    rp.add_argument(
+        "--out",
+        default="reproduce-out",
+        metavar="DIR",
+        help="folder for the report and its figures",
+    )
     rp.add_argument("--quick", action="store_true", help="coarse resolution (under a minute)")
     rp.add_argument("--serial", action="store_true", help="one process only")
     rp.add_argument("--quiet", action="store_true", help="no progress bar")

@@ -2,9 +2,13 @@
 
 * ``stiffness_harmonics`` -- how many harmonics of each mesh stiffness to keep (0 gives
   constant stiffness and no time-varying stiffness code);
-* ``backlash`` -- ``linear``, ``dead-zone``, ``smooth`` or ``polynomial`` (with
+* ``backlash`` -- ``linear``, ``dead-zone`` (the default: the exact dead zone, force zero
+  for ``|x| <= 1``), ``smooth`` or ``polynomial`` (the reference study's fit, with
   ``backlash_order``, ``backlash_range``, ``backlash_step``; or ``backlash_width``), built
-  through one registry of the backlash kinds (``derive/mesh/backlash.py``);
+  through one registry of the backlash kinds (``derive/mesh/backlash.py``).  The
+  polynomial is zero at ``x = 0, +-0.770`` and carries load inside the gap, so a
+  user's gears get the dead zone unless the scene states ``backlash = "polynomial"``
+  (the reference scenes do, as the study states its 7th-order fit);
 * ``transmission_error``, ``mesh_phase``, ``damping_coupling`` -- on or off;
 * ``degrees_of_freedom`` -- torsional, or beyond (``derive/equations/structure.py``).
 """
@@ -28,10 +32,10 @@ __all__ = ["BACKLASH_KEYS", "Features", "parse_features"]
 
 @dataclass(frozen=True)
 class Features:
-    """Which terms the model carries."""
+    """Which terms the model carries (the defaults are a scene's: the exact dead zone)."""
 
     stiffness_harmonics: int = 3
-    backlash: Backlash = field(default_factory=lambda: fit_dead_zone())
+    backlash: Backlash = field(default_factory=DeadZone)
     transmission_error: bool = True
     mesh_phase: bool = True
     damping_coupling: bool = True
@@ -92,7 +96,7 @@ def parse_features(t: Table | None) -> Features:
     if t is None:
         return Features()
     harmonics = t.integer("stiffness_harmonics", 3, low=0, high=64)
-    kind = t.string("backlash", "polynomial", choices=tuple(BACKLASH_MODELS))
+    kind = t.string("backlash", "dead-zone", choices=tuple(BACKLASH_MODELS))
     for other, (keys, _) in _BACKLASH_BUILDERS.items():
         for key in keys:
             if other != kind and key in t.data:

@@ -5,8 +5,9 @@ derivation emits only their terms:
 
 * ``stiffness_harmonics`` -- how many harmonics of each mesh stiffness to keep (0 gives
   constant stiffness and no time-varying stiffness code);
-* ``backlash`` -- ``linear``, ``dead-zone``, ``smooth`` or ``polynomial`` (with
-  ``backlash_order``, ``backlash_range``, ``backlash_step``; or ``backlash_width``);
+* ``backlash`` -- ``linear``, ``dead-zone`` (the default), ``smooth`` or ``polynomial``
+  (the reference study's fit, with ``backlash_order``, ``backlash_range``,
+  ``backlash_step``; or ``backlash_width``);
 * ``transmission_error``, ``mesh_phase``, ``damping_coupling`` -- on or off.
 
 ``[parameters]`` holds named numbers: ``omega`` (the non-dimensional excitation
@@ -22,8 +23,9 @@ numbers such as ``te_amplitude_um`` and the choices ``load_reading`` and
 ``damping_normalisation`` (``"mesh"`` or ``"modal"``, ``derive/equations/nondim.py``).
 
 A topology file may be derived on its own: it then stands for a default scene with every
-feature on, 3 harmonics, the reference study's backlash polynomial, and ``omega`` and the
-damping ratio from its ``[operating]`` table.
+feature on, 3 harmonics, the reference study's backlash polynomial (stated here, not a
+scene's default: the shipped topologies' generated models carry it), and ``omega`` and
+the damping ratio from its ``[operating]`` table.
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from ..mesh.backlash import fit_dead_zone
 from .features import BACKLASH_KEYS, Features, parse_features
 from .reader import InputError, Table, load_toml, nearest, parse_expression
 from .supports import load_topology_data
@@ -343,7 +346,7 @@ def load_target(path: Path | str, overrides: dict[str, float] | None = None) -> 
             topology.name,
             topology.description,
             topology,
-            Features(degrees_of_freedom=dofs),
+            Features(backlash=fit_dead_zone(), degrees_of_freedom=dofs),
             parameters,
             None,
             None,

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["METHODS", "Method", "get_method", "method_names"]
+__all__ = ["METHODS", "RENAMED", "Method", "get_method", "method_names"]
 
 
 @dataclass(frozen=True)
@@ -33,6 +33,9 @@ class Method:
         loop of ``solver/integrate/events.py``); the others rely on error control or a
         fine fixed step.
     description : str
+    engine_name : str
+        The name the back end knows it by (SciPy's ``solve_ivp(method=...)``), when it
+        differs from ``name``; empty: the same.
     """
 
     name: str
@@ -42,6 +45,12 @@ class Method:
     step_unit: int = 0
     locates_surfaces: bool = False
     description: str = ""
+    engine_name: str = ""
+
+    @property
+    def engine(self) -> str:
+        """The name the back end is given."""
+        return self.engine_name or self.name
 
     def __post_init__(self):
         if self.family not in ("scipy", "casadi", "native"):
@@ -62,7 +71,13 @@ _RECORDS = (
         description="SciPy Dormand-Prince 5(4): the reference study's method",
     ),
     Method(
-        "DOP853", "scipy", True, 8, locates_surfaces=True, description="SciPy Dormand-Prince 8(5,3)"
+        "scipy-dop853",
+        "scipy",
+        True,
+        8,
+        locates_surfaces=True,
+        description="SciPy Dormand-Prince 8(5,3)",
+        engine_name="DOP853",
     ),
     Method(
         "LSODA",
@@ -123,13 +138,23 @@ _RECORDS = (
 REGISTRY: dict[str, Method] = {m.name: m for m in _RECORDS}
 METHODS: tuple[str, ...] = tuple(REGISTRY)
 
+# Old names, refused with the new one: "DOP853" and the compiled "dop853" differed by case
+# only (issue 25).
+RENAMED: dict[str, str] = {
+    "DOP853": "method 'DOP853' is now 'scipy-dop853' (the SciPy integrator; 'dop853' is the "
+    "compiled one)",
+}
+
 
 def method_names(family: str | None = None) -> tuple[str, ...]:
     return tuple(m.name for m in _RECORDS if family is None or m.family == family)
 
 
 def get_method(name: str) -> Method:
-    """The record of ``name``; an unknown name fails listing the valid ones."""
+    """The record of ``name``; an unknown name fails listing the valid ones, and an old
+    name (:data:`RENAMED`) fails naming the new one."""
+    if isinstance(name, str) and name in RENAMED:
+        raise ValueError(RENAMED[name])
     try:
         return REGISTRY[name]
     except (KeyError, TypeError):

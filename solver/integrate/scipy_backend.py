@@ -1,4 +1,4 @@
-"""SciPy ``solve_ivp`` back end (RK45, DOP853, LSODA, Radau) on the generated NumPy code.
+"""SciPy ``solve_ivp`` back end (RK45, scipy-dop853, LSODA, Radau) on the generated NumPy code.
 
 Samples come from each method's own dense output; piecewise models run through the one
 event loop (``events.py``) that stops at every switching surface.
@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from .events import escape_event, integrate_located
+from .methods import get_method
 from .result import Request, Run
 
 __all__ = ["run"]
@@ -52,7 +53,7 @@ def run(system, req: Request) -> Run:
         req.x0,
         surfaces=surfaces,
         velocity=contract.velocity_of_state,
-        method=req.method,
+        method=get_method(req.method).engine,
         options=opts,
         extra=extra,
         on_segment=sample,

@@ -4,7 +4,7 @@ Methods are records of a validated registry (``methods.py``); each family has on
 end that takes a :class:`~.result.Request` and returns a :class:`~.result.Run`:
 
 * SciPy ``solve_ivp`` (``scipy_backend.py``): ``RK45`` (the reference study's
-  variable-step Runge-Kutta 4(5)), ``DOP853``, ``LSODA``, ``Radau``, on the generated NumPy
+  variable-step Runge-Kutta 4(5)), ``scipy-dop853``, ``LSODA``, ``Radau``, on the generated NumPy
   right-hand side (and its Jacobian for the implicit ones), stopping at every switching
   surface of a piecewise model (``events.py``) so that the method's order holds across
   the kinks;

@@ -15,6 +15,7 @@ import time
 import numpy as np
 
 from ..system import System
+from ._resample import on_grid
 from .frequency_result import Curve, FrequencyResponse
 
 __all__ = [
@@ -90,8 +91,8 @@ def _hb_factors(system, parameter, br, n, samples: int = 512) -> dict:
     return out
 
 
-def _hb_curve(system, parameter, start, stop, harmonics, n, ds) -> Curve:
-    from ..periodic.hb_continuation import continue_hb
+def _hb_curve(system, parameter, start, stop, harmonics, n, ds, grid) -> Curve:
+    from ..periodic.hb_continuation import HarmonicBalanceProblem, continue_hb
 
     span = abs(stop - start)
     br = continue_hb(
@@ -114,6 +115,9 @@ def _hb_curve(system, parameter, start, stop, harmonics, n, ds) -> Curve:
 
         screening = screen(system, br)
         br = screening.branch
+    br = on_grid(
+        HarmonicBalanceProblem(system, parameter, br.harmonic_balance, check=False), br, grid
+    )
     stats = {}
     prob = br.harmonic_balance
     for c in system.coordinates:
@@ -151,14 +155,16 @@ def _hb_curve(system, parameter, start, stop, harmonics, n, ds) -> Curve:
     )
 
 
-def _shooting_curve(system, parameter, start, stop, n, ds, guess) -> Curve:
+def _shooting_curve(system, parameter, start, stop, n, ds, guess, grid) -> Curve:
     from ..integrate import simulate
     from ..periodic import continue_orbit
+    from ..periodic.continuation import ShootingProblem
 
     started = time.perf_counter()
     br = continue_orbit(
         system, parameter, start, stop, guess, n=n, ds=ds, ds_max=2 * ds, max_points=20_000
     )
+    br = on_grid(ShootingProblem(system, parameter, n), br, grid)
     keys = ("mean", "amplitude", "rms", "max", "min", "dynamic_factor")
     stats = {c: {q: [] for q in keys} for c in system.coordinates}
     for v, x0 in zip(br.values, br.states, strict=True):
@@ -278,16 +284,23 @@ def frequency_response(
     sampled: int = 16,
     samples_per_period: int = 64,
     tail: float | None = None,
+    step: float | None = None,
 ) -> FrequencyResponse:
     """The periodic response over ``parameter`` from ``start`` to ``stop`` by each of
-    ``methods`` (``hb``, ``shooting``); ``points`` sets the resolution: the parameter
-    moves by at most the range over ``points`` per step (harmonic balance: about
-    ``points`` points where the curve runs straight, more where it turns; shooting: the
-    arclength step starts there and adapts up to twice that).  When the harmonic-balance
-    branch turns back and leaves the range at ``start``, a second one is continued from
-    ``stop`` (two curves of method ``hb``).  ``integration``: up and down stepped sweeps of
-    ``points`` frequencies, ``settle`` + ``sampled`` periods each (only over the forcing
-    frequency; see :func:`_integration_curves`).  ``tail``: harmonic balance raises H at
+    ``methods`` (``hb``, ``shooting``, ``integration``); ``points`` is the number of
+    solution points each curve returns: the values ``linspace(start, stop, points)``.
+    Harmonic balance and shooting continue the branch by pseudo-arclength (first step
+    ``step``, default the range over ``points - 1``; harmonic balance: the parameter moves
+    by at most that per step; shooting: the step adapts up to twice that), then solve it
+    again at the grid's values on each monotonic piece, keeping the turning points
+    (``_resample.py``): a branch without folds has ``points`` points; one that folds k
+    times has k + 1 monotonic pieces, each with the grid's values in its span, and its k
+    turning points; a branch that stops early (the parameter's valid range) covers the
+    grid up to there.  When the harmonic-balance branch turns back and leaves the range
+    at ``start``, a second one is continued from ``stop`` (two curves of method ``hb``).
+    ``integration``: up and down stepped sweeps of ``points`` frequencies each,
+    ``settle`` + ``sampled`` periods each (only over the forcing frequency; see
+    :func:`_integration_curves`).  ``tail``: harmonic balance raises H at
     the start (up to :func:`harmonics_cap`) until the top harmonics carry at most this
     share (``harmonic_balance``);
     the largest share along the branch is reported in the curve's details."""
@@ -296,7 +309,10 @@ def frequency_response(
         raise ValueError(f"unknown method(s) {unknown}; methods: {', '.join(METHODS)}")
     if points < 2:
         raise ValueError(f"points must be >= 2, got {points}")
-    ds = abs(stop - start) / points
+    if step is not None and not 0 < step <= abs(stop - start):
+        raise ValueError(f"step must be in (0, |stop - start|], got {step}")
+    ds = step or abs(stop - start) / (points - 1)
+    grid = np.linspace(start, stop, points)
     curves = []
     guess = None
     for m in methods:
@@ -312,12 +328,12 @@ def frequency_response(
                     max_harmonics=harmonics_cap(system),
                     stability=False,
                 ).harmonics
-            curve = _hb_curve(system, parameter, start, stop, harmonics, n, ds)
+            curve = _hb_curve(system, parameter, start, stop, harmonics, n, ds, grid)
             curves.append(curve)
             if curve.details["status"] not in ("complete", "boundary"):
                 # the branch turned back out of the range: the rest of the range from the
                 # other end (the solution a simulation settles on there)
-                curves.append(_hb_curve(system, parameter, stop, start, harmonics, n, ds))
+                curves.append(_hb_curve(system, parameter, stop, start, harmonics, n, ds, grid))
         elif m == "integration":
             curves += _integration_curves(
                 system, parameter, start, stop, points, settle, sampled, samples_per_period
@@ -333,5 +349,5 @@ def frequency_response(
                     stability=False,
                 )
                 guess = first.state(0.0)
-            curves.append(_shooting_curve(system, parameter, start, stop, n, ds, guess))
+            curves.append(_shooting_curve(system, parameter, start, stop, n, ds, guess, grid))
     return FrequencyResponse(system, parameter, float(start), float(stop), tuple(curves))

@@ -134,7 +134,8 @@ def _cli_map(tmp_path, cc: str):
     grid = ["--x=lambda=0:1:3", "--y=f1=0.1:0.2:2", "--initial-states=2"]
     argv = ["map", "reference-light", *grid, *SMALL, f"--out={tmp_path / 'map'}"]
     done = subprocess.run([*GEARSYM, *argv], capture_output=True, text=True, env=env)
-    return done.returncode, done.stderr.splitlines()
+    notes = "gearsym: note:"  # the note on the polynomial backlash (issue 25) aside
+    return done.returncode, [ln for ln in done.stderr.splitlines() if not ln.startswith(notes)]
 
 
 @pytest.mark.slow  # some 40 s: the fallback steps every point in Python

@@ -30,7 +30,7 @@ def closed_form_steady_state(system, tau):
     return np.vstack([u, du])
 
 
-@pytest.mark.parametrize("method", ["DOP853", "cvodes"])
+@pytest.mark.parametrize("method", ["scipy-dop853", "cvodes"])
 def test_linear_limit_matches_the_closed_form_steady_state(linear_system, method):
     tr = simulate(
         linear_system,
@@ -110,7 +110,7 @@ def closed_form_steady_state_from(system, tr):
 
 def test_scipy_and_casadi_agree_on_a_periodic_poincare_point():
     system = System.load("reference_light", **{"lambda": 0.8})
-    a = simulate(system, method="DOP853", rtol=1e-10, atol=1e-12, transient=150, periods=4)
+    a = simulate(system, method="scipy-dop853", rtol=1e-10, atol=1e-12, transient=150, periods=4)
     b = simulate(system, method="cvodes", rtol=1e-10, atol=1e-12, transient=150, periods=4)
     assert np.max(np.abs(a.poincare[:, -1] - b.poincare[:, -1])) < 1e-6
 
@@ -147,7 +147,7 @@ def test_divergence_is_reported_not_hidden(duffing):
 
 
 def test_unknown_method_lists_the_valid_ones(duffing):
-    with pytest.raises(ValueError, match="methods: RK45, DOP853"):
+    with pytest.raises(ValueError, match="methods: RK45, scipy-dop853"):
         simulate(duffing, method="rk45")
 
 

@@ -24,7 +24,13 @@ def fast():
 @pytest.fixture(scope="module")
 def reference_exit(fast):
     run = simulate(
-        fast, method="DOP853", rtol=1e-12, atol=1e-14, transient=10, periods=20, on_invalid="error"
+        fast,
+        method="scipy-dop853",
+        rtol=1e-12,
+        atol=1e-14,
+        transient=10,
+        periods=20,
+        on_invalid="error",
     )
     assert run.status == "invalid"
     return run.left_valid_range
@@ -51,7 +57,7 @@ def test_the_lockstep_engine_locates_each_points_exit(fast, method):
     for system, run in zip(systems, runs, strict=True):
         ref = simulate(
             system,
-            method="DOP853",
+            method="scipy-dop853",
             rtol=1e-12,
             atol=1e-14,
             transient=10,
