@@ -21,10 +21,10 @@ def fast():
     return System.load("reference_light", omega=50.0)
 
 
-@pytest.fixture(scope="module")
-def reference_exit(fast):
-    run = simulate(
-        fast,
+def _scipy_reference(system):
+    """SciPy's DOP853 at tight tolerances with its located event: the reference exit."""
+    return simulate(
+        system,
         method="scipy-dop853",
         rtol=1e-12,
         atol=1e-14,
@@ -32,6 +32,11 @@ def reference_exit(fast):
         periods=20,
         on_invalid="error",
     )
+
+
+@pytest.fixture(scope="module")
+def reference_exit(fast):
+    run = _scipy_reference(fast)
     assert run.status == "invalid"
     return run.left_valid_range
 
@@ -55,15 +60,7 @@ def test_the_lockstep_engine_locates_each_points_exit(fast, method):
     systems = [fast.with_values(**{"lambda": lam}) for lam in (0.1, 0.5, 1.0)]
     runs = simulate_many(systems, method=method, transient=10, periods=20, on_invalid="error")
     for system, run in zip(systems, runs, strict=True):
-        ref = simulate(
-            system,
-            method="scipy-dop853",
-            rtol=1e-12,
-            atol=1e-14,
-            transient=10,
-            periods=20,
-            on_invalid="error",
-        )
+        ref = _scipy_reference(system)
         assert run.status == ref.status
         if ref.left_valid_range is None:
             assert run.left_valid_range is None
