@@ -10,6 +10,7 @@ from pathlib import Path
 
 import gearsym
 import numpy as np
+from gearsym.solver import plots
 
 
 def main(out: Path) -> None:
@@ -21,8 +22,8 @@ def main(out: Path) -> None:
             f"lambda = {point.value:.2f}: u {point.motion('u')}, v {point.motion('v')}, "
             f"min(v) = {point.min('v'):.3f}"
         )
-    figure = gearsym.plot.save(
-        gearsym.plot.bifurcation(result, title="lambda sweep"), out / "bifurcation.png"
+    figure = plots.bifurcation_diagram(
+        [result], list(system.coordinates), out / "bifurcation.png", title="lambda sweep"
     )
     print("wrote", figure, result.save(out / "sweep.json"), result.save(out / "sweep.csv"))
 
