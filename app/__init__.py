@@ -10,6 +10,13 @@ The public API (see ``docs/api.md``)::
     branch = gearsym.continue_orbit(system, "lambda", 0.8, 1.0, orbit.x0)
     bif = gearsym.sweep(system, "lambda", [0.1, 0.5, 0.9])           # bifurcation sweep
     modal = gearsym.modes(gearsym.load("diso-bearings-light"))       # natural frequencies
+    fig = gearsym.plot.bifurcation(bif)                              # a matplotlib Figure
+
+Every command of the CLI has its function here: ``simulate``/``analyse`` (simulate),
+``sweep``, ``regime_map`` (map), ``shoot``, ``continue_orbit`` (continue),
+``frequency_response`` (with ``harmonic_balance`` and ``continue_hb``), ``modes``,
+``fit_dead_zone`` (backlash), ``derive_model`` (derive), ``reproduce``; ``gearsym.plot``
+draws their results.
 
 Rooms: ``gearsym.derive`` (SymPy, SI), ``gearsym.solver`` (non-dimensional numerics),
 ``gearsym.generated`` (emitted code), and this application layer: the scene resolver
@@ -32,6 +39,13 @@ _EXPORTS = {
     "continue_hb": "gearsym.solver.periodic.hb_continuation",
     "frequency_response": "gearsym.solver.sweep.frequency",
     "modes": "gearsym.solver.analysis.modes",
+    "Modes": "gearsym.solver.analysis.modes",
+    "FrequencyResponse": "gearsym.solver.sweep.frequency_result",
+    "regime_map": "gearsym.solver.sweep.atlas",
+    "RegimeMap": "gearsym.solver.sweep.maps_result",
+    "fit_dead_zone": "gearsym.derive",
+    "reproduce": "gearsym.studies.reproduce",
+    "plot": ("gearsym.plot", None),  # the module itself: the figures
     **{
         name: "gearsym.solver"
         for name in (
@@ -62,7 +76,8 @@ def __getattr__(name: str):
     if where is None:
         raise AttributeError(f"module 'gearsym' has no attribute {name!r}")
     module, attr = where if isinstance(where, tuple) else (where, name)
-    value = getattr(_importlib.import_module(module), attr)
+    value = _importlib.import_module(module)
+    value = value if attr is None else getattr(value, attr)
     globals()[name] = value
     return value
 
@@ -78,9 +93,12 @@ __all__ = [
     "Branch",
     "Contract",
     "FlowMap",
+    "FrequencyResponse",
     "InputError",
+    "Modes",
     "Orbit",
     "PointResult",
+    "RegimeMap",
     "ShootingError",
     "SimulationError",
     "StroboscopicMap",
@@ -92,11 +110,15 @@ __all__ = [
     "continue_hb",
     "continue_orbit",
     "derive_model",
+    "fit_dead_zone",
     "frequency_response",
     "harmonic_balance",
     "load",
     "load_target",
     "modes",
+    "plot",
+    "regime_map",
+    "reproduce",
     "save",
     "shoot",
     "simulate",

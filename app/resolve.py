@@ -37,6 +37,7 @@ __all__ = [
     "load_cached",
     "model_cache",
     "module_for",
+    "needs_derivation",
     "split_open_values",
     "store_cached",
 ]
@@ -255,9 +256,11 @@ def _remember(path, digest: str) -> None:
 
 
 def load(target: str | Path | ModuleType, **values) -> System:
-    """The System of a scene, topology or generated module, with ``values`` (scene or
-    model parameters by name, or open values such as ``te_amplitude_um``, which derive a
-    variant of the model once into the cache) set.
+    """The System of a scene, topology or generated module, with ``values`` set: scene or
+    model parameters by name, physical quantities (the module's ``PHYSICAL``: speed_rpm,
+    torque_Nm_<gear>, half_backlash_um_<mesh>, ...; no new derivation), or other open
+    values (``load_reading``, or any quantity a model does not carry as a parameter), which
+    derive a variant of the model once into the cache.
 
     ``target``: a built-in name (``"reference-light"`` or ``"reference_light"``), a path to
     a scene or topology TOML file, a generated ``.py`` file, or a module.
@@ -266,15 +269,30 @@ def load(target: str | Path | ModuleType, **values) -> System:
         return System.load(target, **values)
     if Path(str(target)).suffix == ".py":
         return System.load(Path(target), **values)
-    opened, rest = split_open_values(values)
-    return System.load(module_for(target, opened), **rest)
+    module = module_for(target)
+    opened, rest = split_open_values(values, module)
+    return System.load(module_for(target, opened) if opened else module, **rest)
 
 
-def split_open_values(values: dict) -> tuple[dict, dict]:
-    """(open values, the rest) of named values: the first need a derivation."""
+def split_open_values(values: dict, module: ModuleType | None = None) -> tuple[dict, dict]:
+    """(open values, the rest) of named values: the first need a derivation.  A name the
+    ``module`` carries as a physical quantity (``PHYSICAL`` or ``PHYSICAL_ALIASES``) is a
+    parameter, not an open value."""
     if not values:
         return {}, {}
-    from gearsym.derive.input.open_values import is_open_value
-
-    opened = {k: v for k, v in values.items() if is_open_value(k)}
+    opened = {k: v for k, v in values.items() if needs_derivation(k, module)}
     return opened, {k: v for k, v in values.items() if k not in opened}
+
+
+def needs_derivation(name: str, module: ModuleType | None = None) -> bool:
+    """Whether setting ``name`` derives a new model: an open value
+    (``derive/input/open_values.py``) that ``module`` does not carry as a physical
+    quantity of its generated ``parameters()``."""
+    physical = set(getattr(module, "PHYSICAL", {})) | set(getattr(module, "PHYSICAL_ALIASES", {}))
+    if name in physical:
+        return False
+    try:
+        from gearsym.derive.input.open_values import is_open_value
+    except ImportError:  # a derive layer without open values
+        return False
+    return is_open_value(name)

@@ -32,6 +32,7 @@ from .equations.torsion import derive_equations
 from .input.reader import InputError, expression_source
 from .input.scene import Features, Scene
 from .parameters import Parameter, model_parameters
+from .physical import PhysicalLayer, physical_layer
 
 __all__ = ["CONTRACT_FORMAT", "Model", "Parameter", "derive_model", "operation_count"]
 
@@ -74,6 +75,7 @@ class Model:
     scene_parameters: dict[str, float]
     parameter_sources: dict[str, str]  # model parameter -> Python source in s['<scene name>']
     inputs_hash: str
+    physical: PhysicalLayer | None = None  # the quantities in SI-based units (physical.py)
 
     @property
     def features(self) -> Features:
@@ -243,6 +245,8 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
         unit = nd.value(nd.xi[i, j].subs(nd.zeta, 1))
         sources[f"xi_{disp[i]}_{disp[j]}"] = f"{float(f'{unit:.15g}')!r} * s['damping_ratio']"
 
+    sources = {k: v for k, v in sources.items() if k in names}
+    physical = physical_layer(scene, nd, pars, tuple(names), sources)
     om = nd.value(nd.omega_n_expr)
     scales = {
         "omega_n_rad_per_s": om,
@@ -279,8 +283,9 @@ def derive_model(scene: Scene, name: str | None = None) -> Model:
         scales=scales,
         frequency_ratios=freq,
         scene_parameters=scene_parameters,
-        parameter_sources={k: v for k, v in sources.items() if k in names},
+        parameter_sources=sources,
         inputs_hash=inputs_hash(scene),
+        physical=physical,
     )
 
 

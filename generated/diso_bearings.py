@@ -256,6 +256,33 @@ FEATURES = {'stiffness_harmonics': 3, 'backlash': 'polynomial', 'transmission_er
 SCENE_PARAMETERS = {'damping_ratio': 0.03, 'omega': 0.709571332557897}
 # (low, high, low excluded): derive/input/scene.py PARAMETER_LIMITS
 SCENE_PARAMETER_LIMITS = {'omega': (0.001, 1000.0, False), 'damping_ratio': (0.0, 1.0, False)}
+# Physical quantities a user may set by name (default = the scene's value), and the
+# model parameters they give through the audit page's closed forms (derive/physical.py).
+PHYSICAL = {
+    'speed_rpm': (1500.0, 'rpm', "speed of gear 'p'"),
+    'te_amplitude_um_pg': (5.0, 'um', "first transmission-error harmonic of mesh 'pg'"),
+    'te_amplitude_um_qg': (5.0, 'um', "first transmission-error harmonic of mesh 'qg'"),
+    'te_phase_deg_pg': (0.0, 'deg', "phase of the first transmission-error harmonic of mesh 'pg'"),
+    'te_phase_deg_qg': (0.0, 'deg', "phase of the first transmission-error harmonic of mesh 'qg'"),
+    'stiffness_harmonic_scale_pg': (1.0, '1', "factor on the stiffness harmonics of mesh 'pg' (the mean kept)"),
+    'stiffness_harmonic_scale_qg': (1.0, '1', "factor on the stiffness harmonics of mesh 'qg' (the mean kept)"),
+    'layout_angle_deg_qg': (120.0, 'deg', "angle of mesh 'qg' from the reference mesh round the shared gear"),
+}
+PHYSICAL_LIMITS = {
+    'speed_rpm': (0.0, 1000000.0, True),
+    'te_amplitude_um_pg': (0.0, 10000.0, False),
+    'te_amplitude_um_qg': (0.0, 10000.0, False),
+    'te_phase_deg_pg': (-360.0, 360.0, False),
+    'te_phase_deg_qg': (-360.0, 360.0, False),
+    'stiffness_harmonic_scale_pg': (0.0, 1000.0, False),
+    'stiffness_harmonic_scale_qg': (0.0, 1000.0, False),
+    'layout_angle_deg_qg': (-360.0, 360.0, False),
+}
+PHYSICAL_ALIASES = {'stiffness_harmonic_scale': ('stiffness_harmonic_scale_pg', 'stiffness_harmonic_scale_qg'), 'te_amplitude_um': ('te_amplitude_um_pg', 'te_amplitude_um_qg'), 'te_phase_deg': ('te_phase_deg_pg', 'te_phase_deg_qg'), 'layout_angle_deg': ('layout_angle_deg_qg',)}
+# Setting both a quantity and one of these is refused: they state the same thing.
+PHYSICAL_REPLACES = {'speed_rpm': ('omega',), 'te_amplitude_um_pg': ('E_u_1',), 'te_phase_deg_pg': ('psi_u_1',), 'te_amplitude_um_qg': ('E_v_1',), 'te_phase_deg_qg': ('psi_v_1',), 'layout_angle_deg_qg': ('phi_v',)}
+OMEGA_FROM_SPEED = True  # the scene states a speed, not omega
+LOADS_FROM_TORQUES = True  # the scene states torques
 # mesh coordinate: ((cos index, sin index, harmonic), ...) of k_hat = 1 + sum ...
 STIFFNESS_TERMS = {'u': ((77, 78, 1), (79, 80, 2), (81, 82, 3)), 'v': ((83, 84, 1), (85, 86, 2), (87, 88, 3))}
 OPERATIONS = {'rhs': 232, 'rhs_and_jacobian': 399}
@@ -1410,14 +1437,17 @@ def parameters(**values):
     """Parameter vector p from named values; the rest keep the scene's values.
 
     Names may be scene parameters (SCENE_PARAMETERS: what the scene's [parameters]
-    table sets, such as a load ratio) or model parameters (PARAMETERS); a model
-    parameter given by name overrides what the scene parameters imply.
+    table sets, such as a load ratio), physical quantities (PHYSICAL, in rpm, N m,
+    um, kg m^2, or their PHYSICAL_ALIASES) or model parameters (PARAMETERS); a model
+    parameter given by name overrides what the others imply.
     """
-    unknown = sorted(set(values) - set(SCENE_PARAMETERS) - set(PARAMETERS))
+    unknown = sorted(set(values) - set(SCENE_PARAMETERS) - set(PARAMETERS)
+                     - set(PHYSICAL) - set(PHYSICAL_ALIASES))
     if unknown:
         raise KeyError(f'unknown parameter(s) {unknown}; scene parameters: '
-                       f'{sorted(SCENE_PARAMETERS)}; model parameters: '
-                       f'{list(PARAMETERS)}')
+                       f'{sorted(SCENE_PARAMETERS)}; physical: '
+                       f'{sorted(PHYSICAL) + sorted(PHYSICAL_ALIASES)}; model '
+                       f'parameters: {list(PARAMETERS)}')
     s = dict(SCENE_PARAMETERS)
     s.update((k, float(v)) for k, v in values.items() if k in SCENE_PARAMETERS)
     for k, v in s.items():
@@ -1447,6 +1477,9 @@ def parameters(**values):
     p[35] = -0.0259131277866986 * s['damping_ratio']  # xi_yg_v
     p[37] = -0.00557169911284036 * s['damping_ratio']  # xi_zg_u
     p[38] = -0.00557169911284036 * s['damping_ratio']  # xi_zg_v
+    q, given = _physical(values)
+    if q is not None:
+        _physical_parameters(p, q, s, given)
     for k, v in values.items():
         if k in PARAMETERS and k not in SCENE_PARAMETERS:
             p[PARAMETERS.index(k)] = float(v)
@@ -1475,6 +1508,82 @@ def _check_stiffness(p):
                 + ', '.join(PARAMETERS[i][3:] for i, _, _ in terms)
                 + '): a negative stiffness is not physical; use smaller harmonics')
     _STIFFNESS_CHECKED.add(key)
+
+
+def _physical(values):
+    """The physical quantities in effect (PHYSICAL order) and the names given, or
+    (None, set()) when none is given; aliases apply first, a name given beside its
+    alias wins; a quantity given beside what it replaces is refused."""
+    given = {}
+    for k, v in values.items():
+        for name in PHYSICAL_ALIASES.get(k, ()):
+            given.setdefault(name, (k, v))
+    for k, v in values.items():
+        if k in PHYSICAL:
+            given[k] = (k, v)
+    if not given:
+        return None, set()
+    for name, (key, _) in given.items():
+        for other in PHYSICAL_REPLACES.get(name, ()):
+            if other in values:
+                raise ValueError(f'{key} and {other} both set: they state the same '
+                                 f'quantity, one physically, one not; set one of them')
+    q = [v[0] for v in PHYSICAL.values()]
+    names = list(PHYSICAL)
+    for name, (key, v) in given.items():
+        v = float(v)
+        low, high, low_open = PHYSICAL_LIMITS[name]
+        if not np.isfinite(v) or v < low or (low_open and v == low) or (
+                high is not None and v > high):
+            rule = (f'in ({low:g}, {high:g}]' if low_open else f'in [{low:g}, {high:g}]')
+            raise ValueError(f'{key} must be {rule} {PHYSICAL[name][1]}, got {v:g}')
+        q[names.index(name)] = v
+    return q, set(given)
+
+
+def _physical_parameters(p, q, s, given):
+    """The model parameters from the physical quantities q (closed forms)."""
+    zeta = s['damping_ratio']
+    p[90] = 0.02*q[1]  # E_u_1
+    p[92] = 0.02*q[2]  # E_v_1
+    p[91] = 0.017453292519943295*q[3]  # psi_u_1
+    p[93] = 0.017453292519943295*q[4]  # psi_v_1
+    p[77] = -0.013662261851689467*q[5]  # kc_u_1
+    p[79] = -0.029989318359188107*q[5]  # kc_u_2
+    p[81] = 0.0010927109178232584*q[5]  # kc_u_3
+    p[78] = -0.08477387982709338*q[5]  # ks_u_1
+    p[80] = 0.009254583362040608*q[5]  # ks_u_2
+    p[82] = 0.0023191091869971658*q[5]  # ks_u_3
+    p[83] = -0.013662261851689467*q[6]  # kc_v_1
+    p[85] = -0.029989318359188107*q[6]  # kc_v_2
+    p[87] = 0.0010927109178232584*q[6]  # kc_v_3
+    p[84] = -0.08477387982709338*q[6]  # ks_v_1
+    p[86] = 0.009254583362040608*q[6]  # ks_v_2
+    p[88] = 0.0023191091869971658*q[6]  # ks_v_3
+    _z = 100.0 * q[7] / 360.0  # teeth of the shared gear spanned
+    p[89] = 2.0 * np.pi * (_z - np.floor(_z))  # phi_v
+    if OMEGA_FROM_SPEED or 'speed_rpm' in given:
+        p[0] = 0.00047304755503859764*q[0]  # omega
+
+
+def scales(**values):
+    """Scales back to physical units with these values: omega_n (rad/s), each mesh
+    coordinate's half backlash (m) and mean stiffness (N/m), and the speed in effect
+    (rpm of the operating gear, from omega)."""
+    q, _ = _physical(values)
+    q = q if q is not None else [v[0] for v in PHYSICAL.values()]
+    out = {
+        'omega_n_rad_per_s': float(11068.628724982556),
+        'half_backlash_m_u': float(4.9999999999999996e-05),
+        'mean_stiffness_N_per_m_u': float(881730641.0),
+        'half_backlash_m_v': float(4.9999999999999996e-05),
+        'mean_stiffness_N_per_m_v': float(881730641.0),
+    }
+    omega = parameters(**values)[0]
+    out['mesh_frequency_hz'] = float(omega * out['omega_n_rad_per_s'] / (2.0 * np.pi))
+    out['speed_rpm'] = float(omega * out['omega_n_rad_per_s'] / 5.235987755982989)
+    out['speed_gear'] = 'p'
+    return out
 
 
 def jacobian(tau, x, p):

@@ -106,6 +106,53 @@ FEATURES = {'stiffness_harmonics': 3, 'backlash': 'polynomial', 'transmission_er
 SCENE_PARAMETERS = {'omega': 0.5, 'damping_ratio': 0.03, 'f1': 0.5, 'lambda': 0.1}
 # (low, high, low excluded): derive/input/scene.py PARAMETER_LIMITS
 SCENE_PARAMETER_LIMITS = {'omega': (0.001, 1000.0, False), 'damping_ratio': (0.0, 1.0, False)}
+# Physical quantities a user may set by name (default = the scene's value), and the
+# model parameters they give through the audit page's closed forms (derive/physical.py).
+PHYSICAL = {
+    'speed_rpm': (1056.97618489795, 'rpm', "speed of gear 'p'"),
+    'torque_Nm_p': (2067.71734679524, 'N m', "external torque on gear 'p'"),
+    'attached_inertia_kg_m2_p': (0.0, 'kg m^2', "inertia attached to gear 'p'"),
+    'torque_Nm_q': (159.549649355867, 'N m', "external torque on gear 'q'"),
+    'attached_inertia_kg_m2_q': (0.0, 'kg m^2', "inertia attached to gear 'q'"),
+    'torque_Nm_g': (-4454.53399230222, 'N m', "external torque on gear 'g'"),
+    'attached_inertia_kg_m2_g': (10.0, 'kg m^2', "inertia attached to gear 'g'"),
+    'half_backlash_um_pg': (50.0, 'um', "half backlash of mesh 'pg'"),
+    'stiffness_scale_pg': (1.0, '1', "factor on the stiffness of mesh 'pg' (mean and harmonics)"),
+    'half_backlash_um_qg': (50.0, 'um', "half backlash of mesh 'qg'"),
+    'stiffness_scale_qg': (1.0, '1', "factor on the stiffness of mesh 'qg' (mean and harmonics)"),
+    'te_amplitude_um_pg': (5.0, 'um', "first transmission-error harmonic of mesh 'pg'"),
+    'te_amplitude_um_qg': (5.0, 'um', "first transmission-error harmonic of mesh 'qg'"),
+    'te_phase_deg_pg': (0.0, 'deg', "phase of the first transmission-error harmonic of mesh 'pg'"),
+    'te_phase_deg_qg': (0.0, 'deg', "phase of the first transmission-error harmonic of mesh 'qg'"),
+    'stiffness_harmonic_scale_pg': (1.0, '1', "factor on the stiffness harmonics of mesh 'pg' (the mean kept)"),
+    'stiffness_harmonic_scale_qg': (1.0, '1', "factor on the stiffness harmonics of mesh 'qg' (the mean kept)"),
+    'layout_angle_deg_qg': (120.0, 'deg', "angle of mesh 'qg' from the reference mesh round the shared gear"),
+}
+PHYSICAL_LIMITS = {
+    'speed_rpm': (0.0, 1000000.0, True),
+    'torque_Nm_p': (-1000000000.0, 1000000000.0, False),
+    'attached_inertia_kg_m2_p': (0.0, 1000000000.0, False),
+    'torque_Nm_q': (-1000000000.0, 1000000000.0, False),
+    'attached_inertia_kg_m2_q': (0.0, 1000000000.0, False),
+    'torque_Nm_g': (-1000000000.0, 1000000000.0, False),
+    'attached_inertia_kg_m2_g': (0.0, 1000000000.0, False),
+    'half_backlash_um_pg': (0.0, 100000.0, True),
+    'stiffness_scale_pg': (0.0, 1000.0, True),
+    'half_backlash_um_qg': (0.0, 100000.0, True),
+    'stiffness_scale_qg': (0.0, 1000.0, True),
+    'te_amplitude_um_pg': (0.0, 10000.0, False),
+    'te_amplitude_um_qg': (0.0, 10000.0, False),
+    'te_phase_deg_pg': (-360.0, 360.0, False),
+    'te_phase_deg_qg': (-360.0, 360.0, False),
+    'stiffness_harmonic_scale_pg': (0.0, 1000.0, False),
+    'stiffness_harmonic_scale_qg': (0.0, 1000.0, False),
+    'layout_angle_deg_qg': (-360.0, 360.0, False),
+}
+PHYSICAL_ALIASES = {'half_backlash_um': ('half_backlash_um_pg', 'half_backlash_um_qg'), 'stiffness_scale': ('stiffness_scale_pg', 'stiffness_scale_qg'), 'stiffness_harmonic_scale': ('stiffness_harmonic_scale_pg', 'stiffness_harmonic_scale_qg'), 'te_amplitude_um': ('te_amplitude_um_pg', 'te_amplitude_um_qg'), 'te_phase_deg': ('te_phase_deg_pg', 'te_phase_deg_qg'), 'layout_angle_deg': ('layout_angle_deg_qg',), 'flywheel_inertia_kg_m2': ('attached_inertia_kg_m2_g',)}
+# Setting both a quantity and one of these is refused: they state the same thing.
+PHYSICAL_REPLACES = {'speed_rpm': ('omega',), 'torque_Nm_p': ('f1', 'f_u', 'f_v', 'lambda'), 'torque_Nm_q': ('f1', 'f_u', 'f_v', 'lambda'), 'torque_Nm_g': ('f1', 'f_u', 'f_v', 'lambda'), 'te_amplitude_um_pg': ('E_u_1',), 'te_phase_deg_pg': ('psi_u_1',), 'te_amplitude_um_qg': ('E_v_1',), 'te_phase_deg_qg': ('psi_v_1',), 'layout_angle_deg_qg': ('phi_v',)}
+OMEGA_FROM_SPEED = False  # the scene states a speed, not omega
+LOADS_FROM_TORQUES = False  # the scene states torques
 # mesh coordinate: ((cos index, sin index, harmonic), ...) of k_hat = 1 + sum ...
 STIFFNESS_TERMS = {'u': ((11, 12, 1), (13, 14, 2), (15, 16, 3)), 'v': ((17, 18, 1), (19, 20, 2), (21, 22, 3))}
 OPERATIONS = {'rhs': 91, 'rhs_and_jacobian': 132}
@@ -591,14 +638,17 @@ def parameters(**values):
     """Parameter vector p from named values; the rest keep the scene's values.
 
     Names may be scene parameters (SCENE_PARAMETERS: what the scene's [parameters]
-    table sets, such as a load ratio) or model parameters (PARAMETERS); a model
-    parameter given by name overrides what the scene parameters imply.
+    table sets, such as a load ratio), physical quantities (PHYSICAL, in rpm, N m,
+    um, kg m^2, or their PHYSICAL_ALIASES) or model parameters (PARAMETERS); a model
+    parameter given by name overrides what the others imply.
     """
-    unknown = sorted(set(values) - set(SCENE_PARAMETERS) - set(PARAMETERS))
+    unknown = sorted(set(values) - set(SCENE_PARAMETERS) - set(PARAMETERS)
+                     - set(PHYSICAL) - set(PHYSICAL_ALIASES))
     if unknown:
         raise KeyError(f'unknown parameter(s) {unknown}; scene parameters: '
-                       f'{sorted(SCENE_PARAMETERS)}; model parameters: '
-                       f'{list(PARAMETERS)}')
+                       f'{sorted(SCENE_PARAMETERS)}; physical: '
+                       f'{sorted(PHYSICAL) + sorted(PHYSICAL_ALIASES)}; model '
+                       f'parameters: {list(PARAMETERS)}')
     s = dict(SCENE_PARAMETERS)
     s.update((k, float(v)) for k, v in values.items() if k in SCENE_PARAMETERS)
     for k, v in s.items():
@@ -618,6 +668,9 @@ def parameters(**values):
     p[4] = -0.0230153772879178 * s['damping_ratio']  # xi_u_v
     p[5] = -0.0230153772879178 * s['damping_ratio']  # xi_v_u
     p[6] = 1.0 * s['damping_ratio']  # xi_v_v
+    q, given = _physical(values)
+    if q is not None:
+        _physical_parameters(p, q, s, given)
     for k, v in values.items():
         if k in PARAMETERS and k not in SCENE_PARAMETERS:
             p[PARAMETERS.index(k)] = float(v)
@@ -646,6 +699,113 @@ def _check_stiffness(p):
                 + ', '.join(PARAMETERS[i][3:] for i, _, _ in terms)
                 + '): a negative stiffness is not physical; use smaller harmonics')
     _STIFFNESS_CHECKED.add(key)
+
+
+def _physical(values):
+    """The physical quantities in effect (PHYSICAL order) and the names given, or
+    (None, set()) when none is given; aliases apply first, a name given beside its
+    alias wins; a quantity given beside what it replaces is refused."""
+    given = {}
+    for k, v in values.items():
+        for name in PHYSICAL_ALIASES.get(k, ()):
+            given.setdefault(name, (k, v))
+    for k, v in values.items():
+        if k in PHYSICAL:
+            given[k] = (k, v)
+    if not given:
+        return None, set()
+    for name, (key, _) in given.items():
+        for other in PHYSICAL_REPLACES.get(name, ()):
+            if other in values:
+                raise ValueError(f'{key} and {other} both set: they state the same '
+                                 f'quantity, one physically, one not; set one of them')
+    q = [v[0] for v in PHYSICAL.values()]
+    names = list(PHYSICAL)
+    for name, (key, v) in given.items():
+        v = float(v)
+        low, high, low_open = PHYSICAL_LIMITS[name]
+        if not np.isfinite(v) or v < low or (low_open and v == low) or (
+                high is not None and v > high):
+            rule = (f'in ({low:g}, {high:g}]' if low_open else f'in [{low:g}, {high:g}]')
+            raise ValueError(f'{key} must be {rule} {PHYSICAL[name][1]}, got {v:g}')
+        q[names.index(name)] = v
+    return q, set(given)
+
+
+def _physical_parameters(p, q, s, given):
+    """The model parameters from the physical quantities q (closed forms)."""
+    zeta = s['damping_ratio']
+    _w0 = 0.009071770608818775*q[6] + 0.011839492738755647
+    _w1 = 0.0362870824352751*q[2] + _w0
+    _w2 = q[2] + 0.06504773782252429
+    _w3 = _w2/_w1
+    _w4 = 0.0362870824352751*_w3
+    _w5 = q[10]/q[8]
+    _w6 = 1/q[7]
+    _w7 = q[9]*_w6
+    _w8 = 1/q[9]
+    _w9 = q[7]*_w4*_w8
+    _w10 = q[4] + 0.06504773782252429
+    _w11 = 0.0362870824352751*q[4] + _w0
+    _w12 = np.sqrt(_w10)
+    _w13 = np.sqrt(_w11)
+    _w14 = zeta*np.sqrt(q[10])*np.sqrt(_w2)/(np.sqrt(q[8])*np.sqrt(_w1))
+    p[7] = 1  # kappa_u_u
+    p[8] = -_w4*_w5*_w7  # kappa_u_v
+    p[9] = -_w9  # kappa_v_u
+    p[10] = 1.0*_w11*_w3*_w5/_w10  # kappa_v_v
+    p[3] = zeta  # xi_u_u
+    p[4] = -0.0362870824352751*_w12*_w14*_w7/_w13  # xi_u_v
+    p[5] = -zeta*_w9  # xi_v_u
+    p[6] = 1.0*_w13*_w14/_w12  # xi_v_v
+    p[24] = q[11]*_w6  # E_u_1
+    p[26] = q[12]*_w8  # E_v_1
+    p[25] = 0.017453292519943295*q[13]  # psi_u_1
+    p[27] = 0.017453292519943295*q[14]  # psi_v_1
+    p[11] = -0.013662261851689467*q[15]  # kc_u_1
+    p[13] = -0.029989318359188107*q[15]  # kc_u_2
+    p[15] = 0.0010927109178232584*q[15]  # kc_u_3
+    p[12] = -0.08477387982709338*q[15]  # ks_u_1
+    p[14] = 0.009254583362040608*q[15]  # ks_u_2
+    p[16] = 0.0023191091869971658*q[15]  # ks_u_3
+    p[17] = -0.013662261851689467*q[16]  # kc_v_1
+    p[19] = -0.029989318359188107*q[16]  # kc_v_2
+    p[21] = 0.0010927109178232584*q[16]  # kc_v_3
+    p[18] = -0.08477387982709338*q[16]  # ks_v_1
+    p[20] = 0.009254583362040608*q[16]  # ks_v_2
+    p[22] = 0.0023191091869971658*q[16]  # ks_v_3
+    _z = 100.0 * q[17] / 360.0  # teeth of the shared gear spanned
+    p[23] = 2.0 * np.pi * (_z - np.floor(_z))  # phi_v
+    if OMEGA_FROM_SPEED or 'speed_rpm' in given:
+        p[0] = 0.00017633180604132318*q[0]/(np.sqrt(q[8])*np.sqrt(0.03532088886237956/(q[6] + 1.0449007721763601) + 0.00883022221559489/(q[2] + 0.06504773782252429)))  # omega
+    if LOADS_FROM_TORQUES or any(n.startswith('torque_Nm_') for n in given):
+        _w0 = 0.09524584300020014*q[6] + 0.09952245489749749
+        _w1 = q[2] + 0.06504773782252429
+        _w2 = 0.19049168600040028*q[5]
+        _w3 = 0.001149540509634432/(q[8]*(0.0362870824352751*q[2] + 0.009071770608818775*q[6] + 0.011839492738755647))
+        _w4 = q[4] + 0.06504773782252429
+        p[1] = _w3*(q[1]*_w0 - _w1*_w2)/q[7]  # f_u
+        p[2] = -_w1*_w3*(q[3]*_w0 - _w2*_w4)/(q[9]*_w4)  # f_v
+
+
+def scales(**values):
+    """Scales back to physical units with these values: omega_n (rad/s), each mesh
+    coordinate's half backlash (m) and mean stiffness (N/m), and the speed in effect
+    (rpm of the operating gear, from omega)."""
+    q, _ = _physical(values)
+    q = q if q is not None else [v[0] for v in PHYSICAL.values()]
+    out = {
+        'omega_n_rad_per_s': float(29693.94956889366*np.sqrt(q[8])*np.sqrt(0.03532088886237956/(q[6] + 1.0449007721763601) + 0.00883022221559489/(q[2] + 0.06504773782252429))),
+        'half_backlash_m_u': float(q[7]/1000000),
+        'mean_stiffness_N_per_m_u': float(881730641.0*q[8]),
+        'half_backlash_m_v': float(q[9]/1000000),
+        'mean_stiffness_N_per_m_v': float(881730641.0*q[10]),
+    }
+    omega = parameters(**values)[0]
+    out['mesh_frequency_hz'] = float(omega * out['omega_n_rad_per_s'] / (2.0 * np.pi))
+    out['speed_rpm'] = float(omega * out['omega_n_rad_per_s'] / 5.235987755982989)
+    out['speed_gear'] = 'p'
+    return out
 
 
 def jacobian(tau, x, p):

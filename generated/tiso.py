@@ -148,6 +148,69 @@ FEATURES = {'stiffness_harmonics': 3, 'backlash': 'polynomial', 'transmission_er
 SCENE_PARAMETERS = {'damping_ratio': 0.03, 'omega': 0.709571332557897}
 # (low, high, low excluded): derive/input/scene.py PARAMETER_LIMITS
 SCENE_PARAMETER_LIMITS = {'omega': (0.001, 1000.0, False), 'damping_ratio': (0.0, 1.0, False)}
+# Physical quantities a user may set by name (default = the scene's value), and the
+# model parameters they give through the audit page's closed forms (derive/physical.py).
+PHYSICAL = {
+    'speed_rpm': (1500.0, 'rpm', "speed of gear 'p'"),
+    'torque_Nm_p': (500.0, 'N m', "external torque on gear 'p'"),
+    'attached_inertia_kg_m2_p': (0.0, 'kg m^2', "inertia attached to gear 'p'"),
+    'torque_Nm_q': (200.0, 'N m', "external torque on gear 'q'"),
+    'attached_inertia_kg_m2_q': (0.0, 'kg m^2', "inertia attached to gear 'q'"),
+    'torque_Nm_r': (100.0, 'N m', "external torque on gear 'r'"),
+    'attached_inertia_kg_m2_r': (0.0, 'kg m^2', "inertia attached to gear 'r'"),
+    'torque_Nm_g': (-1650.0, 'N m', "external torque on gear 'g'"),
+    'attached_inertia_kg_m2_g': (10.0, 'kg m^2', "inertia attached to gear 'g'"),
+    'half_backlash_um_pg': (50.0, 'um', "half backlash of mesh 'pg'"),
+    'stiffness_scale_pg': (1.0, '1', "factor on the stiffness of mesh 'pg' (mean and harmonics)"),
+    'half_backlash_um_qg': (50.0, 'um', "half backlash of mesh 'qg'"),
+    'stiffness_scale_qg': (1.0, '1', "factor on the stiffness of mesh 'qg' (mean and harmonics)"),
+    'half_backlash_um_rg': (40.0, 'um', "half backlash of mesh 'rg'"),
+    'stiffness_scale_rg': (1.0, '1', "factor on the stiffness of mesh 'rg' (mean and harmonics)"),
+    'te_amplitude_um_pg': (5.0, 'um', "first transmission-error harmonic of mesh 'pg'"),
+    'te_amplitude_um_qg': (5.0, 'um', "first transmission-error harmonic of mesh 'qg'"),
+    'te_amplitude_um_rg': (4.0, 'um', "first transmission-error harmonic of mesh 'rg'"),
+    'te_phase_deg_pg': (0.0, 'deg', "phase of the first transmission-error harmonic of mesh 'pg'"),
+    'te_phase_deg_qg': (0.0, 'deg', "phase of the first transmission-error harmonic of mesh 'qg'"),
+    'te_phase_deg_rg': (30.0, 'deg', "phase of the first transmission-error harmonic of mesh 'rg'"),
+    'stiffness_harmonic_scale_pg': (1.0, '1', "factor on the stiffness harmonics of mesh 'pg' (the mean kept)"),
+    'stiffness_harmonic_scale_qg': (1.0, '1', "factor on the stiffness harmonics of mesh 'qg' (the mean kept)"),
+    'stiffness_harmonic_scale_rg': (1.0, '1', "factor on the stiffness harmonics of mesh 'rg' (the mean kept)"),
+    'layout_angle_deg_qg': (120.0, 'deg', "angle of mesh 'qg' from the reference mesh round the shared gear"),
+    'layout_angle_deg_rg': (240.0, 'deg', "angle of mesh 'rg' from the reference mesh round the shared gear"),
+}
+PHYSICAL_LIMITS = {
+    'speed_rpm': (0.0, 1000000.0, True),
+    'torque_Nm_p': (-1000000000.0, 1000000000.0, False),
+    'attached_inertia_kg_m2_p': (0.0, 1000000000.0, False),
+    'torque_Nm_q': (-1000000000.0, 1000000000.0, False),
+    'attached_inertia_kg_m2_q': (0.0, 1000000000.0, False),
+    'torque_Nm_r': (-1000000000.0, 1000000000.0, False),
+    'attached_inertia_kg_m2_r': (0.0, 1000000000.0, False),
+    'torque_Nm_g': (-1000000000.0, 1000000000.0, False),
+    'attached_inertia_kg_m2_g': (0.0, 1000000000.0, False),
+    'half_backlash_um_pg': (0.0, 100000.0, True),
+    'stiffness_scale_pg': (0.0, 1000.0, True),
+    'half_backlash_um_qg': (0.0, 100000.0, True),
+    'stiffness_scale_qg': (0.0, 1000.0, True),
+    'half_backlash_um_rg': (0.0, 100000.0, True),
+    'stiffness_scale_rg': (0.0, 1000.0, True),
+    'te_amplitude_um_pg': (0.0, 10000.0, False),
+    'te_amplitude_um_qg': (0.0, 10000.0, False),
+    'te_amplitude_um_rg': (0.0, 10000.0, False),
+    'te_phase_deg_pg': (-360.0, 360.0, False),
+    'te_phase_deg_qg': (-360.0, 360.0, False),
+    'te_phase_deg_rg': (-360.0, 360.0, False),
+    'stiffness_harmonic_scale_pg': (0.0, 1000.0, False),
+    'stiffness_harmonic_scale_qg': (0.0, 1000.0, False),
+    'stiffness_harmonic_scale_rg': (0.0, 1000.0, False),
+    'layout_angle_deg_qg': (-360.0, 360.0, False),
+    'layout_angle_deg_rg': (-360.0, 360.0, False),
+}
+PHYSICAL_ALIASES = {'half_backlash_um': ('half_backlash_um_pg', 'half_backlash_um_qg', 'half_backlash_um_rg'), 'stiffness_scale': ('stiffness_scale_pg', 'stiffness_scale_qg', 'stiffness_scale_rg'), 'stiffness_harmonic_scale': ('stiffness_harmonic_scale_pg', 'stiffness_harmonic_scale_qg', 'stiffness_harmonic_scale_rg'), 'te_amplitude_um': ('te_amplitude_um_pg', 'te_amplitude_um_qg', 'te_amplitude_um_rg'), 'te_phase_deg': ('te_phase_deg_pg', 'te_phase_deg_qg', 'te_phase_deg_rg'), 'layout_angle_deg': ('layout_angle_deg_qg', 'layout_angle_deg_rg'), 'flywheel_inertia_kg_m2': ('attached_inertia_kg_m2_g',)}
+# Setting both a quantity and one of these is refused: they state the same thing.
+PHYSICAL_REPLACES = {'speed_rpm': ('omega',), 'torque_Nm_p': ('f_u', 'f_v', 'f_w'), 'torque_Nm_q': ('f_u', 'f_v', 'f_w'), 'torque_Nm_r': ('f_u', 'f_v', 'f_w'), 'torque_Nm_g': ('f_u', 'f_v', 'f_w'), 'te_amplitude_um_pg': ('E_u_1',), 'te_phase_deg_pg': ('psi_u_1',), 'te_amplitude_um_qg': ('E_v_1',), 'te_phase_deg_qg': ('psi_v_1',), 'te_amplitude_um_rg': ('E_w_1',), 'te_phase_deg_rg': ('psi_w_1',), 'layout_angle_deg_qg': ('phi_v',), 'layout_angle_deg_rg': ('phi_w',)}
+OMEGA_FROM_SPEED = True  # the scene states a speed, not omega
+LOADS_FROM_TORQUES = True  # the scene states torques
 # mesh coordinate: ((cos index, sin index, harmonic), ...) of k_hat = 1 + sum ...
 STIFFNESS_TERMS = {'u': ((22, 23, 1), (24, 25, 2), (26, 27, 3)), 'v': ((28, 29, 1), (30, 31, 2), (32, 33, 3)), 'w': ((34, 35, 1), (36, 37, 2), (38, 39, 3))}
 OPERATIONS = {'rhs': 149, 'rhs_and_jacobian': 228}
@@ -836,14 +899,17 @@ def parameters(**values):
     """Parameter vector p from named values; the rest keep the scene's values.
 
     Names may be scene parameters (SCENE_PARAMETERS: what the scene's [parameters]
-    table sets, such as a load ratio) or model parameters (PARAMETERS); a model
-    parameter given by name overrides what the scene parameters imply.
+    table sets, such as a load ratio), physical quantities (PHYSICAL, in rpm, N m,
+    um, kg m^2, or their PHYSICAL_ALIASES) or model parameters (PARAMETERS); a model
+    parameter given by name overrides what the others imply.
     """
-    unknown = sorted(set(values) - set(SCENE_PARAMETERS) - set(PARAMETERS))
+    unknown = sorted(set(values) - set(SCENE_PARAMETERS) - set(PARAMETERS)
+                     - set(PHYSICAL) - set(PHYSICAL_ALIASES))
     if unknown:
         raise KeyError(f'unknown parameter(s) {unknown}; scene parameters: '
-                       f'{sorted(SCENE_PARAMETERS)}; model parameters: '
-                       f'{list(PARAMETERS)}')
+                       f'{sorted(SCENE_PARAMETERS)}; physical: '
+                       f'{sorted(PHYSICAL) + sorted(PHYSICAL_ALIASES)}; model '
+                       f'parameters: {list(PARAMETERS)}')
     s = dict(SCENE_PARAMETERS)
     s.update((k, float(v)) for k, v in values.items() if k in SCENE_PARAMETERS)
     for k, v in s.items():
@@ -866,6 +932,9 @@ def parameters(**values):
     p[10] = 0.0287692216098972 * s['damping_ratio']  # xi_w_u
     p[11] = 0.0287692216098972 * s['damping_ratio']  # xi_w_v
     p[12] = 1.23811836219831 * s['damping_ratio']  # xi_w_w
+    q, given = _physical(values)
+    if q is not None:
+        _physical_parameters(p, q, s, given)
     for k, v in values.items():
         if k in PARAMETERS and k not in SCENE_PARAMETERS:
             p[PARAMETERS.index(k)] = float(v)
@@ -894,6 +963,153 @@ def _check_stiffness(p):
                 + ', '.join(PARAMETERS[i][3:] for i, _, _ in terms)
                 + '): a negative stiffness is not physical; use smaller harmonics')
     _STIFFNESS_CHECKED.add(key)
+
+
+def _physical(values):
+    """The physical quantities in effect (PHYSICAL order) and the names given, or
+    (None, set()) when none is given; aliases apply first, a name given beside its
+    alias wins; a quantity given beside what it replaces is refused."""
+    given = {}
+    for k, v in values.items():
+        for name in PHYSICAL_ALIASES.get(k, ()):
+            given.setdefault(name, (k, v))
+    for k, v in values.items():
+        if k in PHYSICAL:
+            given[k] = (k, v)
+    if not given:
+        return None, set()
+    for name, (key, _) in given.items():
+        for other in PHYSICAL_REPLACES.get(name, ()):
+            if other in values:
+                raise ValueError(f'{key} and {other} both set: they state the same '
+                                 f'quantity, one physically, one not; set one of them')
+    q = [v[0] for v in PHYSICAL.values()]
+    names = list(PHYSICAL)
+    for name, (key, v) in given.items():
+        v = float(v)
+        low, high, low_open = PHYSICAL_LIMITS[name]
+        if not np.isfinite(v) or v < low or (low_open and v == low) or (
+                high is not None and v > high):
+            rule = (f'in ({low:g}, {high:g}]' if low_open else f'in [{low:g}, {high:g}]')
+            raise ValueError(f'{key} must be {rule} {PHYSICAL[name][1]}, got {v:g}')
+        q[names.index(name)] = v
+    return q, set(given)
+
+
+def _physical_parameters(p, q, s, given):
+    """The model parameters from the physical quantities q (closed forms)."""
+    zeta = s['damping_ratio']
+    _w0 = 1/q[9]
+    _w1 = 1/q[10]
+    _w2 = _w0*_w1
+    _w3 = 0.009071770608818775*q[8] + 0.011839492738755647
+    _w4 = 0.0362870824352751*q[2] + _w3
+    _w5 = q[2] + 0.06504773782252429
+    _w6 = _w5/_w4
+    _w7 = 0.0362870824352751*_w6
+    _w8 = q[11]*q[12]*_w7
+    _w9 = q[14]*_w6
+    _w10 = 0.02876517055018*q[13]*_w9
+    _w11 = 1/q[11]
+    _w12 = q[9]*_w7
+    _w13 = _w11*_w12
+    _w14 = q[4] + 0.06504773782252429
+    _w15 = 0.0362870824352751*q[4] + _w3
+    _w16 = 1/q[13]
+    _w17 = _w12*_w16
+    _w18 = q[6] + 0.021285816634671603
+    _w19 = 0.0362870824352751*q[6] + 0.005805933189644017*q[8] + 0.006839024255987869
+    _w20 = np.sqrt(_w14)
+    _w21 = np.sqrt(_w15)
+    _w22 = zeta*np.sqrt(_w5)/(np.sqrt(q[10])*np.sqrt(_w4))
+    _w23 = np.sqrt(q[12])*_w22
+    _w24 = 0.0362870824352751*q[11]*_w20*_w23/_w21
+    _w25 = np.sqrt(_w18)
+    _w26 = np.sqrt(_w19)
+    _w27 = np.sqrt(q[14])*_w22
+    _w28 = 0.03230795745662559*q[13]*_w25*_w27/_w26
+    p[13] = 1  # kappa_u_u
+    p[14] = _w2*_w8  # kappa_u_v
+    p[15] = _w10*_w2  # kappa_u_w
+    p[16] = _w13  # kappa_v_u
+    p[17] = 1.0*q[12]*_w1*_w15*_w6/_w14  # kappa_v_v
+    p[18] = _w1*_w10*_w11  # kappa_v_w
+    p[19] = _w17  # kappa_w_u
+    p[20] = _w1*_w16*_w8  # kappa_w_v
+    p[21] = 0.7927110315768192*_w1*_w19*_w9/_w18  # kappa_w_w
+    p[4] = zeta  # xi_u_u
+    p[5] = _w0*_w24  # xi_u_v
+    p[6] = _w0*_w28  # xi_u_w
+    p[7] = zeta*_w13  # xi_v_u
+    p[8] = 1.0*_w21*_w23/_w20  # xi_v_v
+    p[9] = _w11*_w28  # xi_v_w
+    p[10] = zeta*_w17  # xi_w_u
+    p[11] = _w16*_w24  # xi_w_v
+    p[12] = 0.8903432099908547*_w26*_w27/_w25  # xi_w_w
+    p[42] = q[15]*_w0  # E_u_1
+    p[44] = q[16]*_w11  # E_v_1
+    p[46] = q[17]*_w16  # E_w_1
+    p[43] = 0.017453292519943295*q[18]  # psi_u_1
+    p[45] = 0.017453292519943295*q[19]  # psi_v_1
+    p[47] = 0.017453292519943295*q[20]  # psi_w_1
+    p[22] = -0.013662261851689467*q[21]  # kc_u_1
+    p[24] = -0.029989318359188107*q[21]  # kc_u_2
+    p[26] = 0.0010927109178232584*q[21]  # kc_u_3
+    p[23] = -0.08477387982709338*q[21]  # ks_u_1
+    p[25] = 0.009254583362040608*q[21]  # ks_u_2
+    p[27] = 0.0023191091869971658*q[21]  # ks_u_3
+    p[28] = -0.013662261851689467*q[22]  # kc_v_1
+    p[30] = -0.029989318359188107*q[22]  # kc_v_2
+    p[32] = 0.0010927109178232584*q[22]  # kc_v_3
+    p[29] = -0.08477387982709338*q[22]  # ks_v_1
+    p[31] = 0.009254583362040608*q[22]  # ks_v_2
+    p[33] = 0.0023191091869971658*q[22]  # ks_v_3
+    p[34] = -0.08376151471481376*q[23]  # kc_w_1
+    p[36] = -0.0037981233442647452*q[23]  # kc_w_2
+    p[38] = -0.009705907871614176*q[23]  # kc_w_3
+    p[35] = -0.10720811899999555*q[23]  # ks_w_1
+    p[37] = 0.013170815927854716*q[23]  # ks_w_2
+    p[39] = 0.0034642019476071053*q[23]  # ks_w_3
+    _z = 100.0 * q[24] / 360.0  # teeth of the shared gear spanned
+    p[40] = 2.0 * np.pi * (_z - np.floor(_z))  # phi_v
+    _z = 100.0 * q[25] / 360.0  # teeth of the shared gear spanned
+    p[41] = 2.0 * np.pi * (_z - np.floor(_z))  # phi_w
+    if OMEGA_FROM_SPEED or 'speed_rpm' in given:
+        p[0] = 0.00017633180604132318*q[0]/(np.sqrt(q[10])*np.sqrt(0.03532088886237956/(q[8] + 1.0449007721763601) + 0.00883022221559489/(q[2] + 0.06504773782252429)))  # omega
+    if LOADS_FROM_TORQUES or any(n.startswith('torque_Nm_') for n in given):
+        _w0 = q[8] + 1.0449007721763601
+        _w1 = 0.09524584300020014*_w0
+        _w2 = q[2] + 0.06504773782252429
+        _w3 = 0.19049168600040028*q[7]
+        _w4 = 0.001149540509634432/(q[10]*(0.0362870824352751*q[2] + 0.009071770608818775*q[8] + 0.011839492738755647))
+        _w5 = q[4] + 0.06504773782252429
+        _w6 = _w2*_w4
+        _w7 = q[6] + 0.021285816634671603
+        p[1] = _w4*(q[1]*_w1 - _w2*_w3)/q[9]  # f_u
+        p[2] = _w6*(q[3]*_w1 - _w3*_w5)/(q[11]*_w5)  # f_v
+        p[3] = _w6*(0.07619667440016012*q[5]*_w0 - _w3*_w7)/(q[13]*_w7)  # f_w
+
+
+def scales(**values):
+    """Scales back to physical units with these values: omega_n (rad/s), each mesh
+    coordinate's half backlash (m) and mean stiffness (N/m), and the speed in effect
+    (rpm of the operating gear, from omega)."""
+    q, _ = _physical(values)
+    q = q if q is not None else [v[0] for v in PHYSICAL.values()]
+    out = {
+        'omega_n_rad_per_s': float(29693.94956889366*np.sqrt(q[10])*np.sqrt(0.03532088886237956/(q[8] + 1.0449007721763601) + 0.00883022221559489/(q[2] + 0.06504773782252429))),
+        'half_backlash_m_u': float(q[9]/1000000),
+        'mean_stiffness_N_per_m_u': float(881730641.0*q[10]),
+        'half_backlash_m_v': float(q[11]/1000000),
+        'mean_stiffness_N_per_m_v': float(881730641.0*q[12]),
+        'half_backlash_m_w': float(q[13]/1000000),
+        'mean_stiffness_N_per_m_w': float(698957606.0*q[14]),
+    }
+    omega = parameters(**values)[0]
+    out['mesh_frequency_hz'] = float(omega * out['omega_n_rad_per_s'] / (2.0 * np.pi))
+    out['speed_rpm'] = float(omega * out['omega_n_rad_per_s'] / 5.235987755982989)
+    out['speed_gear'] = 'p'
+    return out
 
 
 def jacobian(tau, x, p):

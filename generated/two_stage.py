@@ -284,6 +284,27 @@ FEATURES = {'stiffness_harmonics': 3, 'backlash': 'polynomial', 'transmission_er
 SCENE_PARAMETERS = {'damping_ratio': 0.03, 'omega': 0.132368546051907}
 # (low, high, low excluded): derive/input/scene.py PARAMETER_LIMITS
 SCENE_PARAMETER_LIMITS = {'omega': (0.001, 1000.0, False), 'damping_ratio': (0.0, 1.0, False)}
+# Physical quantities a user may set by name (default = the scene's value), and the
+# model parameters they give through the audit page's closed forms (derive/physical.py).
+PHYSICAL = {
+    'speed_rpm': (1500.0, 'rpm', "speed of gear 'a'"),
+    'te_amplitude_um_ab': (4.0, 'um', "first transmission-error harmonic of mesh 'ab'"),
+    'te_phase_deg_ab': (0.0, 'deg', "phase of the first transmission-error harmonic of mesh 'ab'"),
+    'stiffness_harmonic_scale_cd': (1.0, '1', "factor on the stiffness harmonics of mesh 'cd' (the mean kept)"),
+    'stiffness_harmonic_scale_ab': (1.0, '1', "factor on the stiffness harmonics of mesh 'ab' (the mean kept)"),
+}
+PHYSICAL_LIMITS = {
+    'speed_rpm': (0.0, 1000000.0, True),
+    'te_amplitude_um_ab': (0.0, 10000.0, False),
+    'te_phase_deg_ab': (-360.0, 360.0, False),
+    'stiffness_harmonic_scale_cd': (0.0, 1000.0, False),
+    'stiffness_harmonic_scale_ab': (0.0, 1000.0, False),
+}
+PHYSICAL_ALIASES = {'stiffness_harmonic_scale': ('stiffness_harmonic_scale_cd', 'stiffness_harmonic_scale_ab'), 'te_amplitude_um': ('te_amplitude_um_ab',), 'te_phase_deg': ('te_phase_deg_ab',)}
+# Setting both a quantity and one of these is refused: they state the same thing.
+PHYSICAL_REPLACES = {'speed_rpm': ('omega',), 'te_amplitude_um_ab': ('E_u_1',), 'te_phase_deg_ab': ('psi_u_1',)}
+OMEGA_FROM_SPEED = True  # the scene states a speed, not omega
+LOADS_FROM_TORQUES = True  # the scene states torques
 # mesh coordinate: ((cos index, sin index, harmonic), ...) of k_hat = 1 + sum ...
 STIFFNESS_TERMS = {'v': ((89, 90, 1), (91, 92, 2), (93, 94, 3)), 'u': ((95, 96, 1), (97, 98, 2), (99, 100, 3))}
 OPERATIONS = {'rhs': 258, 'rhs_and_jacobian': 439}
@@ -1635,14 +1656,17 @@ def parameters(**values):
     """Parameter vector p from named values; the rest keep the scene's values.
 
     Names may be scene parameters (SCENE_PARAMETERS: what the scene's [parameters]
-    table sets, such as a load ratio) or model parameters (PARAMETERS); a model
-    parameter given by name overrides what the scene parameters imply.
+    table sets, such as a load ratio), physical quantities (PHYSICAL, in rpm, N m,
+    um, kg m^2, or their PHYSICAL_ALIASES) or model parameters (PARAMETERS); a model
+    parameter given by name overrides what the others imply.
     """
-    unknown = sorted(set(values) - set(SCENE_PARAMETERS) - set(PARAMETERS))
+    unknown = sorted(set(values) - set(SCENE_PARAMETERS) - set(PARAMETERS)
+                     - set(PHYSICAL) - set(PHYSICAL_ALIASES))
     if unknown:
         raise KeyError(f'unknown parameter(s) {unknown}; scene parameters: '
-                       f'{sorted(SCENE_PARAMETERS)}; model parameters: '
-                       f'{list(PARAMETERS)}')
+                       f'{sorted(SCENE_PARAMETERS)}; physical: '
+                       f'{sorted(PHYSICAL) + sorted(PHYSICAL_ALIASES)}; model '
+                       f'parameters: {list(PARAMETERS)}')
     s = dict(SCENE_PARAMETERS)
     s.update((k, float(v)) for k, v in values.items() if k in SCENE_PARAMETERS)
     for k, v in s.items():
@@ -1672,6 +1696,9 @@ def parameters(**values):
     p[40] = -0.0388260015256808 * s['damping_ratio']  # xi_xd_v
     p[42] = 0.0144472151854388 * s['damping_ratio']  # xi_yd_v
     p[44] = -0.00825272138769374 * s['damping_ratio']  # xi_zd_v
+    q, given = _physical(values)
+    if q is not None:
+        _physical_parameters(p, q, s, given)
     for k, v in values.items():
         if k in PARAMETERS and k not in SCENE_PARAMETERS:
             p[PARAMETERS.index(k)] = float(v)
@@ -1700,6 +1727,78 @@ def _check_stiffness(p):
                 + ', '.join(PARAMETERS[i][3:] for i, _, _ in terms)
                 + '): a negative stiffness is not physical; use smaller harmonics')
     _STIFFNESS_CHECKED.add(key)
+
+
+def _physical(values):
+    """The physical quantities in effect (PHYSICAL order) and the names given, or
+    (None, set()) when none is given; aliases apply first, a name given beside its
+    alias wins; a quantity given beside what it replaces is refused."""
+    given = {}
+    for k, v in values.items():
+        for name in PHYSICAL_ALIASES.get(k, ()):
+            given.setdefault(name, (k, v))
+    for k, v in values.items():
+        if k in PHYSICAL:
+            given[k] = (k, v)
+    if not given:
+        return None, set()
+    for name, (key, _) in given.items():
+        for other in PHYSICAL_REPLACES.get(name, ()):
+            if other in values:
+                raise ValueError(f'{key} and {other} both set: they state the same '
+                                 f'quantity, one physically, one not; set one of them')
+    q = [v[0] for v in PHYSICAL.values()]
+    names = list(PHYSICAL)
+    for name, (key, v) in given.items():
+        v = float(v)
+        low, high, low_open = PHYSICAL_LIMITS[name]
+        if not np.isfinite(v) or v < low or (low_open and v == low) or (
+                high is not None and v > high):
+            rule = (f'in ({low:g}, {high:g}]' if low_open else f'in [{low:g}, {high:g}]')
+            raise ValueError(f'{key} must be {rule} {PHYSICAL[name][1]}, got {v:g}')
+        q[names.index(name)] = v
+    return q, set(given)
+
+
+def _physical_parameters(p, q, s, given):
+    """The model parameters from the physical quantities q (closed forms)."""
+    zeta = s['damping_ratio']
+    p[102] = 0.02*q[1]  # E_u_1
+    p[103] = 0.017453292519943295*q[2]  # psi_u_1
+    p[89] = 0.006643751799443507*q[3]  # kc_v_1
+    p[91] = -0.00785445427474732*q[3]  # kc_v_2
+    p[93] = -0.0006278102748146566*q[3]  # kc_v_3
+    p[90] = -0.020688767118906062*q[3]  # ks_v_1
+    p[92] = -0.006265532061964176*q[3]  # ks_v_2
+    p[94] = 0.0001790393201360501*q[3]  # ks_v_3
+    p[95] = -0.006213831324531838*q[4]  # kc_u_1
+    p[97] = -0.019254605163556045*q[4]  # kc_u_2
+    p[99] = -0.0011147546517107211*q[4]  # kc_u_3
+    p[96] = -0.05818064844400672*q[4]  # ks_u_1
+    p[98] = 0.002929181627513109*q[4]  # ks_u_2
+    p[100] = -0.0029067546537007013*q[4]  # ks_u_3
+    if OMEGA_FROM_SPEED or 'speed_rpm' in given:
+        p[0] = 8.824569736793811e-05*q[0]  # omega
+
+
+def scales(**values):
+    """Scales back to physical units with these values: omega_n (rad/s), each mesh
+    coordinate's half backlash (m) and mean stiffness (N/m), and the speed in effect
+    (rpm of the operating gear, from omega)."""
+    q, _ = _physical(values)
+    q = q if q is not None else [v[0] for v in PHYSICAL.values()]
+    out = {
+        'omega_n_rad_per_s': float(14833.549714474111),
+        'half_backlash_m_v': float(5.9999999999999995e-05),
+        'mean_stiffness_N_per_m_v': float(1271816810.0),
+        'half_backlash_m_u': float(4.9999999999999996e-05),
+        'mean_stiffness_N_per_m_u': float(876390643.0),
+    }
+    omega = parameters(**values)[0]
+    out['mesh_frequency_hz'] = float(omega * out['omega_n_rad_per_s'] / (2.0 * np.pi))
+    out['speed_rpm'] = float(omega * out['omega_n_rad_per_s'] / 1.3089969389957472)
+    out['speed_gear'] = 'a'
+    return out
 
 
 def jacobian(tau, x, p):

@@ -1,12 +1,17 @@
 """Results to files other tools open: JSON, CSV and MATLAB ``.mat``.
 
-Every result type has ``to_dict()`` (all of it, nested) and ``to_table()`` (the part that
-is a table: one row per sample, sweep point or branch point).  :func:`save` writes
+Every result type has ``to_dict()`` (all of it, nested, under the API's attribute names)
+and ``to_table()`` (the part that is a table: one row per sample, sweep point or branch
+point).  :func:`save` writes
 
 * ``.json`` -- ``to_dict()``, with NaN and infinities as ``null``;
-* ``.csv`` -- ``to_table()``, one header line of column names;
-* ``.mat`` -- ``to_dict()`` as MATLAB structs (``scipy.io.savemat``), with the table's
-  columns beside it under ``table`` so that a MATLAB user gets plain vectors;
+* ``.csv`` -- the header block (:mod:`.provenance`) as leading ``# key: value`` lines, the
+  value in JSON, then ``to_table()`` with one line of column names; booleans as 1/0,
+  missing numbers empty (``pandas.read_csv(f, comment="#")``, MATLAB
+  ``readtable(f, "CommentStyle", "#")``);
+* ``.mat`` -- ``to_dict()`` as the struct ``result`` (``scipy.io.savemat``; text as cell
+  arrays of strings, booleans as double 0/1, null as NaN, rectangular lists of numbers as
+  matrices), with the table's columns beside it in the struct ``table``;
 
 each through a temporary file and a rename, so that a reader never sees half a file.
 """
@@ -15,59 +20,99 @@ from __future__ import annotations
 
 import csv
 import io
-import math
 import os
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ._json import clean, dumps
+from .provenance import KEYS
 
-__all__ = ["FORMATS", "save"]
+__all__ = ["FORMATS", "Document", "document", "save"]
 
 FORMATS = (".json", ".csv", ".mat")
 
 
-def save(result, path) -> Path:
-    """Write ``result`` to ``path``; the format follows the suffix (:data:`FORMATS`)."""
+@dataclass(frozen=True)
+class Document:
+    """A result assembled by a command (a dict and its table) that :func:`save` writes
+    like any result type."""
+
+    data: dict
+    columns: list = field(default_factory=list)
+    rows: list = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        return self.data
+
+    def to_table(self) -> tuple[list, list]:
+        return self.columns, self.rows
+
+
+def document(result, **extra) -> dict:
+    """``result.to_dict()`` with ``extra`` (header keys such as ``initial_state`` and
+    ``command``; the result's own keys win) and the header keys first."""
+    data = {**extra, **result.to_dict()}
+    return {k: data[k] for k in KEYS if k in data} | data
+
+
+def save(result, path, **extra) -> Path:
+    """Write ``result`` to ``path``; the format follows the suffix (:data:`FORMATS`).
+    ``extra`` adds header keys (:func:`document`)."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in FORMATS:
         raise ValueError(f"{path}: unknown format '{suffix}'; formats: {', '.join(FORMATS)}")
+    data = document(result, **extra)
+    if suffix == ".json":
+        return write_atomic(path, dumps(data))
+    if suffix == ".csv":
+        return write_atomic(path, _csv(data, *result.to_table()))
+    from scipy.io import savemat
+
+    columns, rows = result.to_table()
+    table = {_field(c): _column([r[k] for r in rows]) for k, c in enumerate(columns)}
+    buf = io.BytesIO()
+    savemat(buf, {"result": _mat(data), "table": table}, long_field_names=True, do_compression=True)
+    return write_atomic(path, buf.getvalue())
+
+
+def write_atomic(path, content: str | bytes) -> Path:
+    """Write ``content`` to ``path`` through a temporary file and a rename."""
+    path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
-        if suffix == ".json":
-            tmp.write_text(dumps(result.to_dict()), encoding="utf-8")
-        elif suffix == ".csv":
-            tmp.write_text(_csv(*result.to_table()), encoding="utf-8")
+        if isinstance(content, bytes):
+            tmp.write_bytes(content)
         else:
-            from scipy.io import savemat
-
-            data = {"result": _mat(result.to_dict())}
-            columns, rows = result.to_table()
-            data["table"] = {
-                _field(c): np.array([_mat(r[k]) for r in rows]) for k, c in enumerate(columns)
-            }
-            with open(tmp, "wb") as fh:
-                savemat(fh, data, long_field_names=True, do_compression=True)
+            tmp.write_text(content, encoding="utf-8")
         os.replace(tmp, path)
     finally:
         tmp.unlink(missing_ok=True)
     return path
 
 
-def _csv(columns, rows) -> str:
+def _csv(data: dict, columns, rows) -> str:
     out = io.StringIO()
+    for k in KEYS:
+        if k in data:
+            out.write(f"# {k}: {dumps(data[k])}\n")
     writer = csv.writer(out, lineterminator="\n")
     writer.writerow(columns)
     for row in rows:
-        writer.writerow(["" if _missing(v) else v for v in row])
+        writer.writerow([_cell(v) for v in row])
     return out.getvalue()
 
 
-def _missing(v) -> bool:
-    return v is None or (isinstance(v, float) and not math.isfinite(v))
+def _cell(v):
+    v = clean(v)
+    if v is None:
+        return ""
+    if isinstance(v, bool):
+        return int(v)
+    return v
 
 
 def _field(name: str) -> str:
@@ -76,16 +121,44 @@ def _field(name: str) -> str:
     return s if s[:1].isalpha() else f"x_{s}"
 
 
+def _column(values: list):
+    """A table column: text as a cell array of strings, else double (None as NaN)."""
+    values = [clean(v) for v in values]
+    if any(isinstance(v, str) for v in values):
+        return _cells(["" if v is None else str(v) for v in values])
+    return np.array([np.nan if v is None else float(v) for v in values], dtype=float)
+
+
+def _cells(items: list) -> np.ndarray:
+    """An object array (a MATLAB cell array) of ``items``, never a char matrix."""
+    out = np.empty(len(items), dtype=object)
+    out[:] = items
+    return out
+
+
+def _number(v) -> bool:
+    return v is None or (isinstance(v, int | float) and not isinstance(v, str))
+
+
 def _mat(obj):
     """Nested data as savemat takes it: dicts as structs (field names cleaned), lists of
-    numbers as arrays, None as NaN."""
+    numbers as arrays (rectangular lists of them as matrices), lists of text or of mixed
+    items as cell arrays, booleans as double, None as NaN."""
     obj = clean(obj)
     if isinstance(obj, dict):
         return {_field(k): _mat(v) for k, v in obj.items()}
     if isinstance(obj, list):
-        if obj and all(isinstance(v, int | float) or v is None for v in obj):
-            return np.array([np.nan if v is None else v for v in obj], dtype=float)
-        return np.array([_mat(v) for v in obj] + [None], dtype=object)[:-1]
+        if obj and all(_number(v) for v in obj):
+            return np.array([np.nan if v is None else float(v) for v in obj], dtype=float)
+        if (
+            obj
+            and all(isinstance(r, list) and r and all(_number(v) for v in r) for r in obj)
+            and len({len(r) for r in obj}) == 1
+        ):
+            return np.array([[np.nan if v is None else float(v) for v in r] for r in obj])
+        return _cells([_mat(v) for v in obj])
     if obj is None:
         return np.nan
+    if isinstance(obj, bool):
+        return float(obj)
     return obj

@@ -1,16 +1,16 @@
 """Matplotlib figures: bifurcation diagrams, time series, spectra, phase portraits, maps.
 
-Every function takes data and a path, writes one PNG (Agg back end, no display needed) and
-returns the path.  Axes are labelled with their (non-dimensional) units.  One meaning has
-one colour in every figure of the package: the palettes are in :mod:`.plots_maps`;
-markers are at least 3 px, legends sit outside the axes, and a figure of one operating
-point says that point (ω̄, loads, backlash model) and its verdict in its title.
+Every function takes data (a result object of the API) and returns a matplotlib ``Figure``
+(Agg back end, no display needed); saving is the caller's choice (:func:`save_figure`).
+Axes are labelled with their (non-dimensional) units.  One meaning has one colour in
+every figure of the package: the palettes are in :mod:`.plots_style`; markers are at
+least 3 px, legends sit outside the axes, and a figure of one operating point says that
+point (ω̄, loads, backlash model) and its verdict in its title.
 """
 
 from __future__ import annotations
 
 import textwrap
-from pathlib import Path
 
 import matplotlib
 
@@ -19,8 +19,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from .analysis import spectrum  # noqa: E402
+from .analysis.point import verdict_line  # noqa: E402
 from .integrate import Trajectory  # noqa: E402
-from .plots_maps import (  # noqa: E402
+from .plots_style import (  # noqa: E402
     BIFURCATIONS,
     MOTION_CLASSES,
     categorical,
@@ -29,6 +30,7 @@ from .plots_maps import (  # noqa: E402
     not_ok_marks,
     operating_point,
     period_colour,
+    save_figure,
     sweep_marker,
 )
 from .sweep import SweepResult  # noqa: E402
@@ -39,18 +41,11 @@ __all__ = [
     "map_figure",
     "multipliers_figure",
     "point_figure",
+    "save_figure",
 ]
 
 PORTRAIT_PERIODS = 500  # periods a phase portrait draws at most
 HARMONICS_SHOWN = 6  # a spectrum runs to (HARMONICS_SHOWN + 1/2) omega: the 6th is whole
-
-
-def _save(fig, path: Path) -> Path:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120, bbox_inches="tight")
-    plt.close(fig)
-    return path
 
 
 def _distinct(pts: np.ndarray, lo: float, cell: float) -> np.ndarray:
@@ -63,11 +58,10 @@ def _distinct(pts: np.ndarray, lo: float, cell: float) -> np.ndarray:
 def bifurcation_diagram(
     sweeps: list[SweepResult],
     states: list[str],
-    path: Path,
     title: str = "",
     *,
     system=None,
-) -> Path:
+):
     """Poincaré points of each state against the swept parameter, one panel per state.
 
     Forward and backward sweeps are both visible where they agree: the backward sweep's
@@ -111,59 +105,18 @@ def bifurcation_diagram(
     if head:
         axes[0, 0].set_title(head, fontsize=10)
     legend_below(fig, axes.ravel())
-    return _save(fig, path)
+    return fig
 
 
 def _title(tr: Trajectory, point, title: str) -> str:
     lines = [title] if title else []
     lines.append(operating_point(tr.system))
     if point is not None:
-        lines.append(textwrap.fill(_verdict_text(point, tr.system.coordinates), 150))
+        lines.append(textwrap.fill(verdict_line(point), 150))
     return "\n".join(lines)
 
 
-def _verdict_text(point, coordinates) -> str:
-    """The verdict line of one analysed point (a ``PointResult``): the motion (one label
-    when the coordinates agree) and its evidence: the periods run, the orbit's largest
-    Floquet multiplier |μ| or the last window's exponent interval (per unit τ) and 0-1
-    test K, the reason of an undetermined verdict, a chaotic transient."""
-    cls = point.classification
-    motions = {c: getattr(cls[c], "motion", str(cls[c])) for c in coordinates}
-    if len(set(motions.values())) == 1:
-        parts = [f"verdict: {next(iter(motions.values()))} ({', '.join(motions)})"]
-    else:
-        parts = ["verdict: " + ", ".join(f"{c} {m}" for c, m in motions.items())]
-    verdict = getattr(point, "verdict", None)
-    s = verdict.summary() if verdict is not None else {}
-    if "periods_run" in s:
-        parts.append(f"{s['periods_run']} periods run")
-    if s.get("largest_multiplier") is not None:
-        parts.append(f"largest |Floquet multiplier| {s['largest_multiplier']:.4f}")
-    if "exponent_interval" in s:
-        lo, hi = s["exponent_interval"]
-        parts.append(f"largest Lyapunov exponent in [{lo:+.4f}, {hi:+.4f}] per unit τ")
-    elif point.lyapunov is not None:
-        lam = point.lyapunov
-        parts.append(
-            f"largest Lyapunov exponent {lam.exponent:+.4f} ± {lam.uncertainty:.4f} "
-            f"per unit τ ({lam.periods} periods)"
-        )
-    if "zero_one_K" in s:
-        parts.append(f"0-1 test K = {s['zero_one_K']:.2f}")
-    if "two_trajectory_interval" in s:
-        lo, hi = s["two_trajectory_interval"]
-        agrees = " (the second test that agrees)" * (
-            s.get("second_test") == "two-trajectory exponent"
-        )
-        parts.append(f"two-trajectory exponent in [{lo:+.4f}, {hi:+.4f}]{agrees}")
-    if "transient_chaos" in s:
-        parts.append(str(s["transient_chaos"].get("text", "chaotic transient")))
-    if "why" in s:
-        parts.append(f"why: {s['why']}")
-    return "; ".join(parts)
-
-
-def point_figure(point, path: Path, title: str = "", periods_shown: int = 20) -> Path:
+def point_figure(point, title: str = "", periods_shown: int = 20):
     """One operating point: time series, phase portrait with Poincaré points, and spectrum
     of each mesh coordinate (one row per coordinate).
 
@@ -231,7 +184,7 @@ def point_figure(point, path: Path, title: str = "", periods_shown: int = 20) ->
         fontsize=8,
         frameon=False,
     )
-    return _save(fig, path)
+    return fig
 
 
 def _spectrum_panel(ax, tr: Trajectory, c: str) -> None:
@@ -266,11 +219,10 @@ def map_figure(
     max_u,
     min_v,
     motion_v,
-    path: Path,
     title: str = "",
     *,
     names: tuple[str, str, str, str],
-) -> Path:
+):
     """Maps over two parameters (``names[0]`` on the y axis, ``names[1]`` on x): the max of
     state ``names[2]``, the min of state ``names[3]`` (half backlashes) and the motion
     type of ``names[3]`` in the package's motion palette (:data:`MOTION_CLASSES`)."""
@@ -301,7 +253,7 @@ def map_figure(
     if title:
         fig.suptitle(title)
     fig.tight_layout()
-    return _save(fig, path)
+    return fig
 
 
 def _drawable(branches) -> tuple[list, list]:
@@ -314,9 +266,7 @@ def _drawable(branches) -> tuple[list, list]:
     return keep, empty
 
 
-def branch_figure(
-    branches, path: Path, state=None, sweeps=None, title: str = "", *, system=None
-) -> Path:
+def branch_figure(branches, state=None, sweeps=None, title: str = "", *, system=None):
     """Continuation branches over the brute-force diagram: stable solid, unstable dashed,
     bifurcations marked; the Poincaré points of brute-force sweeps behind them (in the
     sweeps' palette).
@@ -379,10 +329,10 @@ def branch_figure(
     if head:
         axes[0, 0].set_title("\n".join(head), fontsize=10)
     legend_below(fig, axes.ravel())
-    return _save(fig, path)
+    return fig
 
 
-def multipliers_figure(multipliers, path: Path, title: str = "") -> Path:
+def multipliers_figure(multipliers, title: str = ""):
     """Floquet multipliers in the complex plane with the unit circle."""
     fig, ax = plt.subplots(figsize=(4.5, 4.5))
     th = np.linspace(0, 2 * np.pi, 400)
@@ -397,4 +347,4 @@ def multipliers_figure(multipliers, path: Path, title: str = "") -> Path:
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
     if title:
         ax.set_title(title, fontsize=9)
-    return _save(fig, path)
+    return fig

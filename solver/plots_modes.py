@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 from .analysis.modes import Modes
-from .plots import _save, plt
+from .plots_style import plt
 
 __all__ = ["campbell_figure"]
 
@@ -22,12 +20,13 @@ _STYLE = {
 def campbell_figure(
     result: Modes,
     speeds_rpm: tuple[float, float],
-    path: Path,
     harmonics: int = 3,
     scene_rpm: float | None = None,
-) -> Path:
+):
     """Natural frequencies (flat: no speed dependence in this model) and the mesh-frequency
-    harmonics ``h z n / 60`` against the reference driver's speed; a dot where they meet."""
+    harmonics ``h z n / 60`` against the reference driver's speed (rpm, from
+    ``speeds_rpm[0]`` to ``speeds_rpm[1]``); a dot where they meet.  ``result``: a
+    :class:`~.analysis.modes.Modes`; returns the ``Figure`` (nothing saved)."""
     fig, ax = plt.subplots(figsize=(8, 5))
     n = np.linspace(speeds_rpm[0], speeds_rpm[1], 2)
     z = result.reference_teeth
@@ -69,4 +68,4 @@ def campbell_figure(
         fontsize=8,
         frameon=False,
     )
-    return _save(fig, path)
+    return fig

@@ -6,7 +6,6 @@ time integration as triangles."""
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import matplotlib
 
@@ -14,7 +13,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .plots_maps import BIFURCATIONS, SWEEPS, legend_below  # noqa: E402
+from .plots_style import BIFURCATIONS, SWEEPS, legend_below  # noqa: E402
 
 __all__ = ["METHODS", "frequency_response_figure"]
 
@@ -35,8 +34,9 @@ def _segments(x, y, stable):
             start = k
 
 
-def frequency_response_figure(resp, path, physical: bool = False, title: str = "") -> Path:
-    """One panel per mesh coordinate.  ``physical``: mesh frequency in Hz and the
+def frequency_response_figure(resp, physical: bool = False, title: str = ""):
+    """One panel per mesh coordinate of a :class:`~.sweep.frequency.FrequencyResponse`;
+    returns the ``Figure`` (nothing saved).  ``physical``: mesh frequency in Hz and the
     dynamic transmission error's amplitude in µm (only over the forcing frequency)."""
     system = resp.system
     coords = system.coordinates
@@ -102,8 +102,4 @@ def frequency_response_figure(resp, path, physical: bool = False, title: str = "
     if title:
         axes[0, 0].set_title(title, fontsize=10)
     legend_below(fig, axes.ravel())  # one legend: each entry once, not once per panel
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120, bbox_inches="tight")
-    plt.close(fig)
-    return path
+    return fig

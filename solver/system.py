@@ -172,12 +172,47 @@ class System:
         return self.module.casadi_functions()
 
     def scales(self) -> dict:
-        """How to go back to SI: omega_n and the half backlash of each coordinate."""
-        return {
+        """How to go back to SI with this system's values: omega_n, the half backlash and
+        mean stiffness of each mesh coordinate, and (for a model with physical quantities,
+        the generated ``scales()``) the mesh frequency and the speed in effect."""
+        out = {
             "omega_n_rad_per_s": float(self.module.OMEGA_N),
             "half_backlash_m": dict(self.module.HALF_BACKLASH),
             "time": "tau = omega_n t; coordinates in half backlashes",
         }
+        scales = getattr(self.module, "scales", None)
+        if scales is None:
+            return out
+        s = scales(**self.values)
+        out["omega_n_rad_per_s"] = s["omega_n_rad_per_s"]
+        out["half_backlash_m"] = {c: s[f"half_backlash_m_{c}"] for c in out["half_backlash_m"]}
+        out["mean_stiffness_N_per_m"] = {
+            c: s[f"mean_stiffness_N_per_m_{c}"] for c in out["half_backlash_m"]
+        }
+        for key in ("mesh_frequency_hz", "speed_rpm", "speed_gear"):
+            out[key] = s[key]
+        return out
+
+    def __repr__(self) -> str:
+        # the forcing frequency and at most four of the values given
+        given = [(k, v) for k, v in self.values.items() if k != self.contract.forcing_frequency]
+        shown = [f"ω̄ = {self.omega:.4g}"] + [f"{k} = {float(v):.4g}" for k, v in given[:4]]
+        more = f" (+{len(given) - 4} more)" if len(given) > 4 else ""
+        return f"System({self.name}: {', '.join(shown)}{more})"
+
+    def summary(self) -> str:
+        """A few lines: the model, its states, the values, the backlash and the scales."""
+        scales = self.scales()
+        b = ", ".join(f"{c} {v * 1e6:.4g} µm" for c, v in scales["half_backlash_m"].items())
+        given = ", ".join(f"{k} = {float(v):.6g}" for k, v in self.values.items())
+        return "\n".join(
+            [
+                f"{self.name} (hash {self.model_hash[:12]}): states {', '.join(self.states)}; "
+                f"{'piecewise' if self.piecewise else 'smooth'}, {self.backlash or 'no'} backlash",
+                f"ω̄ = {self.omega:.6g} (T = {self.period:.6g} τ); values: {given or 'none'}",
+                f"scales: ω_n = {scales['omega_n_rad_per_s']:.6g} rad/s; half backlash {b}",
+            ]
+        )
 
     def describe(self) -> dict:
         return {

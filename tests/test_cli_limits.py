@@ -148,7 +148,7 @@ def test_continue_to_zero_damping_says_the_boundary_and_keeps_the_branch(capsys,
     assert code == 0 and err.startswith("gearsym: note: backlash") and err.count("\n") == 1, err
     said = [ln for ln in out.splitlines() if "boundary" in ln]
     assert len(said) == 1 and said[0].startswith("period-1 branch:"), out
-    (branch,) = json.loads((tmp_path / "branches.json").read_text())
+    (branch,) = json.loads((tmp_path / "branches.json").read_text())["branches"]
     assert branch["status"] == "boundary" and len(branch["values"]) >= 2
     assert branch["values"][-1] == 0.0 and min(branch["values"]) >= 0.0
 

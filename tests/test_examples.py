@@ -7,12 +7,16 @@ libraries and derived models are built from scratch, as on a first run.
 
 import csv
 import os
+import runpy
 import subprocess
 import sys
 from pathlib import Path
 
+import matplotlib.pyplot as plt
 import numpy as np
+import pytest
 import scipy.io
+from matplotlib.figure import Figure
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "docs" / "examples"
 
@@ -40,6 +44,7 @@ def _written(out, *names):
 
 def test_every_example_is_tested_here():
     assert sorted(p.name for p in EXAMPLES.glob("*.py")) == [
+        "notebook.py",
         "orbit_and_continuation.py",
         "own_scene.py",
         "sweep_with_figure.py",
@@ -50,8 +55,8 @@ def test_orbit_and_continuation(tmp_path):
     out, stdout = _run("orbit_and_continuation.py", tmp_path)
     assert "stable: True" in stdout and "Liouville" in stdout
     _written(out, "branch.csv", "branch.mat")
-    with open(out / "branch.csv", newline="") as fh:
-        rows = list(csv.reader(fh))
+    with open(out / "branch.csv", newline="") as fh:  # the header block: "# key: value"
+        rows = list(csv.reader(line for line in fh if not line.startswith("#")))
     assert rows[0][:3] == ["lambda", "stable", "max_multiplier"] and len(rows) > 2
     lam = [float(r[0]) for r in rows[1:]]
     assert lam[0] == 0.8 and lam[-1] == 1.0
@@ -63,8 +68,8 @@ def test_sweep_with_figure(tmp_path):
     out, stdout = _run("sweep_with_figure.py", tmp_path)
     assert stdout.count("lambda = ") == 6
     _written(out, "bifurcation.png", "sweep.json", "sweep.csv")
-    with open(out / "sweep.csv", newline="") as fh:
-        rows = list(csv.reader(fh))
+    with open(out / "sweep.csv", newline="") as fh:  # the header block: "# key: value"
+        rows = list(csv.reader(line for line in fh if not line.startswith("#")))
     assert rows[0][:2] == ["lambda", "status"] and len(rows) == 7
 
 
@@ -76,3 +81,40 @@ def test_own_scene_derives_into_the_given_cache(tmp_path):
     _written(out, "my-light.toml", "point.mat")
     mat = scipy.io.loadmat(out / "point.mat", simplify_cells=True)
     assert set(mat["table"]) == {"tau", "u", "v", "du", "dv"}
+
+
+@pytest.mark.slow
+def test_notebook_builds_figures_from_the_api_alone(tmp_path, monkeypatch):
+    """The notebook-style script (issue 25, point 6): its cells import nothing but
+    ``gearsym`` (and the standard library), each result draws through ``gearsym.plot``
+    into a Figure, and nothing is written unless an output folder is given."""
+    script = EXAMPLES / "notebook.py"
+    imports = [
+        line.split()[1]
+        for line in script.read_text(encoding="utf-8").splitlines()
+        if line.startswith(("import ", "from "))
+    ]
+    assert set(imports) == {"gearsym", "sys", "pathlib"}, imports
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "argv", [str(script)])
+    names = runpy.run_path(str(script), run_name="notebook")  # as a notebook runs it
+    figures = names["figures"]
+    try:
+        assert list(figures) == [
+            "point",
+            "bifurcation",
+            "map-motion",
+            "map-extremes",
+            "multipliers",
+            "branch",
+            "frequency-response",
+            "campbell",
+        ]
+        assert all(isinstance(f, Figure) and f.axes for f in figures.values())
+        assert not list(tmp_path.iterdir())  # saving is the caller's choice
+    finally:
+        plt.close("all")
+    # run as a script with a folder: every figure saved there
+    out, stdout = _run("notebook.py", tmp_path)
+    assert stdout.count("wrote ") == len(figures)
+    _written(out, *(f"{name}.png" for name in figures))

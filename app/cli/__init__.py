@@ -112,6 +112,7 @@ def _closed_pipe(as_program: bool) -> int:
 def main(argv: list[str] | None = None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
+    args.argv = list(sys.argv[1:] if argv is None else argv)  # the command, in result files
     _notes.forget()  # a process may run several commands (tests): each has its notes
     if getattr(args, "method", "absent") is None:
         from gearsym.solver.integrate import fastest_method
@@ -140,6 +141,10 @@ def _run(args) -> int:
     try:
         if getattr(args, "out", None) and args.command != "bench":  # bench checks its own
             out_folder(args.out)
+        if getattr(args, "format", None) is not None:
+            from ._output import result_formats
+
+            result_formats(args)
         code = args.func(args)
         sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's exit
         _notes.say()  # a command that ran to its end (not refused, not failed)

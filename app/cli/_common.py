@@ -186,8 +186,9 @@ def system_of(scene_arg: str, sets: dict[str, float]):
     from gearsym.resolve import module_for, split_open_values
     from gearsym.solver.system import System
 
-    opened, rest = split_open_values(sets)
-    module = module_for(scene_arg, opened)
+    module = module_for(scene_arg)
+    opened, rest = split_open_values(sets, module)
+    module = module_for(scene_arg, opened) if opened else module
     try:
         return note_backlash(System.load(module, **rest))
     except KeyError as err:

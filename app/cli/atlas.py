@@ -18,6 +18,7 @@ from ._common import (
     require,
     system_of,
 )
+from ._output import format_option, write_result
 
 __all__ = ["register"]
 
@@ -33,7 +34,8 @@ def register(sub) -> None:
         "previous x value's end state forward and backward, plus seeded random states) in "
         "the compiled map engine, classify each run (motion per coordinate, largest "
         "Lyapunov exponent, Max/Min, meshing regime) and group the runs into attractors. "
-        "Writes map.json, map.csv and five figures; resumes from DIR/store.",
+        "Writes map.json, map.csv, map.mat (--format) and five figures; resumes from "
+        "DIR/store.",
     )
     mp.add_argument("scene", metavar="SCENE", help="a scene path or built-in name")
     for axis in ("x", "y"):
@@ -106,6 +108,7 @@ def register(sub) -> None:
     )
     mp.add_argument("--scheduler", metavar="ADDRESS", help="dask scheduler address")
     mp.add_argument("--out", metavar="DIR", help="output folder (default map_<model>_<x>_<y>)")
+    format_option(mp, "map")
     mp.add_argument(
         "--json",
         action="store_true",
@@ -144,14 +147,9 @@ def _resolver(scene: str, system, sets: dict, names: tuple[str, str]):
     """System of one grid point: ordinary parameters by ``with_values``; open values
     (those the derivation needs, when the derive layer knows them) through the resolver's
     derivation cache, one model per distinct set of open values."""
-    try:
-        from gearsym.derive.input.open_values import is_open_value
-    except ImportError:  # a derive layer without open values
+    from gearsym.resolve import needs_derivation
 
-        def is_open_value(_name: str) -> bool:
-            return False
-
-    open_axes = [n for n in names if is_open_value(n)]
+    open_axes = [n for n in names if needs_derivation(n, system.module)]
     if not open_axes:
         return None
     from gearsym.resolve import load
@@ -186,7 +184,7 @@ def _bounded(args, runs: int) -> None:
 
 
 def _cmd_map(args) -> int:
-    from gearsym.solver.plots_maps import map_figures
+    from gearsym.solver.plots_maps import write_map_figures
     from gearsym.solver.sweep.atlas import regime_map
 
     xn, xv = _axis(args.x, "--x")
@@ -259,9 +257,10 @@ def _cmd_map(args) -> int:
         )
     except ValueError as err:
         raise Fail(f"map: {err}") from None
-    json_path = result.save(out / "map.json")
-    result.save(out / "map.csv")
-    figures = map_figures(result, out)
+    from gearsym.solver.provenance import provenance
+
+    written = write_result(out, "map", result, args, **provenance(system))
+    figures = write_map_figures(result, out)
     if args.json:
         from gearsym.solver._json import dumps
 
@@ -271,7 +270,7 @@ def _cmd_map(args) -> int:
     if result.resumed:
         print(f"resumed: {result.resumed} finished runs came from {out / 'store'}")
     _summary(result)
-    print(f"wrote {json_path}, map.csv and {len(figures)} figures in {out}")
+    print(f"wrote {', '.join(p.name for p in written)} and {len(figures)} figures in {out}")
     return 0
 
 

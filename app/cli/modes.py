@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import math
 
-from ._common import Fail, figure_file
+from ._common import Fail, figure_file, out_folder
+from ._output import format_option, write_result
 
 __all__ = ["register"]
 
@@ -27,6 +28,8 @@ def register(sub) -> None:
         help="speed range of the first mesh's driver, rpm (default: 0 to twice the scene's)",
     )
     p.add_argument("--plot", metavar="FILE", help="write the resonance diagram (PNG, PDF, SVG)")
+    p.add_argument("--out", metavar="DIR", help="also write modes.json, .csv, .mat (--format)")
+    format_option(p, "modes")
     p.set_defaults(func=_cmd_modes)
 
 
@@ -52,10 +55,18 @@ def _cmd_modes(args) -> int:
     result = modes(module)
     scene_rpm = 60.0 * result.mesh_frequency_hz / result.reference_teeth
     speeds = _speeds(args.speeds, scene_rpm)
+    if args.out:
+        from gearsym.solver.export import Document
+        from gearsym.solver.provenance import provenance
+        from gearsym.solver.system import System
+
+        data = provenance(System.load(module)) | result.to_dict(speeds)
+        write_result(out_folder(args.out), "modes", Document(data, *result.to_table()), args)
     if args.plot:
         from gearsym.solver.plots_modes import campbell_figure
+        from gearsym.solver.plots_style import save_figure
 
-        campbell_figure(result, speeds, args.plot, scene_rpm=scene_rpm)
+        save_figure(campbell_figure(result, speeds, scene_rpm=scene_rpm), args.plot)
     if args.json:
         from gearsym.solver._json import dumps, with_status
 

@@ -16,9 +16,9 @@ from ._common import (
     refuse_conflicts,
     require,
     system_of,
-    write_json,
 )
 from ._limits import MAX_PERIOD, MAX_SEGMENTS, MAX_SETTLED, MAX_TRIES, MIN_STEP, bounded_shoot
+from ._output import branches_document, format_option, write_result
 from ._start import resolve_start, start_options
 
 __all__ = ["register"]
@@ -87,7 +87,12 @@ def register(sub) -> None:
         f"{MAX_SETTLED:,} periods T in all (N x n x (tries + 1))",
     )
     sh.add_argument("--json", action="store_true", help="print the orbit as JSON")
-    sh.add_argument("--out", metavar="DIR", help="also write orbit.json and multipliers.png")
+    sh.add_argument(
+        "--out",
+        metavar="DIR",
+        help="also write orbit.json, .csv, .mat (--format) and multipliers.png",
+    )
+    format_option(sh, "orbit")
     sh.set_defaults(func=_cmd_shoot)
 
     co = sub.add_parser(
@@ -138,8 +143,10 @@ def register(sub) -> None:
     co.add_argument(
         "--out",
         metavar="DIR",
-        help="output folder for branches.json and the figures (default continue_<model>_<param>)",
+        help="output folder for branches.json, .csv, .mat and the figures (default "
+        "continue_<model>_<param>)",
     )
+    format_option(co, "branches")
     co.set_defaults(func=_cmd_continue)
 
 
@@ -216,13 +223,15 @@ def _cmd_shoot(args) -> int:
     data["initial_state"] = start.describe()
     if args.out:
         from gearsym.solver import plots
+        from gearsym.solver.export import Document
+        from gearsym.solver.provenance import provenance
 
-        out = write_json(args.out, "orbit.json", data)
-        plots.multipliers_figure(
-            orbit.floquet.multipliers,
-            out / "multipliers.png",
-            title=f"{system.name}: period-{orbit.n} orbit",
-        )
+        out = out_folder(args.out)
+        doc = Document(provenance(system) | data, *orbit.to_table())
+        write_result(out, "orbit", doc, args)
+        title = f"{system.name}: period-{orbit.n} orbit"
+        fig = plots.multipliers_figure(orbit.floquet.multipliers, title=title)
+        plots.save_figure(fig, out / "multipliers.png")
     if args.compare_monodromy:
         from gearsym.solver.periodic import FlowMap, monodromy_agreement
 
@@ -273,7 +282,6 @@ def _cmd_shoot(args) -> int:
 
 def _cmd_continue(args) -> int:
     from gearsym.solver import plots
-    from gearsym.solver._json import dumps
     from gearsym.solver.periodic import (
         ShootingError,
         StroboscopicMap,
@@ -307,16 +315,16 @@ def _cmd_continue(args) -> int:
             f"{args.settle * args.period:,} periods T, more than {MAX_SETTLED:,}; "
             "lower --settle"
         )
-    from gearsym.derive.input.open_values import is_open_value
+    from gearsym.resolve import needs_derivation
 
-    if is_open_value(args.param):
+    refuse_conflicts(args, [args.param], f"--param {args.param}")
+    system = system_of(args.scene, parse_set(args.set))
+    if needs_derivation(args.param, system.module):
         raise Fail(
             f"--param {args.param}: an open value (each value derives its own model), "
             "not a parameter to continue; map it with `gearsym map`, or set one value "
             "with --set"
         )
-    refuse_conflicts(args, [args.param], f"--param {args.param}")
-    system = system_of(args.scene, parse_set(args.set))
     from gearsym.solver.integrate.simulate import check_start
 
     for option, value in (("--from", args.from_), ("--to", args.to)):
@@ -365,26 +373,19 @@ def _cmd_continue(args) -> int:
                     )
                 except ShootingError as err:
                     print(f"  branch switching at {bif.value:.6g} failed: {err}")
-    (out / "branches.json").write_text(
-        dumps([b.describe() for b in branches], indent=1), encoding="utf-8"
-    )
-    plots.branch_figure(
-        branches,
-        out / "branches.png",
-        system.coordinates,
-        title=f"{system.name}: continuation in {args.param}",
-        system=system,
-    )
+    written = write_result(out, "branches", branches_document(system, branches), args)
+    title = f"{system.name}: continuation in {args.param}"
+    fig = plots.branch_figure(branches, system.coordinates, title=title, system=system)
+    plots.save_figure(fig, out / "branches.png")
     for k, br in enumerate(branches):
         smap = StroboscopicMap(system, br.n)
         for b in br.bifurcations:
             lam = b.value
             _, M, _ = smap.jacobian(b.x0, system.parameters_with(**{args.param: lam}))
-            plots.multipliers_figure(
-                np.linalg.eigvals(M),
-                out / f"multipliers_{k}_{b.kind}_{lam:.6g}.png",
-                title=f"{b.kind} at {args.param} = {lam:.6g}",
+            fig = plots.multipliers_figure(
+                np.linalg.eigvals(M), title=f"{b.kind} at {args.param} = {lam:.6g}"
             )
+            plots.save_figure(fig, out / f"multipliers_{k}_{b.kind}_{lam:.6g}.png")
     for br in branches:
         stable = sum(br.stable)
         print(f"period-{br.n} branch: {len(br.values)} points, {stable} stable; {br.message}")
@@ -393,5 +394,5 @@ def _cmd_continue(args) -> int:
                 f"  {b.kind:<16} {args.param} = {b.value:.8g}  multiplier "
                 f"{b.multiplier.real:+.6f}{b.multiplier.imag:+.6f}i"
             )
-    print(f"wrote {out / 'branches.json'} and {out / 'branches.png'}")
+    print(f"wrote {', '.join(p.name for p in written)} and branches.png in {out}")
     return 0

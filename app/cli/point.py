@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import sys
 
-import numpy as np
-
 from ._common import (
     MAX_TOTAL_PERIODS,
     Fail,
@@ -18,8 +16,8 @@ from ._common import (
     refuse_conflicts,
     require,
     system_of,
-    write_json,
 )
+from ._output import format_option, write_result
 from ._start import resolve_start, start_options
 
 __all__ = ["register"]
@@ -39,7 +37,18 @@ def register(sub) -> None:
     analysis_options(si)
     start_options(si)
     si.add_argument("--json", action="store_true", help="print everything as JSON")
-    si.add_argument("--out", metavar="DIR", help="also write point.json and point.png")
+    si.add_argument(
+        "--units",
+        choices=("model", "physical"),
+        default="model",
+        help="physical: deflections (dynamic transmission error) in µm, mesh forces in N with "
+        "the dynamic factor, frequencies in Hz and orders of the mesh frequency, the speed "
+        "in rpm; model: the model's non-dimensional units",
+    )
+    si.add_argument(
+        "--out", metavar="DIR", help="also write point.json, .csv, .mat (--format) and point.png"
+    )
+    format_option(si, "point")
     si.set_defaults(func=_cmd_simulate)
 
     sw = sub.add_parser(
@@ -77,11 +86,12 @@ def register(sub) -> None:
         "--scheduler", metavar="ADDRESS", help="dask scheduler address, e.g. tcp://head:8786"
     )
     sw.add_argument("--out", metavar="DIR", help="output folder (default sweep_<model>_<param>)")
+    format_option(sw, "sweep")
     sw.add_argument("--quiet", action="store_true", help="no progress bar")
     sw.add_argument(
         "--no-figure",
         action="store_true",
-        help="write the data only (sweep.json), not bifurcation.png",
+        help="write the data only (sweep.json, .csv, .mat), not bifurcation.png",
     )
     analysis_options(sw)
     sw.set_defaults(func=_cmd_sweep)
@@ -103,11 +113,17 @@ def _cmd_simulate(args) -> int:
         raise Fail(f"{where}: {err}") from None
     data = result.describe()
     data["initial_state"] = start.describe()
+    from gearsym.solver.units import Units, point_in_units
+
+    units = Units.of(system, args.units)
+    in_units = point_in_units(result, units)
+    data["in_units"] = in_units
     if args.out:
         from gearsym.solver import plots
 
-        out = write_json(args.out, "point.json", data)
-        plots.point_figure(result, out / "point.png", title=system.name)
+        out = out_folder(args.out)
+        write_result(out, "point", result, args, initial_state=data["initial_state"])
+        plots.save_figure(plots.point_figure(result, title=system.name), out / "point.png")
     tr = result.trajectory
     # exit status 3: the run ended invalid, divergent or failed (docs/user-guide.md)
     code = 0 if tr.status == "ok" else 3
@@ -131,12 +147,25 @@ def _cmd_simulate(args) -> int:
         return "n/a" if v is None else format(v, fmt)
 
     shares = meshing_states(tr)
+    if units.physical:
+        print(f"  operating point: {in_units['operating_point']}")
     for c, k in result.classification.items():
-        u = tr.coordinate(c)
-        u = u[np.isfinite(u)]
-        low, high = (float(u.min()), float(u.max())) if u.size else (None, None)
-        peaks = ", ".join(f"{p['frequency']:.3g}" for p in result._spectrum(c).peaks()[:4])
+        row = in_units["coordinates"][c]
+        low, high = row["range"] or (None, None)
+        peaks = ", ".join(f"{p['frequency']:.4g}" for p in row["peaks"])
         line = f"  {c}: range [{num(low)}, {num(high)}]  peaks at {peaks or 'n/a'}"
+        if units.physical:
+            orders = ", ".join(f"{p['order']:.3g}" for p in row["peaks"])
+            line = (
+                f"  {c}: dynamic TE [{num(low, '.2f')}, {num(high, '.2f')}] µm  peaks at "
+                f"{peaks or 'n/a'} Hz (orders {orders or 'n/a'})"
+            )
+            if row.get("force_range"):
+                fl, fh = row["force_range"]
+                df = row["dynamic_factor"]
+                line += f"\n      mesh force [{fl:.4g}, {fh:.4g}] N, dynamic factor " + (
+                    f"{df:.3f}" if df is not None else "n/a (no static load)"
+                )
         if c in shares:
             f, s, b = (num(shares[c][key], ".2f") for key in ("forward", "separated", "backward"))
             line += f"  force forward/zero/backward {f}/{s}/{b}"
@@ -199,15 +228,15 @@ def _cmd_sweep(args) -> int:
             f"{MAX_SWEEP_POINTS:,} points and {MAX_TOTAL_PERIODS:.0e} periods in all "
             "(hours of work); sweep fewer points or periods"
         )
-    from gearsym.derive.input.open_values import is_open_value
+    from gearsym.resolve import needs_derivation
 
-    if is_open_value(args.param):
+    system = system_of(args.scene, parse_set(args.set))
+    if needs_derivation(args.param, system.module):
         raise Fail(
             f"--param {args.param}: an open value (each value derives its own model); sweep "
             f"it with `gearsym map {args.scene} --x {args.param}=START:STOP:NUM --y "
             "lambda=...`, or set one value with --set"
         )
-    system = system_of(args.scene, parse_set(args.set))
     from gearsym.solver.sweep.chains import checked_values
 
     try:
@@ -234,15 +263,15 @@ def _cmd_sweep(args) -> int:
     failed = [p.value for p in result.points if not p.ok]
     if result.resumed:
         print(f"resumed: {result.resumed} of {len(values)} points came from {out / 'store'}")
-    path = result.save(out / "sweep.json")
+    path, *_ = write_result(out, "sweep", result, args)
     if figure:
         from gearsym.solver import plots
 
-        fig = plots.bifurcation_diagram(
-            [result],
-            list(system.coordinates),
+        fig = plots.save_figure(
+            plots.bifurcation_diagram(
+                [result], list(system.coordinates), title=f"{system.name}: {args.param} sweep"
+            ),
             out / "bifurcation.png",
-            title=f"{system.name}: {args.param} sweep",
         )
         print(f"wrote {path} and {fig}")
     else:

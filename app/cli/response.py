@@ -17,6 +17,7 @@ from ._common import (
     system_of,
 )
 from ._limits import MAX_PERIOD
+from ._output import format_option, write_result
 
 __all__ = ["register"]
 
@@ -117,11 +118,15 @@ def register(sub) -> None:
         help=f"integration: periods sampled at each frequency (at most {MAX_SETTLE:,})",
     )
     fr.add_argument(
-        "--physical",
-        action="store_true",
-        help="figure in mesh frequency (Hz) and transmission-error amplitude (µm)",
+        "--units",
+        choices=("model", "physical"),
+        default="model",
+        help="physical: the figure in mesh frequency (Hz) and dynamic transmission-error "
+        "amplitude (µm); model: the model's non-dimensional units",
     )
+    fr.add_argument("--physical", action="store_true", help="the same as --units physical")
     fr.add_argument("--out", metavar="DIR", help="output folder (default response_<model>)")
+    format_option(fr, "frequency_response")
     fr.add_argument("--json", action="store_true", help="print one JSON record per solution point")
     fr.add_argument("--no-figure", action="store_true", help="write the data only")
     fr.set_defaults(func=_cmd_response)
@@ -188,7 +193,7 @@ def _bounded(args, system, num: int, methods, cap: int, span: float) -> None:
 
 
 def _cmd_response(args) -> int:
-    from gearsym.derive.input.open_values import is_open_value
+    from gearsym.resolve import needs_derivation
     from gearsym.solver._json import dumps
     from gearsym.solver.periodic import HarmonicBalanceError, ShootingError
     from gearsym.solver.sweep.frequency import frequency_response, harmonics_cap
@@ -200,14 +205,14 @@ def _cmd_response(args) -> int:
         raise Fail(f"--period must be >= 1, got {args.period}")
     if args.tail is not None and not (0 < args.tail < 1):
         raise Fail(f"--tail must be a share in (0, 1), got {args.tail}")
-    if is_open_value(name):
+    refuse_conflicts(args, [name], f"--param {args.param}")
+    system = system_of(args.scene, parse_set(args.set))
+    if needs_derivation(name, system.module):
         raise Fail(
             f"--param {name}: an open value (each value derives its own model), not a "
             "parameter to continue; map it with `gearsym map`, or set one value with "
             "--set"
         )
-    refuse_conflicts(args, [name], f"--param {args.param}")
-    system = system_of(args.scene, parse_set(args.set))
     for value in (start, stop):
         try:
             system.parameters_with(**{name: value})
@@ -245,18 +250,19 @@ def _cmd_response(args) -> int:
         )
     except (HarmonicBalanceError, ShootingError) as err:
         raise RunFailed(f"frequency-response: {err}") from None
-    (out / "frequency_response.json").write_text(dumps(resp.to_dict(), indent=1), encoding="utf-8")
-    resp.save(out / "frequency_response.csv")
-    resp.save(out / "frequency_response.mat")
+    written = write_result(out, "frequency_response", resp, args)
     figure = None
     if not args.no_figure:
         from gearsym.solver.plots_response import frequency_response_figure
+        from gearsym.solver.plots_style import save_figure
 
-        figure = frequency_response_figure(
-            resp,
+        figure = save_figure(
+            frequency_response_figure(
+                resp,
+                physical=args.physical or args.units == "physical",
+                title=f"{system.name}: period-{args.period} response over {name}",
+            ),
             out / "frequency_response.png",
-            physical=args.physical,
-            title=f"{system.name}: period-{args.period} response over {name}",
         )
     if args.json:
         for rec in resp.records():
@@ -298,6 +304,6 @@ def _cmd_response(args) -> int:
             print(f"  note: {note}")
         if c.details.get("status") in ("boundary", "max-points"):
             print(f"  {c.details['message']}")
-    print(f"wrote {out / 'frequency_response.json'}" + (f" and {figure}" if figure else ""))
+    print(f"wrote {written[0]}" + (f" and {figure}" if figure else ""))
     sys.stdout.flush()
     return 0

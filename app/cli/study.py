@@ -24,7 +24,9 @@ def register(sub) -> None:
     )
     rp.add_argument("--quick", action="store_true", help="coarse resolution (under a minute)")
     rp.add_argument("--serial", action="store_true", help="one process only")
-    rp.add_argument("--quiet", action="store_true", help="no progress bar")
+    rp.add_argument(
+        "--quiet", action="store_true", help="no progress lines on stderr (otherwise one per stage)"
+    )
     rp.set_defaults(func=_cmd_reproduce)
 
     be = sub.add_parser(
@@ -54,19 +56,15 @@ def register(sub) -> None:
 
 
 def _cmd_reproduce(args) -> int:
-    import time
-
     from gearsym.studies.reproduce import reproduce
 
-    started = time.perf_counter()
-    report = reproduce(
+    done = reproduce(
         Path(args.out),
         quick=args.quick,
         executor="serial" if args.serial else "processes",
         progress=not args.quiet,
     )
-    print(f"wrote {report} ({time.perf_counter() - started:.0f} s)")
-    print(report.read_text(encoding="utf-8").split("## Figures")[0])
+    print(done.summary())  # the report itself is in its file only
     return 0
 
 

@@ -46,7 +46,7 @@ def _difference(a, b, state: str) -> float:
 
 
 def _figure(torsional, bearing, path: Path) -> Path:
-    from gearsym.solver.plots import _save, plt
+    from gearsym.solver.plots import plt, save_figure
 
     fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
     for col, ((case, f1), tor, bea) in enumerate(zip(_CASES, torsional, bearing, strict=True)):
@@ -67,7 +67,7 @@ def _figure(torsional, bearing, path: Path) -> Path:
             if row == 1:
                 ax.set_xlabel("lambda = |f2/f1|")
     axes[0, 0].legend(loc="best", fontsize=8, markerscale=3)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def bearings_section(torsional: list, bearing: list, out: Path) -> str:

@@ -28,7 +28,7 @@ def _long_enough(r) -> bool:
     return int(seen.get("budget") or 0) >= LONG_BUDGET
 
 
-def lengthen(pairs, settings: dict, *, executor: str, workers: int | None) -> list:
+def lengthen(pairs, settings: dict, *, executor: str, workers: int | None, progress=None) -> list:
     """Each run of ``pairs`` continued with the long budget where it needs it.
 
     Parameters
@@ -37,6 +37,9 @@ def lengthen(pairs, settings: dict, *, executor: str, workers: int | None) -> li
         The model at the run's parameter values and the run.
     settings : dict
         ``method``, ``rtol``, ``atol`` of the runs.
+    progress : callable, optional
+        ``progress(total)`` -> a :class:`~gearsym.solver.sweep.progress.Progress` of the
+        runs continued (called once, before they start).
 
     Returns
     -------
@@ -61,8 +64,9 @@ def lengthen(pairs, settings: dict, *, executor: str, workers: int | None) -> li
         Look(str(pairs[k][0].module.__file__), tuple(map(float, pairs[k][0].p)), out[k], options)
         for k in todo
     ]
+    bar = progress(len(looks)) if progress is not None else None
     if looks:
-        done = map_tasks(run_look, looks, executor=executor, workers=workers)
+        done = map_tasks(run_look, looks, executor=executor, workers=workers, on_result=bar)
         for k, r in zip(todo, done, strict=True):
             out[k] = r
     return out
@@ -78,7 +82,9 @@ def periods_run(records) -> str:
     return f"run {n[0]:,} to {n[-1]:,} periods"
 
 
-def lengthen_sweeps(items, select, settings: dict, *, executor: str, workers: int | None):
+def lengthen_sweeps(
+    items, select, settings: dict, *, executor: str, workers: int | None, progress=None
+):
     """Sweeps with the runs ``select`` picks continued with the long budget (one batch
     over every sweep, so the workers share it).
 
@@ -88,6 +94,8 @@ def lengthen_sweeps(items, select, settings: dict, *, executor: str, workers: in
         Each sweep and its model (at the sweep's base values).
     select : callable (SweepResult, value, RunRecord) -> bool
         Whether a run carries a claim.
+    progress : callable, optional
+        As for :func:`lengthen`.
 
     Returns
     -------
@@ -100,7 +108,7 @@ def lengthen_sweeps(items, select, settings: dict, *, executor: str, workers: in
             if select(sw, float(v), r):
                 pairs.append((system.with_values(**{sw.parameter: float(v)}), r))
                 where.append((j, k))
-    done = lengthen(pairs, settings, executor=executor, workers=workers)
+    done = lengthen(pairs, settings, executor=executor, workers=workers, progress=progress)
     points = [list(sw.points) for sw, _ in items]
     changed = set()
     for (j, k), r, (_, before) in zip(where, done, pairs, strict=True):

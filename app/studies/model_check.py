@@ -14,6 +14,7 @@ among them a spurious stable one on the unloaded side while ``0 < |F| < F*``
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -32,7 +33,10 @@ def _dead(x: float) -> float:
     return 0.0 if abs(x) <= 1 else x - math.copysign(1.0, x)
 
 
+@functools.lru_cache(maxsize=2)
 def _model(scene: str):
+    """The derived Model of a scene (SymPy, seconds): derived once per process for the
+    model check and the sensitivity section's physical scales."""
     from gearsym.derive import derive_model, load_target, resolve_target
 
     return derive_model(load_target(resolve_target(scene)))

@@ -47,7 +47,10 @@ def analyse_all(sweeps: dict, models: dict, settings: dict, out, files: dict, **
     out : Path
         Where figures go (data under ``out/data``); their names go into ``files[model]``.
     batch : dict
-        ``quick``, ``executor``, ``workers``.
+        ``quick``, ``executor``, ``workers``; optional ``progress``: ``progress(total)`` ->
+        a :class:`~gearsym.solver.sweep.progress.Progress` of the tasks; optional
+        ``figures``: ``(function, args)`` pairs (module-level functions that draw and save
+        a figure from data the batch does not change), drawn by the workers beside the runs.
 
     Returns
     -------
@@ -103,7 +106,14 @@ def analyse_all(sweeps: dict, models: dict, settings: dict, out, files: dict, **
             title = f"{case} load, lambda = {value:.4g}: a point the sweep judged chaotic"
             keys.append(("polynomial", "chaotic", case, value))
             tasks.append(("point", (at, hit.x_final, settings, (path, title, None))))
-    done = map_tasks(_run, tasks, executor=batch["executor"], workers=batch["workers"])
+    for k, call in enumerate(batch.get("figures", ())):  # short: after the runs
+        keys.append(("figure", "call", k))
+        tasks.append(("call", call))
+    progress = batch.get("progress")
+    bar = progress(len(tasks)) if progress is not None else None
+    done = map_tasks(
+        _run, tasks, executor=batch["executor"], workers=batch["workers"], on_result=bar
+    )
     return {k: r for k, r in zip(keys, done, strict=True) if k[0] != "figure"}
 
 
@@ -112,6 +122,10 @@ def _run(task: tuple):
     from gearsym.solver import plots
 
     kind, args = task
+    if kind == "call":
+        function, call_args = args
+        function(*call_args)
+        return None
     if kind == "continue":
         return _continue_case(*args)
     if kind == "response":
@@ -121,13 +135,14 @@ def _run(task: tuple):
         return frequency_response(system, "omega", lo, hi, points=num, harmonics=harmonics)
     if kind == "bifurcation":
         sweeps, path, title, system = args
-        plots.bifurcation_diagram(sweeps, ["u", "v"], path, title=title, system=system)
+        fig = plots.bifurcation_diagram(sweeps, ["u", "v"], title=title, system=system)
+        plots.save_figure(fig, path)
         return None
     system, x0, options, draw = args
     result = analyse_point(system, x0, **options)
     if draw is not None:
         path, title, data = draw
-        plots.point_figure(result, path, title=title)
+        plots.save_figure(plots.point_figure(result, title=title), path)
         if data is not None:
             data.write_text(dumps(result.describe()), encoding="utf-8")
     return result

@@ -8,7 +8,7 @@ import numpy as np
 from .cases import CASES
 from .claims import NOT_A_CLAIM, NOT_TESTED, STUDY, Found, carried, findings, runs, runs_text
 
-__all__ = ["findings_table", "report", "runs", "runs_text", "stable_coverage"]
+__all__ = ["findings_table", "graded", "report", "runs", "runs_text", "stable_coverage", "tally"]
 
 
 def _verdict(ok) -> str:
@@ -90,14 +90,37 @@ def findings_table(study: dict, poly: dict, dead: dict) -> list[str]:
     return rows
 
 
-def report(res, lam, bundles: dict, elapsed, quick, systems, branches, method: str) -> str:
-    """The report's Markdown up to its figure list (``bundles``: "polynomial" and "dead
-    zone", each a :class:`Bundle`; ``systems``: case -> System of the polynomial)."""
-    poly, dead = bundles["polynomial"], bundles["dead zone"]
+def graded(bundles: dict, lam, res) -> dict:
+    """``{"polynomial": findings, "dead zone": findings}``: each finding of the study
+    graded on each model's runs (``claims.findings``)."""
     map_lam = np.round(np.linspace(0.0, 1.0, res.map_points), 10)
-    rows = findings_table(
-        STUDY, findings(poly, lam, map_lam, CASES), findings(dead, lam, map_lam, CASES)
-    )
+    return {name: findings(bundles[name], lam, map_lam, CASES) for name in bundles}
+
+
+def tally(found: dict) -> dict:
+    """Per model, how many of the study's findings agree, partly agree, differ or were
+    not tested (as the findings table grades them; observations the study did not make
+    are not counted); only the verdicts that occur."""
+    out = {}
+    for model, per in found.items():
+        grades = [f.grade for f in per.values() if f.grade != NOT_A_CLAIM]
+        counts = {_verdict(g).strip("*"): 0 for g in grades}
+        for g in grades:
+            counts[_verdict(g).strip("*")] += 1
+        order = ("agrees", "partly", "differs", "not tested")
+        out[model] = {v: counts[v] for v in order if v in counts}
+    return out
+
+
+def report(
+    res, lam, bundles: dict, elapsed, quick, systems, branches, method: str, found=None
+) -> str:
+    """The report's Markdown up to its figure list (``bundles``: "polynomial" and "dead
+    zone", each a :class:`Bundle`; ``systems``: case -> System of the polynomial;
+    ``found``: :func:`graded`'s result, computed here if not given)."""
+    poly, dead = bundles["polynomial"], bundles["dead zone"]
+    found = found or graded(bundles, lam, res)
+    rows = findings_table(STUDY, found["polynomial"], found["dead zone"])
     cont_lines = []
     for case, _, f1 in CASES:
         found = sorted(

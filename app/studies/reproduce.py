@@ -12,15 +12,15 @@ the study leaves open are those of the shipped scenes, stated in their files.
 from __future__ import annotations
 
 import hashlib
-import sys
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 from gearsym.solver._json import dumps
 from gearsym.solver.integrate import fastest_method
-from gearsym.solver.sweep import Progress, SweepJob, sweep_many
+from gearsym.solver.sweep import SweepJob, sweep_many
+from gearsym.solver.sweep.progress import Stages, fmt_seconds
 from gearsym.solver.system import System
 
 from .bearings import bearing_jobs, bearings_section
@@ -29,9 +29,51 @@ from .claims import Bundle
 from .figures import figure_list
 from .long_runs import lengthen_sweeps
 from .points import analyse_all, pick
-from .report import FIGURES_MARK, report
+from .report import FIGURES_MARK, graded, report, tally
+from .sensitivity import STAGES as SENSITIVITY_STAGES
 
-__all__ = ["reproduce"]
+__all__ = ["STAGES", "Reproduced", "reproduce", "verdict_words"]
+
+# the stages of a run, in order, as the progress lines and the timings name them
+STAGES = (
+    "lambda sweeps and maps (points)",
+    "runs the claims rest on, continued (runs)",
+    "operating points, branches, responses (tasks)",
+    "figures (figures)",
+    *SENSITIVITY_STAGES,
+    "report (sections)",
+)
+
+
+def verdict_words(counts: dict) -> str:
+    """``{"agrees": 4, "partly": 2}`` -> ``'4 agree, 2 partly agree'``."""
+    plural = {"agrees": "agree", "partly": "partly agree", "differs": "differ"}
+    return ", ".join(f"{n} {plural.get(v, v)}" for v, n in counts.items())
+
+
+@dataclass(frozen=True)
+class Reproduced:
+    """What a run of :func:`reproduce` wrote and how it went: the report's path, the
+    count of each verdict per model (``{"polynomial": {"agrees": 3, ...}, ...}``), the
+    wall time and ``(stage, seconds)`` per stage."""
+
+    report: Path
+    verdicts: dict
+    seconds: float
+    stages: tuple
+
+    def summary(self) -> str:
+        """A few lines for the end of a run: the verdicts, the time, where things are."""
+        lines = []
+        for model, counts in self.verdicts.items():
+            lines.append(f"findings of the study, {model}: {verdict_words(counts)}")
+        folder = self.report.parent
+        lines += [
+            f"time: {fmt_seconds(self.seconds)}",
+            f"report: {self.report}",
+            f"figures: {folder}/*.png, {folder / 'sensitivity'}/; data: {folder / 'data'}/",
+        ]
+        return "\n".join(lines)
 
 
 def reproduce(
@@ -41,15 +83,12 @@ def reproduce(
     executor: str = "processes",
     workers: int | None = None,
     progress: bool = True,
-) -> Path:
+) -> Reproduced:
     """Run everything, write figures, data and ``report.md`` under ``out``; return the
-    report's path."""
+    report's path, the verdicts' tally and how long each stage took.  Progress goes to
+    stderr, one line per stage (:class:`~gearsym.solver.sweep.progress.Stages`)."""
     res = RESOLUTIONS["quick" if quick else "full"]
-
-    def stage(text: str) -> None:
-        if progress:
-            print(f"reproduce: {text} ({time.perf_counter() - started:.0f} s)", file=sys.stderr)
-
+    stages = Stages(len(STAGES), "reproduce", enabled=progress)
     out = Path(out)
     (out / "data").mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
@@ -95,11 +134,12 @@ def reproduce(
         for group in groups.values()
         for job in group
     ]
-    bar = Progress(sum(len(j.values) for j in jobs), "sweeps", enabled=progress)
+    bar = stages.stage(
+        STAGES[0], sum(len(j.values) for j in jobs), after="now the border runs, re-examined"
+    )
     done = iter(sweep_many(jobs, executor=executor, workers=workers, progress=bar))
     got = {name: [next(done) for _ in group] for name, group in groups.items()}
-    stage("sweeps done; the runs the claims rest on, with the long budget")
-    got = _lengthen_claims(got, groups, settings, executor, workers)
+    got = _lengthen_claims(got, groups, settings, executor, workers, stages)
     by_case = {case: got["cases"][2 * k : 2 * k + 2] for k, (case, _, _) in enumerate(CASES)}
     dead_case = {case: got["dead cases"][2 * k : 2 * k + 2] for k, (case, _, _) in enumerate(CASES)}
     bearing_sweeps, maps = got["bearings"], got["maps"]
@@ -124,32 +164,45 @@ def reproduce(
     files["dead zone"]["model_hash"] = dead["light"].model_hash
     from gearsym.solver import plots
 
-    stage("sweeps done; figures")
     from .figures import backlash_figure, floquet_figure, stiffness_figure, sweep_state_figure
 
+    # figures of what the batch does not change, drawn by its workers (in this process
+    # they kept both workers idle)
     start = "start: each mesh pressed into contact by its load, at rest; then each point from"
-    for case, _, f1 in CASES:
-        sweep_state_figure(
-            by_case[case],
-            out / f"meshing_lyapunov_{case}.png",
-            f"{case} load, f1 = {f1}: meshing state and largest Lyapunov exponent",
-            f"{systems[case].name}, scene values (no overrides); {start} the previous one's "
-            f"end state; {res.transient} + {res.periods} periods, {method} "
-            f"rtol {TOLERANCES['rtol']:g}",
-        )
     plain = f"{systems['light'].name}, scene values (no overrides)"
-    backlash_figure(systems["light"], out / "backlash.png", plain)
-    stiffness_figure(systems["light"], out / "stiffness.png", plain)
-
-    stage(
-        "operating points lambda = 0.1, 0.8 (both models, from the sweep and from rest), "
-        "chaotic points, periodic branches and frequency responses, as one batch"
-    )
+    drawn = [
+        (
+            sweep_state_figure,
+            (
+                by_case[case],
+                out / f"meshing_lyapunov_{case}.png",
+                f"{case} load, f1 = {f1}: meshing state and largest Lyapunov exponent",
+                f"{systems[case].name}, scene values (no overrides); {start} the previous "
+                f"one's end state; {res.transient} + {res.periods} periods, {method} "
+                f"rtol {TOLERANCES['rtol']:g}",
+            ),
+        )
+        for case, _, f1 in CASES
+    ]
+    drawn += [
+        (backlash_figure, (systems["light"], out / "backlash.png", plain)),
+        (stiffness_figure, (systems["light"], out / "stiffness.png", plain)),
+    ]
     sweeps = {"polynomial": by_case, "dead zone": dead_case}
     models = {"polynomial": systems, "dead zone": dead}
     done = analyse_all(
-        sweeps, models, settings, out, files, quick=quick, executor=executor, workers=workers
+        sweeps,
+        models,
+        settings,
+        out,
+        files,
+        quick=quick,
+        executor=executor,
+        workers=workers,
+        progress=lambda total: stages.stage(STAGES[2], total),
+        figures=drawn,
     )
+    bar = stages.stage(STAGES[3], 6)  # the f1 map, 2 x 2 of the branches, the responses
     from .mechanisms import mechanisms_section
 
     points, dead_points = pick(done, "polynomial", "sweep"), pick(done, "dead zone", "sweep")
@@ -161,26 +214,27 @@ def reproduce(
     max_u = [sw.maxima("u") for sw in maps]
     min_v = [sw.minima("v") for sw in maps]
     motion_v = [sw.motion("v") for sw in maps]
-    plots.map_figure(
+    fig = plots.map_figure(
         np.array(res.map_f1),
         map_lam,
         max_u,
         min_v,
         motion_v,
-        out / "map_f1_lambda.png",
         title="light-load scene with f1 varied",
         names=("f1", "lambda", "u", "v"),
     )
+    plots.save_figure(fig, out / "map_f1_lambda.png")
+    bar.step()
     branches = {case: done[("branches", case)] for case, _, _ in CASES}
     for case, _, f1 in CASES:
-        plots.branch_figure(
+        fig = plots.branch_figure(
             branches[case],
-            out / f"continuation_{case}.png",
             ("u", "v"),
             sweeps=by_case[case],
             title=f"{case} load, f1 = {f1}: periodic branches over the sweeps",
             system=systems[case],
         )
+        plots.save_figure(fig, out / f"continuation_{case}.png")
         floquet_figure(
             branches[case],
             out / f"floquet_{case}.png",
@@ -191,20 +245,22 @@ def reproduce(
         (out / "data" / f"continuation_{case}.json").write_text(
             dumps([b.describe() for b in branches[case]]), encoding="utf-8"
         )
+        bar.step(n=2)
     from .response import response_section, run_response
 
-    stage("frequency response around omega = 0.5: report")
     responses = {k[1:]: r for k, r in done.items() if k[0] == "response"}
     response_rows = run_response(out, systems, CASES, points, quick=quick, done=responses)
+    bar.step()
     from .report_sensitivity import sensitivity_section
     from .sensitivity import SCENES, physical_scales, run_sensitivity
 
-    stage("sensitivity to the open values (regime maps; store under out/store)")
     rows = run_sensitivity(
-        out, res, settings, quick=quick, executor=executor, workers=workers, progress=progress
+        out, res, settings, quick=quick, executor=executor, workers=workers, stages=stages
     )
+    bar = stages.stage(STAGES[6], 5)
     scales = physical_scales(SCENES["light"][0])
     section = sensitivity_section(rows, scales, {c: f1 for c, (_, f1) in SCENES.items()}, points)
+    bar.step()
     elapsed = time.perf_counter() - started
     bundles = {
         "polynomial": Bundle("polynomial", by_case, points, maps, res.map_f1, files["polynomial"]),
@@ -212,18 +268,24 @@ def reproduce(
             "dead zone", dead_case, dead_points, got["dead maps"], res.map_f1, files["dead zone"]
         ),
     }
-    text = report(res, lam, bundles, elapsed, quick, systems, branches, method)
+    found = graded(bundles, lam, res)
+    text = report(res, lam, bundles, elapsed, quick, systems, branches, method, found=found)
     head, sep, tail = text.partition("## Figures")
-    stage("the lambda sweeps on bearings: report")
+    bar.step()
     forward = [by_case[case][0] for case, _, _ in CASES]
     bearings = bearings_section(forward, bearing_sweeps, out)
+    bar.step()
     from .model_check import model_check_section
 
+    checked = model_check_section(systems, {case: f1 for case, _, f1 in CASES})
+    bar.step()
+    mechanisms = mechanisms_section(starts)
+    bar.step()
     text = (
         head
-        + model_check_section(systems, {case: f1 for case, _, f1 in CASES})
+        + checked
         + "\n"
-        + mechanisms_section(starts)
+        + mechanisms
         + "\n"
         + response_section(response_rows)
         + "\n"
@@ -237,29 +299,40 @@ def reproduce(
     text = text.replace(FIGURES_MARK, figure_list(out))
     path = out / "report.md"
     path.write_text(text, encoding="utf-8")
-    return path
+    stages.end()
+    return Reproduced(path, tally(found), time.perf_counter() - started, tuple(stages.times))
 
 
-def _lengthen_claims(got: dict, groups: dict, settings, executor, workers) -> dict:
+def _lengthen_claims(got: dict, groups: dict, settings, executor, workers, stages) -> dict:
     """The sweeps with every run a claim may rest on continued with the long budget:
     the forward case sweeps' non-periodic runs in the study's low-lambda ranges (u
     quasi-periodic up to 0.57 light, 0.13 heavy; v chaotic up to 0.3) and the maps'
-    non-periodic runs (the trend of Min(v) over chaotic points)."""
+    non-periodic runs (the trend of Min(v) over chaotic points).  One batch for all, so
+    that the workers share it."""
     low = {0.1: 0.57, 0.5: 0.3}  # f1 -> the largest lambda of a low-lambda claim
+    names = ("cases", "dead cases", "maps", "dead maps")
+    on_maps = {id(sw) for n in names[2:] for sw in got[n]}
 
-    def on_cases(sw, value, r):
+    def select(sw, value, r):
+        if id(sw) in on_maps:
+            return True
         f1 = float(sw.base_values.get("f1", 0.1 if "light" in sw.model else 0.5))
         return sw.direction == "forward" and value <= low.get(f1, 0.57) + 1e-9
 
-    def on_maps(sw, value, r):
-        return True
-
+    items = [(sw, job.system) for n in names for sw, job in zip(got[n], groups[n], strict=True)]
+    longer = iter(
+        lengthen_sweeps(
+            items,
+            select,
+            settings,
+            executor=executor,
+            workers=workers,
+            progress=lambda total: stages.stage(STAGES[1], total),
+        )
+    )
     out = dict(got)
-    for names, select in ((("cases", "dead cases"), on_cases), (("maps", "dead maps"), on_maps)):
-        items = [(sw, job.system) for n in names for sw, job in zip(got[n], groups[n], strict=True)]
-        longer = iter(lengthen_sweeps(items, select, settings, executor=executor, workers=workers))
-        for n in names:
-            out[n] = [next(longer) for _ in got[n]]
+    for n in names:
+        out[n] = [next(longer) for _ in got[n]]
     return out
 
 

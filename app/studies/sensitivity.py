@@ -10,7 +10,6 @@ before any run.
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -54,6 +53,11 @@ FINDINGS = {
     ),
 }
 SCENES = {"light": ("reference-light", 0.1), "heavy": ("reference-heavy", 0.5)}
+# the stages of run_sensitivity, as its progress lines name them
+STAGES = (
+    "sensitivity: models derived and compiled (models)",
+    "sensitivity: regime maps, long runs and figures (maps)",
+)
 
 
 @dataclass
@@ -82,9 +86,12 @@ def is_text(values) -> bool:
 
 def _load_value(scene: str, f1: float, reading: str, key: str, value):
     """The System of ``scene`` in ``reading`` with the open value ``key`` = ``value``
-    (one derivation, cached)."""
+    (one derivation, cached, where ``key`` is not a parameter of the model; ``key``
+    None: the scene's own model in ``reading``)."""
     from gearsym.resolve import load
 
+    if key is None:
+        return load(scene, load_reading=reading)
     if key == "backlash":
         return load(BACKLASH_SCENES[value] or scene, load_reading=reading, f1=f1)
     return load(scene, load_reading=reading, **{key: value})
@@ -142,121 +149,138 @@ def _named(records, key, values):
     return [{**r, key: values[int(round(r[key]))]} for r in records]
 
 
-def run_sensitivity(out: Path, res, settings: dict, *, quick, executor, workers, progress):
+def _derives(module, key: str, value) -> bool:
+    """Whether ``load`` derives a model of its own for ``key`` = ``value`` (an open value
+    of the derivation) rather than setting it as a parameter of ``module`` (the generated
+    model of the map's scene and reading)."""
+    if key == "backlash":
+        return True
+    from gearsym.resolve import split_open_values
+
+    return bool(split_open_values({key: value}, module)[0])
+
+
+def run_sensitivity(out: Path, res, settings: dict, *, quick, executor, workers, stages=None):
     """Regime maps over lambda by each open value at both loads, in both load readings;
-    figures and data under ``out``; a list of :class:`Sensitivity` rows."""
+    figures and data under ``out``; a list of :class:`Sensitivity` rows.  ``stages``: a
+    :class:`~gearsym.solver.sweep.progress.Stages` the two stages (models, maps) report to."""
     from gearsym.resolve import load
     from gearsym.solver.sweep import map_tasks
-    from gearsym.solver.sweep.atlas import regime_map
+    from gearsym.solver.sweep.progress import Stages
 
+    stages = stages or Stages(2, "sensitivity", enabled=False)
     spread = QUICK_SPREAD if quick else OPEN_SPREAD
     lam = np.round(np.linspace(0.0, 1.0, 6 if quick else 11), 10)
-    folder = out / "sensitivity"
-    folder.mkdir(parents=True, exist_ok=True)
-    # Every model of every map derived and compiled first, by the workers: one at a time
-    # in this process, the derivations and compilations kept the workers idle for about
-    # half of the stage.
+    (out / "sensitivity").mkdir(parents=True, exist_ok=True)
+    # Every model of every map derived and compiled first, side by side (one at a time in
+    # this process they kept the workers idle for about half of the stage); a value that
+    # is a parameter of the generated model needs no model of its own.
+    base = {(s, r): load(s, load_reading=r).module for s, _ in SCENES.values() for r in READINGS}
     every = dict.fromkeys(
         (scene, f1, reading, key, value)
+        if _derives(base[scene, reading], key, value)
+        else (scene, f1, reading, None, None)  # the scene's own model
         for case, (scene, f1) in SCENES.items()
         for reading in READINGS
         for key, (values, _, _) in spread.items()
         for value in values
     )
-    if progress:
-        print(
-            f"sensitivity: the models of {len(every)} open values, derived and compiled "
-            "side by side",
-            file=sys.stderr,
-        )
-    map_tasks(_prepare, list(every), executor=executor, workers=workers)
-    rows, drawings = [], []
-    for case, (scene, f1) in SCENES.items():
-        for reading in READINGS:
-            base = load(scene, load_reading=reading)
-            for key, (values, stated, unit) in spread.items():
-                if progress:
-                    print(
-                        f"sensitivity: {case} load, {reading}, {key} = {list(values)}",
-                        file=sys.stderr,
-                    )
-                text = is_text(values)
-                axis = np.arange(len(values), dtype=float) if text else np.array(values, float)
-                name = f"{case}_{reading}_{key}"
-                m = regime_map(
-                    base,
-                    ("lambda", lam),
-                    (key, axis),
-                    initial_states=3,
-                    seed=0,
-                    transient=res.transient,
-                    periods=res.periods,
-                    lyapunov_periods=min(res.lyapunov_periods, res.transient + res.periods),
-                    method=settings["method"],
-                    rtol=settings["rtol"],
-                    atol=settings["atol"],
-                    executor=executor,
-                    workers=workers,
-                    store=out / "store" / f"sensitivity_{name}",
-                    progress=progress,
-                    resolve=_resolver(scene, f1, reading, key, values),
-                )
-                resolve = _resolver(scene, f1, reading, key, values)
-                m, carriers = _lengthen_carriers(
-                    m, FINDINGS[case], key, resolve, settings, executor, workers
-                )
-                m.save(out / "data" / f"sensitivity_{name}.json")
-                drawings.append(
-                    (
-                        m,
-                        folder,
-                        f"{case}-{reading}-{key}",
-                        {key: list(values)} if text else None,
-                        f"{scene} (f1 = {f1}), load reading {reading}, {key} as on the "
-                        "y axis, all else as stated",
-                        ("motion", "lyapunov", "attractors", "meshing"),
-                    )
-                )
-                records = _named(m.records(), key, values)
-                motions, critical = {}, {}
-                for v in values:
-                    here = [r for r in records if r[key] == v and r["status"] == "ok"]
-                    motions[v] = sorted({r["motion"][c] for r in here for c in ("u", "v")})
-                    critical[v] = _critical(records, lam, v, key)
-                reproduced = {}
-                for finding, coord, test, (lo, hi) in FINDINGS[case]:
-                    inside = [r for r in records if lo <= r["lambda"] <= hi]
-                    shows = [r[key] for r in inside if _matches(r["motion"][coord], test)]
-                    reproduced[finding] = [v for v in values if v in shows]
-                rows.append(
-                    Sensitivity(
-                        case,
-                        key,
-                        values,
-                        stated,
-                        unit,
-                        motions,
-                        critical,
-                        reproduced,
-                        sum(r["status"] != "ok" for r in records),
-                        [],  # the figures, drawn below
-                        reading,
-                        carriers,
-                    )
-                )
-    # the figures drawn by the workers, after every map (in this process they took a
-    # tenth of the stage)
-    drawn = map_tasks(_draw, drawings, executor=executor, workers=workers)
-    for row, figs in zip(rows, drawn, strict=True):
-        row.figures = figs
+    bar = stages.stage(STAGES[0], len(every))
+    map_tasks(_prepare, list(every), executor=executor, workers=workers, on_result=bar)
+    # Then each map, its long runs and its figures as one task of a worker (serial inside):
+    # the workers share the maps, not the columns of one map, so no core waits for the
+    # end of a map's chains, and no process pool is started per map.  The largest first.
+    tasks = [
+        (out, res, settings, lam, case, scene, f1, reading, key, spread[key])
+        for case, (scene, f1) in SCENES.items()
+        for reading in READINGS
+        for key in spread
+    ]
+    order = sorted(range(len(tasks)), key=lambda k: -len(tasks[k][-1][0]))
+    bar = stages.stage(STAGES[1], len(tasks))
+    done = map_tasks(
+        _map_task, [tasks[k] for k in order], executor=executor, workers=workers, on_result=bar
+    )
+    rows = [None] * len(tasks)
+    for k, row in zip(order, done, strict=True):
+        rows[k] = row
     return rows
 
 
-def _draw(args: tuple) -> list:
-    """Worker: the figures of one sensitivity map (``map_figures``' arguments); paths."""
-    from gearsym.solver.plots_maps import map_figures
+def _map_task(args: tuple) -> Sensitivity:
+    """Worker: one regime map over lambda by one open value (serial), its claim-carrying
+    runs continued, its data and figures written; its :class:`Sensitivity` row."""
+    from gearsym.resolve import load
+    from gearsym.solver.sweep.atlas import regime_map
 
-    return map_figures(*args)
+    out, res, settings, lam, case, scene, f1, reading, key, (values, stated, unit) = args
+    text = is_text(values)
+    axis = np.arange(len(values), dtype=float) if text else np.array(values, float)
+    name = f"{case}_{reading}_{key}"
+    resolve = _resolver(scene, f1, reading, key, values)
+    m = regime_map(
+        load(scene, load_reading=reading),
+        ("lambda", lam),
+        (key, axis),
+        initial_states=3,
+        seed=0,
+        transient=res.transient,
+        periods=res.periods,
+        lyapunov_periods=min(res.lyapunov_periods, res.transient + res.periods),
+        method=settings["method"],
+        rtol=settings["rtol"],
+        atol=settings["atol"],
+        executor="serial",
+        store=out / "store" / f"sensitivity_{name}",
+        resolve=resolve,
+    )
+    m, carriers = _lengthen_carriers(m, FINDINGS[case], key, resolve, settings, "serial", None)
+    m.save(out / "data" / f"sensitivity_{name}.json")
+    figures = _draw(
+        (
+            m,
+            out / "sensitivity",
+            f"{case}-{reading}-{key}",
+            {key: list(values)} if text else None,
+            f"{scene} (f1 = {f1}), load reading {reading}, {key} as on the y axis, all else "
+            "as stated",
+            ("motion", "lyapunov", "attractors", "meshing"),
+        )
+    )
+    records = _named(m.records(), key, values)
+    motions, critical = {}, {}
+    for v in values:
+        here = [r for r in records if r[key] == v and r["status"] == "ok"]
+        motions[v] = sorted({r["motion"][c] for r in here for c in ("u", "v")})
+        critical[v] = _critical(records, lam, v, key)
+    reproduced = {}
+    for finding, coord, test, (lo, hi) in FINDINGS[case]:
+        inside = [r for r in records if lo <= r["lambda"] <= hi]
+        shows = [r[key] for r in inside if _matches(r["motion"][coord], test)]
+        reproduced[finding] = [v for v in values if v in shows]
+    failed = sum(r["status"] != "ok" for r in records)
+    return Sensitivity(
+        case,
+        key,
+        values,
+        stated,
+        unit,
+        motions,
+        critical,
+        reproduced,
+        failed,
+        figures,
+        reading,
+        carriers,
+    )
+
+
+def _draw(args: tuple) -> list:
+    """Worker: the figures of one sensitivity map (``write_map_figures``' arguments);
+    paths."""
+    from gearsym.solver.plots_maps import write_map_figures
+
+    return write_map_figures(*args)
 
 
 def _lengthen_carriers(m, findings, key, resolve, settings, executor, workers):
@@ -304,10 +328,9 @@ def physical_scales(scene: str) -> dict:
     """Force and length scales of a scene's model (application layer: it derives).
     The non-dimensional mesh force times ``force_N`` is newtons; u times ``b_um`` is the
     dynamic transmission error in µm."""
-    from gearsym.derive import derive_model, load_target, resolve_target
+    from .model_check import _model
 
-    model = derive_model(load_target(resolve_target(scene)))
-    s = model.scales
+    s = _model(scene).scales
     out = {}
     for c, b in s["half_backlash_m"].items():
         km = s["mean_stiffness_N_per_m"][c]

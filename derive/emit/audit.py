@@ -19,6 +19,7 @@ from ..input.paths import display_path
 from ..input.readings import reading_section
 from ..mesh.backlash import ForceSign, fit_dead_zone
 from ..model import Model
+from .audit_physical import physical_section
 from .audit_structure import structure_sections
 from .audit_torsion import torsional_sections
 from .markdown import latex
@@ -195,6 +196,7 @@ def audit_page(model: Model, command: str) -> str:
     section = reading_section(model)
     if section:
         w(section)
+    w(physical_section(model))
     w("Parameter values of the emitted model, in the order of the generated code:\n")
     w("| # | name | symbol | value | meaning |")
     w("|---|---|---|---|---|")
@@ -325,7 +327,9 @@ def index_page(models: list[Model], command: str) -> str:
         "without its set-up. A discrete least-squares fit of the odd powers to the unit dead "
         "zone on 601 uniform samples $x = -3, -2.99, \\dots, 3$ (step 0.01) gives "
         f"${_coefficients(fit_dead_zone(7, 3.0, 0.01))}$, the printed digits; it is the default "
-        "of `gearsym backlash` and of the scenes. The continuous $L^2$ fit on $[-3, 3]$ gives "
+        "of `gearsym backlash` and the backlash of the reference scenes (a user's scene gets "
+        "the exact dead zone unless it asks for the polynomial). The continuous $L^2$ fit on "
+        "$[-3, 3]$ gives "
         f"${_coefficients(fit_dead_zone(7, 3.0, None))}$. The fit is valid for $|x| \\le 3$ "
         "only and has a negative slope at $x = 0$.\n",
         "## Relation to the reference study's form\n",

@@ -22,6 +22,7 @@ from ..escape import code_name, code_names, text
 from ..input.scene import PARAMETER_LIMITS
 from ..model import Model, operation_count  # operation_count re-exported
 from .c import c_source
+from .physical_code import physical_lines, physical_tables
 from .printer import CodePrinter, function_body
 
 __all__ = ["CodePrinter", "emit_module", "operation_count", "write_atomic"]
@@ -205,6 +206,7 @@ def emit_module(model: Model, command: str) -> str:
             f"{k!r}: {v!r}" for k, v in PARAMETER_LIMITS.items() if k in model.scene_parameters
         )
         + "}",
+        *physical_tables(model.physical, fmt),
         "# mesh coordinate: ((cos index, sin index, harmonic), ...) of k_hat = 1 + sum ...",
         f"STIFFNESS_TERMS = {stiffness_terms!r}",
         f"OPERATIONS = {model.operations!r}",
@@ -244,14 +246,17 @@ def emit_module(model: Model, command: str) -> str:
         '    """Parameter vector p from named values; the rest keep the scene\'s values.',
         "",
         "    Names may be scene parameters (SCENE_PARAMETERS: what the scene's [parameters]",
-        "    table sets, such as a load ratio) or model parameters (PARAMETERS); a model",
-        "    parameter given by name overrides what the scene parameters imply.",
+        "    table sets, such as a load ratio), physical quantities (PHYSICAL, in rpm, N m,",
+        "    um, kg m^2, or their PHYSICAL_ALIASES) or model parameters (PARAMETERS); a model",
+        "    parameter given by name overrides what the others imply.",
         '    """',
-        "    unknown = sorted(set(values) - set(SCENE_PARAMETERS) - set(PARAMETERS))",
+        "    unknown = sorted(set(values) - set(SCENE_PARAMETERS) - set(PARAMETERS)",
+        "                     - set(PHYSICAL) - set(PHYSICAL_ALIASES))",
         "    if unknown:",
         "        raise KeyError(f'unknown parameter(s) {unknown}; scene parameters: '",
-        "                       f'{sorted(SCENE_PARAMETERS)}; model parameters: '",
-        "                       f'{list(PARAMETERS)}')",
+        "                       f'{sorted(SCENE_PARAMETERS)}; physical: '",
+        "                       f'{sorted(PHYSICAL) + sorted(PHYSICAL_ALIASES)}; model '",
+        "                       f'parameters: {list(PARAMETERS)}')",
         "    s = dict(SCENE_PARAMETERS)",
         "    s.update((k, float(v)) for k, v in values.items() if k in SCENE_PARAMETERS)",
         "    for k, v in s.items():",
@@ -268,6 +273,15 @@ def emit_module(model: Model, command: str) -> str:
             f"    p[{model.parameter_names.index(k)}] = {src}  # {text(k)}"
             for k, src in model.parameter_sources.items()
         ),
+        *(
+            [
+                "    q, given = _physical(values)",
+                "    if q is not None:",
+                "        _physical_parameters(p, q, s, given)",
+            ]
+            if model.physical is not None
+            else []
+        ),
         "    for k, v in values.items():",
         "        if k in PARAMETERS and k not in SCENE_PARAMETERS:",
         "            p[PARAMETERS.index(k)] = float(v)",
@@ -275,6 +289,7 @@ def emit_module(model: Model, command: str) -> str:
         "    return np.array(p, dtype=float)",
         "",
         *_stiffness_check_lines(stiffness_terms),
+        *(physical_lines(model)[1:] + [""] if model.physical is not None else []),
         "def jacobian(tau, x, p):",
         '    """d rhs / d X, shape (n, n) or (n, n, N)."""',
         *jac_lines,

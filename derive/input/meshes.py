@@ -56,6 +56,10 @@ class Mesh:
     # Angle of the driver's centre round the driven gear's, from +x, counter-clockwise seen
     # from +z (the axes' direction), rad: it sets the line of action's direction.
     driver_position: float = 0.0
+    # (teeth of the gear shared with the reference mesh, angle in deg) when the phase comes
+    # from the layout; the generated parameters() recomputes the phase from them
+    # (derive/physical.py).
+    layout_angle: tuple[int, float] | None = None
 
 
 def parse_mesh(mt: Table, meshes: list[Mesh], by_id: dict[str, Gear]) -> Mesh:
@@ -99,7 +103,7 @@ def parse_mesh(mt: Table, meshes: list[Mesh], by_id: dict[str, Gear]) -> Mesh:
     backlash = mt.number("half_backlash_um", low=0, low_open=True) * 1e-6
     stiffness = _stiffness(mt.table("stiffness"), pair, (g1, g2))
     te = _transmission_error(mt.table("transmission_error", None))
-    phase, phase_source = _phase(mt, meshes, ends, by_id)
+    phase, phase_source, layout = _phase(mt, meshes, ends, by_id)
     orientation = mt.string("orientation", "forward", choices=ORIENTATIONS)
     position = math.radians(mt.number("driver_position_deg", 0.0, low=-360.0, high=360.0))
     mt.finish()
@@ -125,6 +129,7 @@ def parse_mesh(mt: Table, meshes: list[Mesh], by_id: dict[str, Gear]) -> Mesh:
         pair,
         ORIENTATIONS[orientation],
         position,
+        layout,
     )
 
 
@@ -135,7 +140,7 @@ def _stiffness(t: Table, pair: PairGeometry, gears: tuple[Gear, Gear]) -> MeshSt
     if scale == 1.0:
         return k
     return MeshStiffness(
-        k.mean, tuple(scale * c for c in k.cos), tuple(scale * c for c in k.sin), k.source
+        k.mean, tuple(scale * c for c in k.cos), tuple(scale * c for c in k.sin), k.source, scale
     )
 
 
@@ -253,8 +258,9 @@ def _check_contact(t: Table, pair: PairGeometry, ends: list[str]) -> None:
         )
 
 
-def _phase(t: Table, meshes: list, ends: list[str], by_id: dict) -> tuple[float, str]:
-    """Stiffness/transmission-error phase lag of a mesh relative to the first mesh.
+def _phase(t: Table, meshes: list, ends: list[str], by_id: dict) -> tuple:
+    """Stiffness/transmission-error phase lag of a mesh relative to the first mesh, what it
+    comes from, and (teeth of the shared gear, angle) when from the layout, else None.
 
     Either given (``stiffness_phase_deg``) or from the layout (``layout_angle_deg``): a mesh
     that shares a gear with the first mesh, in the same role (driver or driven in both),
@@ -264,7 +270,7 @@ def _phase(t: Table, meshes: list, ends: list[str], by_id: dict) -> tuple[float,
     """
     given, angle = t.has("stiffness_phase_deg"), t.has("layout_angle_deg")
     if not (given or angle):
-        return 0.0, "reference" if not meshes else "none given"
+        return 0.0, "reference" if not meshes else "none given", None
     if not meshes:
         raise t.error(
             "layout_angle_deg" if angle else "stiffness_phase_deg",
@@ -276,7 +282,7 @@ def _phase(t: Table, meshes: list, ends: list[str], by_id: dict) -> tuple[float,
             "layout_angle_deg", "give either stiffness_phase_deg or layout_angle_deg, not both"
         )
     if given:
-        return math.radians(t.number("stiffness_phase_deg")), "given"
+        return math.radians(t.number("stiffness_phase_deg")), "given", None
     psi = t.number("layout_angle_deg", low=-360.0, high=360.0)
     ref = meshes[0]
     common = sorted({ends[0], ends[1]} & {ref.driver, ref.driven})
@@ -297,8 +303,10 @@ def _phase(t: Table, meshes: list, ends: list[str], by_id: dict) -> tuple[float,
         )
     teeth = by_id[gear].teeth * psi / 360.0
     delta = teeth - math.floor(teeth)
-    return 2.0 * math.pi * delta, (
-        f"layout: {psi:g} deg round gear '{gear}' spans {teeth:.4f} teeth, delta = {delta:.4f}"
+    return (
+        2.0 * math.pi * delta,
+        f"layout: {psi:g} deg round gear '{gear}' spans {teeth:.4f} teeth, delta = {delta:.4f}",
+        (by_id[gear].teeth, psi),
     )
 
 

@@ -47,6 +47,7 @@ class MeshStiffness:
     cos: tuple[float, ...] = ()
     sin: tuple[float, ...] = ()
     source: str = "harmonics"
+    harmonic_scale: float = 1.0  # the factor already applied to cos and sin (open value)
 
     def __post_init__(self):
         if not (self.mean > 0 and math.isfinite(self.mean)):

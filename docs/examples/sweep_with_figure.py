@@ -10,7 +10,6 @@ from pathlib import Path
 
 import gearsym
 import numpy as np
-from gearsym.solver import plots
 
 
 def main(out: Path) -> None:
@@ -22,8 +21,8 @@ def main(out: Path) -> None:
             f"lambda = {point.value:.2f}: u {point.motion('u')}, v {point.motion('v')}, "
             f"min(v) = {point.min('v'):.3f}"
         )
-    figure = plots.bifurcation_diagram(
-        [result], list(system.coordinates), out / "bifurcation.png", title="lambda sweep"
+    figure = gearsym.plot.save(
+        gearsym.plot.bifurcation(result, title="lambda sweep"), out / "bifurcation.png"
     )
     print("wrote", figure, result.save(out / "sweep.json"), result.save(out / "sweep.csv"))
 

@@ -55,6 +55,30 @@ class Modes:
     reference_teeth: int
     reference_driver: str = ""  # the first mesh's driver, whose speed the diagram uses
 
+    def __repr__(self) -> str:
+        elastic = [m for m in self.modes if m.label != "rigid-body"]
+        first = f"; lowest {elastic[0].frequency_hz:.4g} Hz" if elastic else ""
+        return (
+            f"Modes({self.model}: {len(self.modes)} modes, "
+            f"{len(self.modes) - len(elastic)} rigid-body{first}; mesh frequency "
+            f"{self.mesh_frequency_hz:.4g} Hz)"
+        )
+
+    def summary(self) -> str:
+        """One line per mode (at most 12): frequency, over the mesh frequency, its kind."""
+        lines = [
+            f"modes of {self.model}; mesh frequency {self.mesh_frequency_hz:.6g} Hz "
+            f"({self.reference_teeth} teeth of {self.reference_driver or 'the driver'})"
+        ]
+        for m in self.modes[:12]:
+            lines.append(
+                f"  {m.index}: {m.frequency_hz:10.4f} Hz ({self.over_mesh(m):.3f} x mesh), "
+                f"{m.label}"
+            )
+        if len(self.modes) > 12:
+            lines.append(f"  ... {len(self.modes) - 12} more")
+        return "\n".join(lines)
+
     def over_mesh(self, mode: Mode) -> float:
         return mode.frequency_hz / self.mesh_frequency_hz
 
@@ -92,6 +116,18 @@ class Modes:
             "speed_range_rpm": list(speeds_rpm),
             "resonances": self.resonances(speeds_rpm),
         }
+
+    def to_dict(self, speeds_rpm: tuple[float, float] | None = None) -> dict:
+        """:meth:`to_json` over ``speeds_rpm`` (default 0 to twice the scene's speed of
+        the reference driver)."""
+        if speeds_rpm is None:
+            speeds_rpm = (0.0, 120.0 * self.mesh_frequency_hz / self.reference_teeth)
+        return self.to_json(speeds_rpm)
+
+    def to_table(self) -> tuple[list, list]:
+        """One row per mode: index, frequency (Hz and over the mesh frequency), label."""
+        columns = ["index", "frequency_hz", "over_mesh_frequency", "label"]
+        return columns, [[m.index, m.frequency_hz, self.over_mesh(m), m.label] for m in self.modes]
 
 
 def modes(model, omega: float | None = None) -> Modes:

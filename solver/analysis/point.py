@@ -89,6 +89,38 @@ class PointResult:
             return {s: Extremes(float(hi[k]), float(lo[k])) for k, s in enumerate(states)}
         return {s: Extremes(e["max"], e["min"]) for s, e in extremes(self.trajectory).items()}
 
+    def __repr__(self) -> str:
+        tr = self.trajectory
+        motion = self.verdict.motion if self.verdict is not None else "no verdict"
+        return (
+            f"PointResult({tr.system!r}: {motion}; "
+            f"{tr.transient} + {tr.periods} periods, {tr.status})"
+        )
+
+    def summary(self) -> str:
+        """A few lines to read: the model and values, the verdict with its evidence, the
+        run, the extremes of each coordinate (:meth:`to_dict` has everything)."""
+        import textwrap
+
+        tr = self.trajectory
+        ext = self._extremes()
+        return "\n".join(
+            [
+                f"{tr.system!r}",
+                textwrap.fill(verdict_line(self), 100, subsequent_indent="  "),
+                f"run: {tr.method} rtol {tr.rtol:g}, {tr.transient} + {tr.periods} periods, "
+                f"status {tr.status}, {tr.wall_time:.2f} s",
+                "extremes: "
+                + ", ".join(
+                    f"{c} in [{ext[c].min}, {ext[c].max}]"
+                    if ext[c].max is None
+                    else f"{c} in [{ext[c].min:.4g}, {ext[c].max:.4g}]"
+                    for c in tr.system.coordinates
+                )
+                + " (half backlashes)",
+            ]
+        )
+
     def describe(self, poincare: bool = True) -> dict:
         """The point's summary (its :meth:`record`) with the system's description."""
         rec = self.record()
@@ -111,8 +143,11 @@ class PointResult:
         return known if known is not None else spectrum(self.trajectory, c)
 
     def to_dict(self, samples: bool = True) -> dict:
-        """Everything of :meth:`describe`, with the time series when ``samples``."""
-        out = self.describe()
+        """The header block (``provenance.provenance``) and everything of
+        :meth:`describe`, with the time series when ``samples``."""
+        from ..provenance import provenance
+
+        out = provenance(self.trajectory.system) | self.describe()
         if samples:
             out["samples"] = {k: v for k, v in self.trajectory.to_dict().items() if k in ("t", "x")}
         return out
@@ -121,11 +156,11 @@ class PointResult:
         """The sampled response, one row per sample (see ``Trajectory.to_table``)."""
         return self.trajectory.to_table()
 
-    def save(self, path):
+    def save(self, path, **extra):
         """Write to ``path``: ``.json``, ``.csv`` or ``.mat`` (see ``solver/export.py``)."""
         from ..export import save
 
-        return save(self, path)
+        return save(self, path, **extra)
 
 
 def classification_tolerance(method: str, rtol: float) -> float:
@@ -253,3 +288,46 @@ def _closing_sample(tr, st: Settled, rtol: float, atol: float, steps_per_period:
             steps_per_period=steps_per_period,
         )
     return again if again.status == "ok" else tr
+
+
+def verdict_line(point) -> str:
+    """The verdict line of one analysed point (a ``PointResult``): the motion (one label
+    when the coordinates agree) and its evidence: the periods run, the orbit's largest
+    Floquet multiplier |μ| or the last window's exponent interval (per unit τ) and 0-1
+    test K, the reason of an undetermined verdict, a chaotic transient (the title of a
+    point's figure and :meth:`PointResult.summary`)."""
+    coordinates = point.trajectory.system.coordinates
+    cls = point.classification
+    motions = {c: getattr(cls[c], "motion", str(cls[c])) for c in coordinates}
+    if len(set(motions.values())) == 1:
+        parts = [f"verdict: {next(iter(motions.values()))} ({', '.join(motions)})"]
+    else:
+        parts = ["verdict: " + ", ".join(f"{c} {m}" for c, m in motions.items())]
+    verdict = getattr(point, "verdict", None)
+    s = verdict.summary() if verdict is not None else {}
+    if "periods_run" in s:
+        parts.append(f"{s['periods_run']} periods run")
+    if s.get("largest_multiplier") is not None:
+        parts.append(f"largest |Floquet multiplier| {s['largest_multiplier']:.4f}")
+    if "exponent_interval" in s:
+        lo, hi = s["exponent_interval"]
+        parts.append(f"largest Lyapunov exponent in [{lo:+.4f}, {hi:+.4f}] per unit τ")
+    elif point.lyapunov is not None:
+        lam = point.lyapunov
+        parts.append(
+            f"largest Lyapunov exponent {lam.exponent:+.4f} ± {lam.uncertainty:.4f} "
+            f"per unit τ ({lam.periods} periods)"
+        )
+    if "zero_one_K" in s:
+        parts.append(f"0-1 test K = {s['zero_one_K']:.2f}")
+    if "two_trajectory_interval" in s:
+        lo, hi = s["two_trajectory_interval"]
+        agrees = " (the second test that agrees)" * (
+            s.get("second_test") == "two-trajectory exponent"
+        )
+        parts.append(f"two-trajectory exponent in [{lo:+.4f}, {hi:+.4f}]{agrees}")
+    if "transient_chaos" in s:
+        parts.append(str(s["transient_chaos"].get("text", "chaotic transient")))
+    if "why" in s:
+        parts.append(f"why: {s['why']}")
+    return "; ".join(parts)

@@ -64,6 +64,33 @@ class Trajectory:
         """The time derivative of mesh coordinate ``coordinate``."""
         return self.x[self.system.velocity_index(coordinate)]
 
+    def __repr__(self) -> str:
+        return (
+            f"Trajectory({self.system!r}: {self.method}, {self.transient} + {self.periods} "
+            f"periods x {self.samples_per_period} samples, {len(self.x)} states, {self.status})"
+        )
+
+    def summary(self) -> str:
+        """A few lines: the model and values, the run, how it ended."""
+        exit_ = self.left_valid_range
+        return "\n".join(
+            [
+                repr(self.system),
+                f"{self.method} rtol {self.rtol:g} atol {self.atol:g}: {self.transient} "
+                f"periods discarded, {self.periods} sampled ({self.samples_per_period} per "
+                f"period, τ {self.t[0]:.6g} to {self.t[-1]:.6g})"
+                if self.t.size
+                else "",
+                f"status {self.status}{': ' + self.message if self.message else ''}; "
+                f"{self.nfev} evaluations, {self.nsteps} steps, {self.wall_time:.2f} s",
+            ]
+            + (
+                [f"left the valid range at τ = {exit_[0]:.6g} ({exit_[1]} = {exit_[2]:.4g})"]
+                if exit_
+                else []
+            )
+        )
+
     def describe(self) -> dict:
         return {
             "method": self.method,

@@ -65,13 +65,20 @@ def interval_of(system, name: str) -> Interval:
     the model states it; ``KeyError`` for a name that is neither."""
     module = system.module
     scene = getattr(module, "SCENE_PARAMETERS", {})
-    if name not in scene and name not in system.contract.parameters:
-        raise KeyError(
-            f"no parameter '{name}'; scene parameters: {', '.join(sorted(scene))}; model "
-            f"parameters: {', '.join(system.contract.parameters)}"
-        )
+    physical = getattr(module, "PHYSICAL", {})
+    aliases = getattr(module, "PHYSICAL_ALIASES", {})
+    if name not in scene and name not in system.contract.parameters and name not in physical:
+        if name not in aliases:
+            more = f"; physical: {', '.join([*physical, *aliases])}" if physical else ""
+            raise KeyError(
+                f"no parameter '{name}'; scene parameters: {', '.join(sorted(scene))}; model "
+                f"parameters: {', '.join(system.contract.parameters)}{more}"
+            )
     low, high, low_open = -math.inf, math.inf, False
-    stated = getattr(module, "SCENE_PARAMETER_LIMITS", {}).get(name)
+    limits = getattr(module, "PHYSICAL_LIMITS", {})
+    stated = getattr(module, "SCENE_PARAMETER_LIMITS", {}).get(name) or limits.get(
+        (aliases.get(name) or (name,))[0]
+    )
     if stated is not None:
         low, high, low_open = stated
         low = -math.inf if low is None else float(low)

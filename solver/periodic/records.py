@@ -130,26 +130,62 @@ class Branch:
     def multipliers(self) -> list:
         return [p.multipliers for p in self.points if p.multipliers is not None]
 
+    def __repr__(self) -> str:
+        v = self.values
+        span = f"{v.min():.4g} to {v.max():.4g}" if v.size else "no points"
+        kinds = ", ".join(sorted({b.kind for b in self.bifurcations}))
+        return (
+            f"Branch({self.model.get('model', '?')}: period-{self.n} in {self.parameter} "
+            f"{span}, {v.size} points, {int(np.sum(self.stable))} stable, "
+            f"{len(self.bifurcations)} bifurcation(s){' (' + kinds + ')' if kinds else ''}; "
+            f"{self.status})"
+        )
+
+    def summary(self) -> str:
+        """A few lines: the branch, its stability, each bifurcation, how it ended."""
+        lines = [repr(self)[len("Branch(") : -1]]
+        for b in self.bifurcations[:6]:
+            lines.append(
+                f"  {b.kind} at {self.parameter} = {b.value:.8g}, multiplier "
+                f"{b.multiplier.real:+.6f}{b.multiplier.imag:+.6f}i"
+            )
+        if len(self.bifurcations) > 6:
+            lines.append(f"  ... {len(self.bifurcations) - 6} more bifurcations")
+        lines.append(self.message or f"status: {self.status}")
+        return "\n".join(lines)
+
     def describe(self) -> dict:
-        def largest(m):
-            return None if m is None else float(np.max(np.abs(m)))
+        """The branch under the API's names: ``n``, ``values``, ``states`` (one row per
+        point, in the order of ``state_names``), ``stable``, ``stability`` and
+        ``multipliers`` (per point ``{"re": [...], "im": [...]}``, or None without
+        stability), the bifurcations, ``status`` and ``message``."""
+
+        def complexes(m):
+            return None if m is None else {"re": np.real(m).tolist(), "im": np.imag(m).tolist()}
 
         return {
             "parameter": self.parameter,
-            "period_multiple": self.n,
+            "n": self.n,
             "values": [float(p.value) for p in self.points],
-            "x0": [[float(v) for v in p.x0] for p in self.points],
+            "states": [[float(v) for v in p.x0] for p in self.points],
             "stable": [bool(p.stable) for p in self.points],
-            "max_multiplier": [largest(p.multipliers) for p in self.points],
+            "stability": [p.stability for p in self.points],
+            "multipliers": [complexes(p.multipliers) for p in self.points],
             "bifurcations": [b.to_dict() for b in self.bifurcations],
             "status": self.status,
             "message": self.message,
         }
 
     def to_dict(self) -> dict:
-        """:meth:`describe` with the state names, the model (name, hash, base values) and
-        the scales back to SI."""
-        return self.model | {"states": list(self.state_names)} | self.describe()
+        """:meth:`describe` after the header block (``provenance.header``: version, model,
+        hash, scales back to SI, the values it was run with) and the state names."""
+        from ..provenance import header
+
+        m = self.model
+        head = {}
+        if m:
+            head = header(m["model"], m["model_hash"], m["scales"], m["base_values"])
+        return head | {"state_names": list(self.state_names)} | self.describe()
 
     def to_table(self) -> tuple[list, list]:
         """One row per branch point: the parameter, stability, largest |multiplier|, x0."""
@@ -167,11 +203,11 @@ class Branch:
         ]
         return columns, rows
 
-    def save(self, path):
+    def save(self, path, **extra):
         """Write to ``path``: ``.json``, ``.csv`` or ``.mat`` (see ``solver/export.py``)."""
         from ..export import save
 
-        return save(self, path)
+        return save(self, path, **extra)
 
     # -- the Fourier statistics of a harmonic-balance branch ------------------------------
     def _fourier(self):

@@ -66,6 +66,37 @@ class Orbit:
     def period(self) -> float:
         return self.n * self.system.period
 
+    def __repr__(self) -> str:
+        f = self.floquet
+        stab = "" if f is None else f", {f.stability or ('stable' if f.stable else 'unstable')}"
+        top = "" if f is None else f", max |μ| {float(np.max(np.abs(f.multipliers))):.4g}"
+        return (
+            f"Orbit({self.system!r}: period-{self.n}, nT = {self.period:.6g} τ{stab}{top}, "
+            f"residual {self.residual:.1e})"
+        )
+
+    def summary(self) -> str:
+        """A few lines: the orbit, its start, Newton's convergence, the multipliers."""
+        x0 = ", ".join(f"{s} = {v:.6g}" for s, v in zip(self.system.states, self.x0, strict=True))
+        lines = [
+            f"period-{self.n} orbit of {self.system!r}, period {self.period:.6g} τ"
+            + (f" (minimal: {self.minimal_period}T)" if self.minimal_period else ""),
+            f"x0 at τ = {self.t0:.6g}: {x0}",
+            f"Newton: {self.iterations} iterations, residual {self.residual:.2e}, "
+            f"{self.segments} segment(s)",
+        ]
+        f = self.floquet
+        if f is not None:
+            mu = sorted(f.multipliers, key=abs, reverse=True)
+            text = ", ".join(f"{m.real:+.4f}{m.imag:+.4f}i" for m in mu[:6])
+            lines.append(
+                f"Floquet: {f.stability or ('stable' if f.stable else 'unstable')}, "
+                f"critical |μ| = {abs(f.critical):.6f} ({f.kind}); "
+                f"Liouville error {f.liouville_error:.1e}"
+            )
+            lines.append(f"multipliers: {text}" + (f" (+{len(mu) - 6})" if len(mu) > 6 else ""))
+        return "\n".join(lines)
+
     def describe(self) -> dict:
         return {
             "period_multiple": self.n,

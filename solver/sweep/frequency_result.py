@@ -62,13 +62,36 @@ class FrequencyResponse:
     def records(self) -> list[dict]:
         return [r for c in self.curves for r in c.records()]
 
+    def _curves_text(self) -> str:
+        return ", ".join(f"{c.method} {len(c.values)}" for c in self.curves)
+
+    def __repr__(self) -> str:
+        return (
+            f"FrequencyResponse({self.system!r}: {self.parameter} {self.start:.4g} to "
+            f"{self.stop:.4g}; points per method: {self._curves_text()})"
+        )
+
+    def summary(self) -> str:
+        """A few lines: per method its points, stable share, events and the peak
+        amplitude of each coordinate (half backlashes)."""
+        lines = [f"frequency response of {self.system!r} over {self.parameter}"]
+        for c in self.curves:
+            peaks = ", ".join(
+                f"{k} {np.nanmax(s['amplitude']):.4g}" if len(c.values) else k
+                for k, s in c.stats.items()
+            )
+            events = ", ".join(f"{e.kind} at {e.value:.4g}" for e in c.events[:4])
+            more = f" (+{len(c.events) - 4})" if len(c.events) > 4 else ""
+            lines.append(
+                f"  {c.method}: {len(c.values)} points, {int(np.sum(c.stable))} stable, "
+                f"peak amplitude {peaks}; events: {events or 'none'}{more}; {c.wall_time:.1f} s"
+            )
+        return "\n".join(lines)
+
     def to_dict(self) -> dict:
-        d = self.system.describe()
-        return {
-            "model": d["model"],
-            "model_hash": d["model_hash"],
-            "values": {k: float(v) for k, v in self.system.values.items()},
-            "scales": self.system.scales(),
+        from ..provenance import provenance
+
+        return provenance(self.system) | {
             "parameter": self.parameter,
             "range": [self.start, self.stop],
             "curves": [
@@ -102,8 +125,8 @@ class FrequencyResponse:
             )
         return columns, rows
 
-    def save(self, path):
+    def save(self, path, **extra):
         """Write to ``path``: ``.json``, ``.csv`` or ``.mat`` (see ``solver/export.py``)."""
         from ..export import save
 
-        return save(self, path)
+        return save(self, path, **extra)

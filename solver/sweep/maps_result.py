@@ -59,6 +59,55 @@ class RegimeMap:
         meshing = self.cells[0][0].dominant.run.meshing_regime
         return tuple(c for c in self.coordinates if c in meshing)
 
+    def _grid_text(self) -> str:
+        def axis(name, v):
+            return f"{name} {v[0]:.4g} to {v[-1]:.4g} ({len(v)})" if len(v) else name
+
+        return f"{axis(self.x, self.x_values)} x {axis(self.y, self.y_values)}"
+
+    def _motions(self, most: int | None = None) -> str:
+        """``period-1 in 12 cells, chaotic in 3``: the dominant attractor's motion."""
+        from collections import Counter
+
+        counts = Counter(
+            c.dominant.run.motion(self.coordinates[0])
+            if c.dominant.run.ok
+            else c.dominant.run.status
+            for column in self.cells
+            for c in column
+        )
+        shown = counts.most_common(most)
+        more = len(counts) - len(shown)
+        text = ", ".join(f"{m} in {k}" for m, k in shown) + (f", {more} more" if more else "")
+        return text + " cells"
+
+    def __repr__(self) -> str:
+        return (
+            f"RegimeMap({self.model}: {self._grid_text()}, "
+            f"{self.settings.get('initial_states')} initial states; {self._motions(3)})"
+        )
+
+    def summary(self) -> str:
+        """A few lines: the grid, the runs, the dominant motions, coexisting attractors."""
+        s = self.settings
+        count = self.grid("attractors")
+        most = int(np.nanmax(count)) if np.any(np.isfinite(count)) else 0
+        fixed = ", ".join(
+            f"{k} = {v:.4g}" for k, v in self.values.items() if k not in (self.x, self.y)
+        )
+        return "\n".join(
+            [
+                f"regime map of {self.model}: {self._grid_text()}"
+                + (f"; {fixed}" if fixed else ""),
+                f"runs: {s.get('initial_states')} initial states per point, "
+                f"{s.get('transient')} + {s.get('periods')} periods, {s.get('method')} "
+                f"rtol {s.get('rtol')}; {self.wall_time:.1f} s",
+                f"dominant motion: {self._motions()}",
+                f"coexisting attractors: up to {most} at a point, "
+                f"{int(np.sum(count > 1))} points with more than one",
+            ]
+        )
+
     def records(self) -> list[dict]:
         """One record per (grid point, attractor), the two values under their names."""
         out = []
@@ -122,10 +171,10 @@ class RegimeMap:
             )
         return columns, rows
 
-    def save(self, path) -> Path:
+    def save(self, path, **extra) -> Path:
         from ..export import save
 
-        return save(self, path)
+        return save(self, path, **extra)
 
     @classmethod
     def load(cls, path) -> RegimeMap:

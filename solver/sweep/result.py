@@ -52,17 +52,54 @@ class SweepResult:
         """Min of ``state`` at every point (NaN where a point failed)."""
         return np.array([p.min(state) for p in self.points])
 
-    def _head(self) -> dict:
-        """Everything of :meth:`to_dict` but the points."""
-        return {
-            "model": self.model,
-            "model_hash": self.model_hash,
+    def _motions(self, most: int | None = None) -> str:
+        """``period-1 at 4, chaotic at 2``: the attractor's motion (the first coordinate's
+        verdict, which every coordinate shares) or a failed run's status; ``most`` kinds."""
+        from collections import Counter
+
+        counts = Counter(
+            p.motion(next(iter(p.classification))) if p.ok else p.status for p in self.points
+        )
+        shown = counts.most_common(most)
+        more = len(counts) - len(shown)
+        return ", ".join(f"{m} at {k}" for m, k in shown) + (f", {more} more" if more else "")
+
+    def _what(self) -> str:
+        v = self.values
+        span = f"{v[0]:.4g} to {v[-1]:.4g}" if len(v) else "no values"
+        return f"{self.model}: {self.parameter} {span}, {len(self.points)} points, {self.direction}"
+
+    def __repr__(self) -> str:
+        return f"SweepResult({self._what()}; {self._motions(3)})"
+
+    def summary(self) -> str:
+        """A few lines: what was swept, the motions found and where each one ran."""
+        lines = [f"sweep of {self._what()}", f"motions: {self._motions() or 'none'}"]
+        runs, last = [], None
+        for value, p in zip(self.values, self.points, strict=False):
+            m = p.motion(next(iter(p.classification))) if p.ok else p.status
+            if m != last:
+                runs.append([m, value, value])
+                last = m
+            runs[-1][2] = value
+        shown = [f"{m} {a:.4g} to {b:.4g}" if a != b else f"{m} {a:.4g}" for m, a, b in runs]
+        lines.append(f"along {self.parameter}: " + "; ".join(shown[:8]))
+        if len(shown) > 8:
+            lines[-1] += f"; ... ({len(shown) - 8} more runs of one motion)"
+        shown = {k: v for k, v in self.settings.items() if k != "x0" and v is not None}
+        lines.append("settings: " + ", ".join(f"{k} = {v}" for k, v in shown.items()))
+        return "\n".join(lines)
+
+    def _head(self, **extra) -> dict:
+        """Everything of :meth:`to_dict` but the points: the header block
+        (``provenance.header``; ``overrides`` are ``base_values``), then the sweep."""
+        from ..provenance import header
+
+        return header(self.model, self.model_hash, self.scales, self.base_values, **extra) | {
             "parameter": self.parameter,
             "values": self.values.tolist(),
             "direction": self.direction,
-            "base_values": self.base_values,
             "settings": self.settings,
-            "scales": self.scales,
         }
 
     def to_dict(self) -> dict:
@@ -94,24 +131,24 @@ class SweepResult:
         ]
         return columns, rows
 
-    def save(self, path: Path) -> Path:
+    def save(self, path: Path, **extra) -> Path:
         """Write the sweep (parameter values, scales and model hash included): ``.json``,
-        ``.csv`` or ``.mat`` (see ``solver/export.py``)."""
+        ``.csv`` or ``.mat`` (see ``solver/export.py``); ``extra`` adds header keys."""
         path = Path(path)
         if path.suffix.lower() == ".json" and self.texts is not None:
-            write_atomic(path, self.to_json())
+            write_atomic(path, self.to_json(**extra))
             return path
         from ..export import save
 
-        return save(self, path)
+        return save(self, path, **extra)
 
-    def to_json(self) -> str:
+    def to_json(self, **extra) -> str:
         """``dumps(self.to_dict())``, made from the points' stored texts when there are."""
         if self.texts is None or len(self.texts) != len(self.points):
-            return dumps(self.to_dict())
+            return dumps({**self._head(**extra), **self.to_dict()})
         # "points" is the last key and json.dumps nests without indentation: the document
         # is the head with the texts spliced into its empty list.
-        head = dumps({**self._head(), "points": []})
+        head = dumps({**self._head(**extra), "points": []})
         return head[: -len("]}")] + ", ".join(self.texts) + "]}"
 
     @classmethod
@@ -127,7 +164,7 @@ class SweepResult:
             d["parameter"],
             np.asarray(d["values"]),
             d["direction"],
-            d["base_values"],
+            d["overrides"] if "overrides" in d else d["base_values"],
             d["settings"],
             [RunRecord.from_dict(p) for p in d["points"]],
             d.get("scales", {}),

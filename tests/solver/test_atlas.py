@@ -194,7 +194,7 @@ def test_map_records_round_trip(duffing, tmp_path):
 
 
 def test_map_figures_label_a_text_axis_and_write_only_the_kinds_asked(duffing, tmp_path):
-    from gearsym.solver.plots_maps import map_figures
+    from gearsym.solver.plots_maps import map_figures, write_map_figures
 
     s = duffing.with_values(a=1.0, c=0.1, k=0.1, B=0.3, omega=1.2)
     m = regime_map(
@@ -207,13 +207,13 @@ def test_map_figures_label_a_text_axis_and_write_only_the_kinds_asked(duffing, t
         periods=32,
         executor="serial",
     )
-    paths = map_figures(
+    paths = write_map_figures(
         m, tmp_path, "t", ticks={"B": ["low", "high"]}, title="a title", kinds=("motion",)
     )
     assert [p.name for p in paths] == ["t-motion.png"]
     assert sorted(f.name for f in tmp_path.iterdir()) == ["t-motion.png"]
     with pytest.raises(ValueError, match="kinds: spectrum unknown"):
-        map_figures(m, tmp_path, "t", kinds=("spectrum",))
+        map_figures(m, kinds=("spectrum",))
     import matplotlib.pyplot as plt
     from gearsym.solver.plots_maps import _label
 

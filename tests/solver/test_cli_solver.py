@@ -88,6 +88,10 @@ def test_sweep_refuses_a_bad_range(capsys):
 def test_reproduce_quick_writes_the_report(tmp_path, capsys):
     assert main(["reproduce", "--quick", "--out", str(tmp_path), "--quiet"]) == 0
     report = (tmp_path / "report.md").read_text()
+    # stdout: the short summary, not the report (issue 25, point 7)
+    said = capsys.readouterr().out
+    assert said.startswith("findings of the study, polynomial: ") and "## " not in said
+    assert f"report: {tmp_path / 'report.md'}" in said and len(said.splitlines()) == 5
     head = "| study | found with the polynomial | found with the dead zone | verdict | why |"
     assert head in report and "nan" not in report.lower().split()
     # the figure list names exactly the figures written
@@ -251,7 +255,7 @@ def test_continue_lists_the_folds_of_the_light_load_branch(tmp_path, capsys):
     assert code == 0
     out = capsys.readouterr().out
     assert sum(line.lstrip().startswith("fold ") for line in out.splitlines()) == 2
-    branches = json.loads((tmp_path / "branches.json").read_text())
+    branches = json.loads((tmp_path / "branches.json").read_text())["branches"]
     folds = sorted(b["value"] for b in branches[0]["bifurcations"])
     # The hysteresis window of the brute-force sweeps, [0.3, 0.8], lies between them.
     assert 0.25 < folds[0] < 0.3 and 0.8 < folds[1] < 0.85

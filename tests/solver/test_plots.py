@@ -3,12 +3,12 @@ markers of at least 3 px, both sweeps visible, legends outside the axes, the ope
 point and the verdict in the title of a one-point figure, spectra unfloored and whole to
 the sixth harmonic, runs that left the valid range shown in every map.
 
-The figure functions return the saved path; the tests catch the Figure on its way to
-the file (``_save``) and read its artists."""
+The figure functions return the Figure (nothing saved); the tests read its artists."""
 
 from dataclasses import replace
 
 import matplotlib.colors as mcolors
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 from gearsym.solver import plots, plots_maps
@@ -20,24 +20,10 @@ from gearsym.solver.sweep.atlas import regime_map
 DPI = 120  # the figures' resolution: a marker of ms points is ms * DPI / 72 px
 
 
-@pytest.fixture
-def caught(monkeypatch):
-    """The figures ``plots`` and ``plots_maps`` save, with their captions."""
-    figures = []
-
-    def keep(module):
-        original = module._save
-
-        def save(fig, path, *caption):
-            figures.append((fig, caption[0] if caption else ""))
-            fig.canvas.draw()  # lay out before the file closes it
-            return original(fig, path, *caption)
-
-        monkeypatch.setattr(module, "_save", save)
-
-    keep(plots)
-    keep(plots_maps)
-    return figures
+@pytest.fixture(autouse=True)
+def _close_figures():
+    yield
+    plt.close("all")
 
 
 def test_area_palettes_give_each_colour_one_meaning():
@@ -75,13 +61,12 @@ def _sweeps(duffing):
     return s, [sweep(s, "omega", [1.1, 1.2, 1.3], backward=b, **settings) for b in (False, True)]
 
 
-def test_bifurcation_diagram_shows_both_sweeps_and_the_operating_point(duffing, caught, tmp_path):
+def test_bifurcation_diagram_shows_both_sweeps_and_the_operating_point(duffing, tmp_path):
     system, sweeps = _sweeps(duffing)
-    path = plots.bifurcation_diagram(
-        sweeps, ["x"], tmp_path / "b.png", title="a sweep", system=system
-    )
-    assert path.exists()
-    fig, _ = caught[-1]
+    fig = plots.bifurcation_diagram(sweeps, ["x"], title="a sweep", system=system)
+    assert not list(tmp_path.iterdir())  # nothing saved: the caller's choice
+    path = plots.save_figure(fig, tmp_path / "b.png")
+    assert path.stat().st_size > 1000 and not plt.fignum_exists(fig.number)
     ax = fig.axes[0]
     lines = {ln.get_label(): ln for ln in ax.get_lines()}
     fwd, bwd = lines["forward sweep"], lines["backward sweep"]
@@ -94,11 +79,10 @@ def test_bifurcation_diagram_shows_both_sweeps_and_the_operating_point(duffing, 
     assert "a sweep\nω̄ = 1.1 to 1.3 over omega 1.1 to 1.3" in ax.get_title()
 
 
-def test_point_figure_titles_verdict_and_keeps_the_sixth_harmonic(duffing, caught, tmp_path):
+def test_point_figure_titles_verdict_and_keeps_the_sixth_harmonic(duffing):
     s = duffing.with_values(k=0.1, B=0.3, a=1.0, c=0.1, omega=1.2)
     point = analyse_point(s, None, transient=30, periods=16, lyapunov_periods=0)
-    plots.point_figure(point, tmp_path / "p.png", title="a point")
-    fig, _ = caught[-1]
+    fig = plots.point_figure(point, title="a point")
     title = fig._suptitle.get_text()
     assert "a point" in title and "ω̄ = 1.2" in title and "verdict: " in title
     spec = fig.axes[2]
@@ -111,8 +95,8 @@ def test_point_figure_titles_verdict_and_keeps_the_sixth_harmonic(duffing, caugh
     keep = (sp.frequency <= 6.5 * 1.2) & (sp.amplitude > 0)
     assert np.array_equal(curve.get_ydata(), sp.amplitude[keep])  # nothing floored
     # a bare trajectory still draws, without a verdict
-    plots.point_figure(point.trajectory, tmp_path / "t.png")
-    assert "verdict" not in caught[-1][0]._suptitle.get_text()
+    bare = plots.point_figure(point.trajectory)
+    assert "verdict" not in bare._suptitle.get_text()
 
 
 def _branch(values, n=1, fold=None):
@@ -126,10 +110,9 @@ def _branch(values, n=1, fold=None):
     return Branch("lambda", n, pts, bifs, state_names=("u", "v", "du", "dv"))
 
 
-def test_branch_figure_draws_each_coordinate_and_says_what_it_left_out(caught, tmp_path):
+def test_branch_figure_draws_each_coordinate_and_says_what_it_left_out():
     branches = [_branch([0.0, 0.2, 0.4], fold=0.2), _branch([0.0, 0.0])]
-    plots.branch_figure(branches, tmp_path / "c.png", ("u", "v"), title="two panels")
-    fig, _ = caught[-1]
+    fig = plots.branch_figure(branches, ("u", "v"), title="two panels")
     assert len(fig.axes) == 2 and len(fig.legends) == 1
     assert all(ax.get_legend() is None for ax in fig.axes)
     assert "1 branch(es) without extent in the parameter not drawn" in fig.axes[0].get_title()
@@ -142,7 +125,7 @@ def test_branch_figure_draws_each_coordinate_and_says_what_it_left_out(caught, t
         assert mark.get_ydata()[0] == pytest.approx([0.2, -0.2][k])
 
 
-def test_maps_show_runs_that_left_the_valid_range(duffing, caught, tmp_path):
+def test_maps_show_runs_that_left_the_valid_range(duffing):
     s = duffing.with_values(a=1.0, c=0.1, k=0.1, B=0.3, omega=1.2)
     m = regime_map(
         s,
@@ -158,8 +141,10 @@ def test_maps_show_runs_that_left_the_valid_range(duffing, caught, tmp_path):
     left = replace(cell.dominant, run=replace(cell.dominant.run, status="left the valid range"))
     cells = ((replace(cell, attractors=(left,)), *m.cells[0][1:]), *m.cells[1:])
     m = replace(m, cells=cells)
-    plots_maps.map_figures(m, tmp_path, "t", kinds=("motion", "lyapunov", "attractors"))
-    (motion, cap_motion), (lyap, _), (count, cap_count) = caught[-3:]
+    figures = plots_maps.map_figures(m, kinds=("motion", "lyapunov", "attractors"))
+    motion, lyap, count = figures.values()
+    # the caption line is the figure's last text
+    cap_motion, cap_count = motion.texts[-1].get_text(), count.texts[-1].get_text()
     shown = [t.get_text() for t in motion.axes[0].get_legend().get_texts()]
     assert "left the valid range" in shown
     hatched = [p for p in lyap.axes[0].patches if p.get_hatch()]
