@@ -10,6 +10,7 @@ shipped set in memory and lists every file that differs from what is on disk.
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -115,6 +116,23 @@ def write_files(files: dict[str, str], root: Path) -> list[Path]:
     return written
 
 
+def differs(old: str, new: str) -> str:
+    """Why a file on disk (``old``) is stale against its regeneration (``new``): a
+    generated module whose code changed under the same INPUTS_SHA256 means that models
+    derived into users' caches before the change would be loaded stale."""
+
+    def digest(text):
+        found = re.search(r"^INPUTS_SHA256 = ['\"]([0-9a-f]{64})['\"]", text, re.M)
+        return found and found.group(1)
+
+    if digest(old) and digest(old) == digest(new):
+        return (
+            "differs with the same INPUTS_SHA256: the emitted code changed, so bump "
+            "EMITTED_FORMAT in derive/_version.py, then run gearsym derive"
+        )
+    return "differs"
+
+
 def check(root: Path | None = None) -> list[str]:
     """Files under ``root`` that differ from a fresh regeneration of the shipped set."""
     root = Path(root) if root is not None else project_root()
@@ -124,8 +142,8 @@ def check(root: Path | None = None) -> list[str]:
         path = root / rel
         if not path.exists():
             stale.append(f"{rel} (missing)")
-        elif path.read_text(encoding="utf-8") != text:
-            stale.append(f"{rel} (differs)")
+        elif (old := path.read_text(encoding="utf-8")) != text:
+            stale.append(f"{rel} ({differs(old, text)})")
     if not (root / STIFFNESS_FIGURE).exists():
         stale.append(f"{STIFFNESS_FIGURE} (missing)")
     owned = set(built.files)

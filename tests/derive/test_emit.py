@@ -288,3 +288,16 @@ def test_batch_with_shared_parameters_gives_the_same_dx(tmp_path, scene, variati
             lib.ev_batch(tau, n, X, P, b)
             scale = np.max(np.abs(a), axis=1, keepdims=True)
             assert np.all(np.abs(a - b) <= 1e-15 * scale), np.max(np.abs(a - b) / scale)
+
+
+def test_check_names_code_changed_under_the_same_inputs_hash():
+    """A generated module whose text changed while its INPUTS_SHA256 did not would leave
+    stale models in users' caches (the cache is keyed by that hash): ``derive --check``
+    says to bump EMITTED_FORMAT; a changed hash is an ordinary regeneration."""
+    from gearsym.derive.build import differs
+
+    head = "INPUTS_SHA256 = '{}'\n"
+    same = head.format("a" * 64)
+    assert "bump EMITTED_FORMAT" in differs(same + "x = 1\n", same + "x = 2\n")
+    assert differs(same + "x = 1\n", head.format("b" * 64) + "x = 2\n") == "differs"
+    assert differs("# an audit page\n", "# another\n") == "differs"
