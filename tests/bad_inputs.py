@@ -355,8 +355,8 @@ CASES += []
 # continuation parameters and their valid ranges
 CASES += [
     (f"{FR} --param load_reading=0:1:3", "open value"),
-    (f"{FR} --param flywheel_inertia_kg_m2=0:1:3", "open value"),
-    ("continue reference-light --param layout_angle_deg --from 0 --to 10", "open value"),
+    ("frequency-response diso-bearings-light --param flywheel_inertia_kg_m2=0:1:3", "open value"),
+    ("continue diso-bearings-light --param flywheel_inertia_kg_m2 --from 2 --to 10", "open value"),
     (f"{FR} --param nosuch=0:1:3", "nosuch"),
     (f"{FR} --param damping_ratio=0.03:1.5:3", "damping_ratio"),
     (f"{FR} --param omega=0.5:-0.1:3", "omega"),
