@@ -59,51 +59,88 @@ def document(result, **extra) -> dict:
 
 def save(result, path, **extra) -> Path:
     """Write ``result`` to ``path``; the format follows the suffix (:data:`FORMATS`).
-    ``extra`` adds header keys (:func:`document`)."""
+    ``extra`` adds header keys (:func:`document`).  Arrays (a long run's samples) are
+    written in blocks, never as one list or one text in memory."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in FORMATS:
         raise ValueError(f"{path}: unknown format '{suffix}'; formats: {', '.join(FORMATS)}")
     data = document(result, **extra)
     if suffix == ".json":
-        return write_atomic(path, dumps(data))
+        return write_atomic(path, _json_parts(data))
     if suffix == ".csv":
         return write_atomic(path, _csv(data, *result.to_table()))
     from scipy.io import savemat
 
     columns, rows = result.to_table()
-    table = {_field(c): _column([r[k] for r in rows]) for k, c in enumerate(columns)}
-    buf = io.BytesIO()
-    savemat(buf, {"result": _mat(data), "table": table}, long_field_names=True, do_compression=True)
-    return write_atomic(path, buf.getvalue())
+    if isinstance(rows, np.ndarray):
+        table = {_field(c): np.asarray(rows[:, k], dtype=float) for k, c in enumerate(columns)}
+    else:
+        table = {_field(c): _column([r[k] for r in rows]) for k, c in enumerate(columns)}
+    content = {"result": _mat(data), "table": table}
+    return write_atomic(
+        path, lambda fh: savemat(fh, content, long_field_names=True, do_compression=True)
+    )
 
 
-def write_atomic(path, content: str | bytes) -> Path:
-    """Write ``content`` to ``path`` through a temporary file and a rename."""
+def write_atomic(path, content) -> Path:
+    """Write ``content`` to ``path`` through a temporary file and a rename: text, bytes,
+    an iterable of text or bytes parts, or a function that writes to a binary file."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    parts = [content] if isinstance(content, str | bytes) else content
     try:
-        if isinstance(content, bytes):
-            tmp.write_bytes(content)
-        else:
-            tmp.write_text(content, encoding="utf-8")
+        with open(tmp, "wb") as fh:
+            if callable(parts):
+                parts(fh)
+            for part in () if callable(parts) else parts:
+                fh.write(part if isinstance(part, bytes) else part.encode("utf-8"))
         os.replace(tmp, path)
     finally:
         tmp.unlink(missing_ok=True)
     return path
 
 
-def _csv(data: dict, columns, rows) -> str:
-    out = io.StringIO()
+_BLOCK = 8192  # array entries (or table rows) per written block
+
+
+def _json_parts(obj):
+    """``dumps(obj)`` in parts: the same text, with long float arrays written block by
+    block (``json.dumps`` separators: ``", "`` and ``": "``)."""
+    if isinstance(obj, dict):
+        yield "{"
+        for k, (key, value) in enumerate(obj.items()):
+            yield (", " if k else "") + dumps(str(key)) + ": "
+            yield from _json_parts(value)
+        yield "}"
+    elif isinstance(obj, np.ndarray) and obj.ndim == 1 and obj.size > _BLOCK:
+        yield "["
+        for k in range(0, obj.size, _BLOCK):
+            yield (", " if k else "") + dumps(obj[k : k + _BLOCK])[1:-1]
+        yield "]"
+    else:
+        yield dumps(obj)
+
+
+def _csv(data: dict, columns, rows):
+    """The CSV text in parts: the header lines, the column names, then the rows in
+    blocks (an array of rows: non-finite entries as empty cells)."""
+    head = io.StringIO()
     for k in KEYS:
         if k in data:
-            out.write(f"# {k}: {dumps(data[k])}\n")
-    writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(columns)
-    for row in rows:
-        writer.writerow([_cell(v) for v in row])
-    return out.getvalue()
+            head.write(f"# {k}: {dumps(data[k])}\n")
+    csv.writer(head, lineterminator="\n").writerow(columns)
+    yield head.getvalue()
+    for k in range(0, len(rows), _BLOCK):
+        out = io.StringIO()
+        writer = csv.writer(out, lineterminator="\n")
+        block = rows[k : k + _BLOCK]
+        if isinstance(block, np.ndarray):
+            writer.writerows(clean(np.asarray(block, dtype=float)))
+        else:
+            writer.writerows([_cell(v) for v in row] for row in block)
+        yield out.getvalue()
 
 
 def _cell(v):
@@ -144,6 +181,10 @@ def _mat(obj):
     """Nested data as savemat takes it: dicts as structs (field names cleaned), lists of
     numbers as arrays (rectangular lists of them as matrices), lists of text or of mixed
     items as cell arrays, booleans as double, None as NaN."""
+    if isinstance(obj, np.ndarray) and obj.dtype.kind in "fiub":
+        return np.asarray(obj, dtype=float)  # NaN stays NaN, as in MATLAB
+    if isinstance(obj, dict):
+        return {_field(k): _mat(v) for k, v in obj.items()}
     obj = clean(obj)
     if isinstance(obj, dict):
         return {_field(k): _mat(v) for k, v in obj.items()}

@@ -112,16 +112,18 @@ class Trajectory:
         }
 
     def to_dict(self, samples: bool = True) -> dict:
-        """The run's settings and outcome, with the samples (``t`` and each state)."""
+        """The run's settings and outcome, with the samples (``t`` and each state) as
+        NumPy arrays (a long run holds millions of them; ``solver/export.py`` writes them
+        in blocks, and ``gearsym.solver._json.dumps`` takes them)."""
         out = {"system": self.system.describe(), "integration": self.describe()}
         if samples:
-            out["t"] = self.t.tolist()
-            out["x"] = {s: self.x[k].tolist() for k, s in enumerate(self.system.states)}
+            out["t"] = self.t
+            out["x"] = {s: self.x[k] for k, s in enumerate(self.system.states)}
         return out
 
-    def to_table(self) -> tuple[list, list]:
-        """One row per sample: tau and every state."""
-        return ["tau", *self.system.states], np.vstack([self.t, self.x]).T.tolist()
+    def to_table(self) -> tuple[list, np.ndarray]:
+        """One row per sample: tau and every state (an array, one row per sample)."""
+        return ["tau", *self.system.states], np.vstack([self.t, self.x]).T
 
     def save(self, path):
         """Write to ``path``: ``.json``, ``.csv`` or ``.mat`` (see ``solver/export.py``)."""
