@@ -193,3 +193,44 @@ def test_an_unknown_format_is_refused_in_one_line(tmp_path, capsys):
     code = main([*COMMANDS["shoot"][1], "--out", str(tmp_path), "--format", "json,xlsx"])
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and "--format json,xlsx: 'xlsx'" in err, err
+
+
+def test_long_arrays_are_written_in_blocks_as_the_same_text(tmp_path):
+    """A long run's samples are written block by block (bounded memory, tests/test_memory.py):
+    the JSON must be the text of ``dumps`` on the whole (the reference: the unstreamed
+    writer), non-finite numbers null in JSON, empty in CSV and NaN in the .mat."""
+    from gearsym.solver import export
+    from gearsym.solver._json import dumps
+
+    t = np.linspace(0.0, 1.0, 3 * export._BLOCK + 5)
+    x = np.sin(t)
+    x[7], x[export._BLOCK + 1] = np.nan, np.inf
+    doc = export.Document(
+        {"model": "m", "samples": {"t": t, "x": x}}, ["tau", "x"], np.column_stack([t, x])
+    )
+    for suffix in (".json", ".csv", ".mat"):
+        export.save(doc, tmp_path / f"a{suffix}")
+    assert (tmp_path / "a.json").read_text(encoding="utf-8") == dumps(doc.to_dict())
+    header, columns, rows = read_csv(tmp_path / "a.csv")
+    assert header == {"model": "m"} and columns == ["tau", "x"] and len(rows) == t.size
+    assert rows[7][1] == "" and rows[export._BLOCK + 1][1] == ""
+    assert [float(r[1]) for r in rows[-3:]] == x[-3:].tolist()
+    mat = loadmat(tmp_path / "a.mat", simplify_cells=True)
+    for got in (mat["table"]["x"], mat["result"]["samples"]["x"]):
+        assert np.isnan(got[7]) and np.isinf(got[export._BLOCK + 1])
+        assert np.allclose(got[export._BLOCK + 2 :], x[export._BLOCK + 2 :], rtol=0, atol=0)
+
+
+def test_a_trajectory_file_carries_the_header_block(tmp_path):
+    import gearsym
+
+    tr = gearsym.simulate(gearsym.load("reference-linear"), transient=5, periods=3)
+    for suffix in (".json", ".csv", ".mat"):
+        tr.save(tmp_path / f"run{suffix}", command="a test")
+    doc = json.loads((tmp_path / "run.json").read_text(encoding="utf-8"))
+    header, columns, rows = read_csv(tmp_path / "run.csv")
+    for key in HEADER:
+        assert key in doc and header[key] == doc[key], key
+    assert doc["model_hash"] == tr.system.model_hash and columns[0] == "tau"
+    assert len(rows) == len(doc["t"]) == tr.t.size
+    same(doc, loadmat(tmp_path / "run.mat", simplify_cells=True)["result"], "run")

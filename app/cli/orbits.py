@@ -217,7 +217,7 @@ def _cmd_shoot(args) -> int:
         raise RunFailed(f"shoot: {err}; residuals {[f'{r:.2g}' for r in err.history]}") from None
     orbit = found.orbit or found.lower
     data = orbit.describe()
-    data["requested_period_multiple"] = args.period
+    data["requested"] = args.period
     data["found_requested_period"] = found.found
     data["attempts"] = found.attempts
     data["initial_state"] = start.describe()

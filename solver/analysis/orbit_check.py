@@ -78,11 +78,11 @@ class OrbitCheck:
     def describe(self) -> dict:
         mu = [] if self.multipliers is None else self.multipliers
         return {
-            "period_multiple": self.n,
+            "n": self.n,
             "converged": self.converged,
             "minimal_period": self.minimal_period,
             "residual": self.residual,
-            "newton_iterations": self.iterations,
+            "iterations": self.iterations,
             "distance_from_run": self.distance,
             "multipliers": [[float(m.real), float(m.imag)] for m in mu],
             "largest_multiplier": None if self.multipliers is None else self.largest,

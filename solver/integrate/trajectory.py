@@ -114,8 +114,14 @@ class Trajectory:
     def to_dict(self, samples: bool = True) -> dict:
         """The run's settings and outcome, with the samples (``t`` and each state) as
         NumPy arrays (a long run holds millions of them; ``solver/export.py`` writes them
-        in blocks, and ``gearsym.solver._json.dumps`` takes them)."""
-        out = {"system": self.system.describe(), "integration": self.describe()}
+        in blocks, and ``gearsym.solver._json.dumps`` takes them), after the header block
+        of every result file (``solver/provenance.py``)."""
+        from ..provenance import provenance
+
+        out = provenance(self.system) | {
+            "system": self.system.describe(),
+            "integration": self.describe(),
+        }
         if samples:
             out["t"] = self.t
             out["x"] = {s: self.x[k] for k, s in enumerate(self.system.states)}
@@ -125,8 +131,8 @@ class Trajectory:
         """One row per sample: tau and every state (an array, one row per sample)."""
         return ["tau", *self.system.states], np.vstack([self.t, self.x]).T
 
-    def save(self, path):
+    def save(self, path, **extra):
         """Write to ``path``: ``.json``, ``.csv`` or ``.mat`` (see ``solver/export.py``)."""
         from ..export import save
 
-        return save(self, path)
+        return save(self, path, **extra)

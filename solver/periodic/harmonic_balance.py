@@ -135,11 +135,11 @@ class HBSolution:
     def describe(self) -> dict:
         return {
             "method": "harmonic balance (AFT)",
-            "period_multiple": self.n,
+            "n": self.n,
             "harmonics": self.harmonics,
             "samples": self.samples,
             "residual": self.residual,
-            "newton_iterations": self.iterations,
+            "iterations": self.iterations,
             "tail_share": self.tail_share(),
             "values": {k: float(v) for k, v in self.system.values.items()},
             "coordinates": {

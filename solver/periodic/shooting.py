@@ -99,13 +99,13 @@ class Orbit:
 
     def describe(self) -> dict:
         return {
-            "period_multiple": self.n,
-            "minimal_period_multiple": self.minimal_period,
-            "period_tau": self.period,
+            "n": self.n,
+            "minimal_period": self.minimal_period,
+            "period": self.period,
             "t0": self.t0,
             "x0": dict(zip(self.system.states, map(float, self.x0), strict=True)),
             "residual": self.residual,
-            "newton_iterations": self.iterations,
+            "iterations": self.iterations,
             "history": self.history,
             "segments": self.segments,
             "floquet": None if self.floquet is None else self.floquet.describe(),
@@ -291,7 +291,7 @@ class OrbitSearch:
     def to_dict(self) -> dict:
         best = self.orbit or self.lower
         return {
-            "requested_period_multiple": self.requested,
+            "requested": self.requested,
             "found": self.found,
             "attempts": self.attempts,
             "orbit": None if best is None else best.to_dict(),

@@ -223,8 +223,8 @@ def test_shoot_json_reports_the_orbit_and_its_multipliers(tmp_path, capsys):
     )
     assert code == 0
     data = json.loads(capsys.readouterr().out)
-    assert data["residual"] < 1e-10 and data["newton_iterations"] >= 1
-    assert set(data["x0"]) == {"u", "v", "du", "dv"} and data["period_tau"] > 0
+    assert data["residual"] < 1e-10 and data["iterations"] >= 1
+    assert set(data["x0"]) == {"u", "v", "du", "dv"} and data["period"] > 0
     fl = data["floquet"]
     assert len(fl["multipliers"]) == 4 and fl["stable"] is True
     assert fl["liouville_error"] < 1e-8

@@ -64,8 +64,8 @@ def test_shoot_reports_a_lower_period_as_what_it_is(capsys):
     argv = ["shoot", "reference-light", "--set", "lambda=0.8", "--period", "2", "--tries", "1"]
     assert main([*argv, "--json"]) == 3  # not the period asked for: exit status 3
     data = json.loads(capsys.readouterr().out)
-    assert data["found_requested_period"] is False and data["requested_period_multiple"] == 2
-    assert data["period_multiple"] == 1 and data["minimal_period_multiple"] == 1
+    assert data["found_requested_period"] is False and data["requested"] == 2
+    assert data["n"] == 1 and data["minimal_period"] == 1
     assert main(argv) == 3
     out = capsys.readouterr().out
     assert out.startswith("no orbit of minimal period 2 found") and "period-1 orbit" in out
