@@ -127,8 +127,9 @@ def differs(old: str, new: str) -> str:
 
     if digest(old) and digest(old) == digest(new):
         return (
-            "differs with the same INPUTS_SHA256: the emitted code changed, so bump "
-            "EMITTED_FORMAT in derive/_version.py, then run gearsym derive"
+            "differs under the same INPUTS_SHA256: edited by hand, or the emitted code "
+            "changed; then bump EMITTED_FORMAT in derive/_version.py, so that models "
+            "cached before are derived again"
         )
     return "differs"
 
