@@ -46,6 +46,9 @@ _EXPORTS = {
     "fit_dead_zone": "gearsym.derive",
     "reproduce": "gearsym.studies.reproduce",
     "plot": ("gearsym.plot", None),  # the module itself: the figures
+    "Units": "gearsym.solver.units",
+    "in_units": "gearsym.solver.units",
+    "orbit_in_units": "gearsym.solver.units",
     **{
         name: "gearsym.solver"
         for name in (
@@ -106,6 +109,7 @@ __all__ = [
     "SweepResult",
     "System",
     "Trajectory",
+    "Units",
     "analyse",
     "continue_hb",
     "continue_orbit",
@@ -113,9 +117,11 @@ __all__ = [
     "fit_dead_zone",
     "frequency_response",
     "harmonic_balance",
+    "in_units",
     "load",
     "load_target",
     "modes",
+    "orbit_in_units",
     "plot",
     "regime_map",
     "reproduce",

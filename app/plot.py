@@ -50,13 +50,14 @@ def point(result, title: str = "", periods_shown: int = 20):
     return point_figure(result, title=title, periods_shown=periods_shown)
 
 
-def bifurcation(sweeps, states=None, title: str = "", *, system=None):
+def bifurcation(sweeps, states=None, title: str = "", *, system=None, units: str = "model"):
     """Poincaré points against the swept parameter, one panel per state.
 
     ``sweeps``: a ``SweepResult`` (``gearsym.sweep``) or a list of them (a forward and a
     backward sweep: rings and dots, so hysteresis shows); ``states``: state names
     (default: the mesh coordinates); ``system``: the ``System`` swept, for ω̄ and the
-    loads in the title.  Returns a Figure.
+    loads in the title; ``units="physical"`` (needs ``system``): deflections in µm at each
+    point's own scales, the speed in rpm beside ω̄.  Returns a Figure.
     """
     from gearsym.solver.plots import bifurcation_diagram
 
@@ -68,34 +69,38 @@ def bifurcation(sweeps, states=None, title: str = "", *, system=None):
             if system is not None
             else list(getattr(first, "classification", None) or ["u"])
         )
-    return bifurcation_diagram(sweeps, list(states), title=title, system=system)
+    return bifurcation_diagram(sweeps, list(states), title=title, system=system, units=units)
 
 
-def map(result, *, kinds=None, ticks=None, title=None):
+def map(result, *, kinds=None, ticks=None, title=None, system=None, units: str = "model"):
     """The figures of a regime map: ``{kind: Figure}`` for the kinds asked (default all:
     ``motion``, ``lyapunov``, ``attractors``, ``extremes``, ``meshing`` -- the last only
     for a model with contact edges), each with its caption line.
 
     ``result``: a ``RegimeMap`` (``gearsym.regime_map``); ``ticks``: ``{axis: [label per
-    value]}`` for an axis whose values stand for text; ``title`` opens the caption.
+    value]}`` for an axis whose values stand for text; ``title`` opens the caption;
+    ``units="physical"`` with the mapped ``system``: extremes in µm, exponents per second,
+    the speed or mesh frequency beside an omega or speed axis.
     """
     from gearsym.solver.plots_maps import FIGURES, map_figures
 
-    return map_figures(result, ticks=ticks, title=title, kinds=FIGURES if kinds is None else kinds)
+    kinds = FIGURES if kinds is None else kinds
+    return map_figures(result, ticks=ticks, title=title, kinds=kinds, system=system, units=units)
 
 
-def branches(result, state=None, sweeps=None, title: str = "", *, system=None):
+def branches(result, state=None, sweeps=None, title: str = "", *, system=None, units="model"):
     """Continued periodic branches: stable solid, unstable dashed, bifurcations marked,
     over the Poincaré points of brute-force ``sweeps`` (``SweepResult`` list) if given.
 
     ``result``: a ``Branch`` (``gearsym.continue_orbit``) or a list of them; ``state``: a
     state name or a sequence of names (a panel each; default the first state); ``system``:
-    for ω̄ and the loads in the title.  Returns a Figure.
+    for ω̄ and the loads in the title; ``units="physical"`` (needs ``system``): states in
+    µm, the speed in rpm beside ω̄.  Returns a Figure.
     """
     from gearsym.solver.plots import branch_figure
 
     result = [result] if not isinstance(result, list | tuple) else list(result)
-    return branch_figure(result, state, sweeps=sweeps, title=title, system=system)
+    return branch_figure(result, state, sweeps=sweeps, title=title, system=system, units=units)
 
 
 def multipliers(orbit, title: str = ""):

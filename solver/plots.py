@@ -2,10 +2,11 @@
 
 Every function takes data (a result object of the API) and returns a matplotlib ``Figure``
 (Agg back end, no display needed); saving is the caller's choice (:func:`save_figure`).
-Axes are labelled with their (non-dimensional) units.  One meaning has one colour in
-every figure of the package: the palettes are in :mod:`.plots_style`; markers are at
-least 3 px, legends sit outside the axes, and a figure of one operating point says that
-point (ω̄, loads, backlash model) and its verdict in its title.
+Axes are labelled with their units: the model's (half backlashes, τ) by default,
+``units="physical"`` for µm and the speed in rpm beside omega (``solver/units.py``).
+One meaning has one colour in every figure of the package: the palettes are in
+:mod:`.plots_style`; markers are at least 3 px, legends sit outside the axes, and a figure
+of one operating point says that point (ω̄, loads, backlash model) and its verdict in its title.
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ from .plots_style import (  # noqa: E402
     sweep_marker,
 )
 from .sweep import SweepResult  # noqa: E402
+from .units import Units, parameter_axis, secondary_axis, state_factors, state_unit  # noqa: E402
 
 __all__ = [
     "bifurcation_diagram",
@@ -61,6 +63,7 @@ def bifurcation_diagram(
     title: str = "",
     *,
     system=None,
+    units: str = "model",
 ):
     """Poincaré points of each state against the swept parameter, one panel per state.
 
@@ -69,8 +72,12 @@ def bifurcation_diagram(
     (3.5 px) on top; hysteresis shows as rings and dots apart.  Points whose run did not
     end normally (diverged, left the valid range) are crosses on the panel's lower edge.
     ``system``: the model the sweeps ran on; the title then states ω̄ and the loads (from
-    the sweep's first to its last value).  Units: half backlashes.
+    the sweep's first to its last value).  ``units``: ``model`` (half backlashes, and per
+    unit τ for velocities) or ``physical`` (needs ``system``: deflections in µm, with the
+    half backlash at each value; omega or the speed with the other on a top axis).
     """
+    if units == "physical" and system is None:
+        raise ValueError("units='physical' needs the system the sweeps ran on (system=)")
     fig, axes = plt.subplots(
         len(states), 1, figsize=(7.5, 2.8 * len(states)), sharex=True, squeeze=False
     )
@@ -82,10 +89,11 @@ def bifurcation_diagram(
         cell = max(float(np.ptp(finite)) if finite.size else 0.0, 1e-12) * 1e-4
         for sw in order:
             xs, ys = [], []
-            for value, pts in zip(sw.values, sw.poincare(state), strict=True):
+            scale, unit = state_factors(system, units, sw.parameter, sw.values, state)
+            for value, pts, k in zip(sw.values, sw.poincare(state), scale, strict=True):
                 pts = _distinct(np.asarray(pts, float), lo, cell)
                 xs.append(np.full(pts.size, value))
-                ys.append(pts)
+                ys.append(pts * k)
             ax.plot(
                 np.concatenate(xs) if xs else [],
                 np.concatenate(ys) if ys else [],
@@ -94,9 +102,9 @@ def bifurcation_diagram(
                 **sweep_marker(sw.direction),
             )
             not_ok_marks(ax, sw.values, [p.status for p in sw.points])
-        ax.set_ylabel(f"{state} (Poincaré), half backlashes")
+        ax.set_ylabel(f"{state} (Poincaré), {unit}" if sweeps else state)
         ax.grid(alpha=0.3)
-    axes[-1, 0].set_xlabel(sweeps[0].parameter)
+    _parameter_axis(axes, system, units, sweeps[0].parameter if sweeps else "")
     head = title
     if system is not None:
         head += ("\n" if head else "") + operating_point(
@@ -106,6 +114,17 @@ def bifurcation_diagram(
         axes[0, 0].set_title(head, fontsize=10)
     legend_below(fig, axes.ravel())
     return fig
+
+
+def _parameter_axis(axes, system, units: str, name: str) -> None:
+    """The bottom panel's x label in ``units``; a physical omega or speed gets the other
+    on the top panel's secondary axis (``units.parameter_axis``)."""
+    if system is None:
+        axes[-1, 0].set_xlabel(name)
+        return
+    label, top = parameter_axis(Units.of(system, units), name)
+    axes[-1, 0].set_xlabel(label)
+    secondary_axis(axes[0, 0], top)
 
 
 def _title(tr: Trajectory, point, title: str) -> str:
@@ -266,7 +285,9 @@ def _drawable(branches) -> tuple[list, list]:
     return keep, empty
 
 
-def branch_figure(branches, state=None, sweeps=None, title: str = "", *, system=None):
+def branch_figure(
+    branches, state=None, sweeps=None, title: str = "", *, system=None, units: str = "model"
+):
     """Continuation branches over the brute-force diagram: stable solid, unstable dashed,
     bifurcations marked; the Poincaré points of brute-force sweeps behind them (in the
     sweeps' palette).
@@ -275,8 +296,10 @@ def branch_figure(branches, state=None, sweeps=None, title: str = "", *, system=
     may show in one coordinate only), or None (the branches' first state).  One legend
     for the figure, below it.  Branches without extent in the parameter are not drawn
     and the title says how many.  ``system``: the model, for ω̄ and loads in the title.
-    Units: half backlashes.
+    ``units``: as :func:`bifurcation_diagram`'s (``physical`` needs ``system``).
     """
+    if units == "physical" and system is None:
+        raise ValueError("units='physical' needs the system the branches belong to (system=)")
     drawn, empty = _drawable(branches)
     if state is None:
         state = branches[0].state_names[0] if branches else "x"
@@ -287,9 +310,10 @@ def branch_figure(branches, state=None, sweeps=None, title: str = "", *, system=
     for ax, name in zip(axes[:, 0], names, strict=True):
         for sw in sorted(sweeps or [], key=lambda sw: sw.direction != "backward"):
             xs, ys = [], []
-            for value, pts in zip(sw.values, sw.poincare(name), strict=True):
+            scale, _ = state_factors(system, units, sw.parameter, sw.values, name)
+            for value, pts, k in zip(sw.values, sw.poincare(name), scale, strict=True):
                 xs.append(np.full(np.size(pts), value))
-                ys.append(np.asarray(pts, float))
+                ys.append(np.asarray(pts, float) * k)
             if xs:
                 style = sweep_marker(sw.direction) | {"alpha": 0.5}
                 label = f"brute force, {sw.direction} sweep (Poincaré points)"
@@ -297,7 +321,8 @@ def branch_figure(branches, state=None, sweeps=None, title: str = "", *, system=
         for br in drawn:
             index = br.state_names.index(name)
             lam = np.asarray(br.values)
-            y = np.array([s[index] for s in br.states])
+            scale, _ = state_factors(system, units, br.parameter, lam, name)
+            y = np.array([s[index] for s in br.states]) * scale
             stable = np.asarray(br.stable)
             for flag, style in ((True, "-"), (False, "--")):
                 if not np.any(stable == flag):
@@ -312,11 +337,13 @@ def branch_figure(branches, state=None, sweeps=None, title: str = "", *, system=
                 )
             for b in br.bifurcations:
                 marker, colour = BIFURCATIONS[b.kind]
-                ax.plot(b.value, b.x0[index], marker, color=colour, ms=7, mfc="none", mew=1.5)
+                k = state_factors(system, units, br.parameter, [b.value], name)[0][0]
+                ax.plot(b.value, b.x0[index] * k, marker, color=colour, ms=7, mfc="none", mew=1.5)
                 ax.plot([], [], marker, color=colour, ms=7, mfc="none", mew=1.5, label=b.kind)
-        ax.set_ylabel(f"{name} at τ = 0 mod nT\n(half backlashes)")
+        unit = state_unit(system, units, name) or "half backlashes"
+        ax.set_ylabel(f"{name} at τ = 0 mod nT\n({unit})")
         ax.grid(alpha=0.3)
-    axes[-1, 0].set_xlabel(branches[0].parameter if branches else "")
+    _parameter_axis(axes, system, units, branches[0].parameter if branches else "")
     head = [title] if title else []
     if system is not None and drawn:
         span = np.concatenate([np.asarray(br.values, float) for br in drawn])

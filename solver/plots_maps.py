@@ -33,6 +33,7 @@ from .plots_style import (
     sweep_marker,
 )
 from .sweep.maps_result import RegimeMap
+from .units import Units, at, parameter_axis, secondary_axis
 
 __all__ = [
     "BIFURCATIONS",
@@ -71,17 +72,27 @@ def _edges(v) -> np.ndarray:
     return np.concatenate([[2 * v[0] - mid[0]], mid, [2 * v[-1] - mid[-1]]])
 
 
-def _label(ax, m: RegimeMap, ticks: dict | None = None) -> None:
+def _label(ax, m: RegimeMap, ticks: dict | None = None, units: Units | None = None) -> None:
     """Axis names; an unevenly spaced axis gets one tick per value (cells of equal size);
-    ``ticks`` names the values of an axis that stands for text (``{axis: [label, ...]}``)."""
+    ``ticks`` names the values of an axis that stands for text (``{axis: [label, ...]}``).
+    ``units`` (physical): omega or the speed says the other (``units.parameter_axis``): on
+    a top axis for x, in the label for y (the colour bar holds the right side)."""
     ticks = ticks or {}
     for values, name, axis in ((m.x_values, m.x, ax.xaxis), (m.y_values, m.y, ax.yaxis)):
         if name in ticks:
             axis.set_label_text(name)
             axis.set_ticks(np.asarray(values, float), list(ticks[name]))
             continue
-        axis.set_label_text(name + (" (unevenly spaced values)" if _uneven(values) else ""))
-        if _uneven(values):
+        label, top = name, None
+        if units is not None:
+            label, top = parameter_axis(units, name)
+        uneven = _uneven(values)
+        if top is not None and axis is ax.yaxis:  # short lines: the axis is 3 inches
+            label = f"{label.split(' (')[0]}\n{top[0]} = {top[1](1.0):.5g} × {name}"
+        elif top is not None and not uneven:
+            secondary_axis(ax, top)
+        axis.set_label_text(label + (" (unevenly spaced values)" if uneven else ""))
+        if uneven:
             axis.set_ticks(np.arange(len(values)), [f"{v:g}" for v in values])
 
 
@@ -160,6 +171,15 @@ def _captioned(fig, caption: str):
     return fig
 
 
+def _cell_units(m: RegimeMap, system, units: str) -> np.ndarray:
+    """(ny, nx) :class:`Units` of the cells (each with its x and y values set)."""
+    out = np.empty((len(m.y_values), len(m.x_values)), dtype=object)
+    for iy, y in enumerate(m.y_values):
+        for ix, x in enumerate(m.x_values):
+            out[iy, ix] = at(system, units, {m.x: float(x), m.y: float(y)})
+    return out
+
+
 FIGURES = ("motion", "lyapunov", "attractors", "extremes", "meshing")
 
 
@@ -170,9 +190,12 @@ def write_map_figures(
     ticks: dict | None = None,
     title: str | None = None,
     kinds: tuple = FIGURES,
+    *,
+    system=None,
+    units: str = "model",
 ) -> list[Path]:
     """:func:`map_figures` written into ``folder`` as ``<prefix>-<kind>.png``; the paths."""
-    figures = map_figures(m, ticks=ticks, title=title, kinds=kinds)
+    figures = map_figures(m, ticks=ticks, title=title, kinds=kinds, system=system, units=units)
     return [save_figure(fig, Path(folder) / f"{prefix}-{k}.png") for k, fig in figures.items()]
 
 
@@ -182,6 +205,8 @@ def map_figures(
     ticks: dict | None = None,
     title: str | None = None,
     kinds: tuple = FIGURES,
+    system=None,
+    units: str = "model",
 ) -> dict:
     """The figures of a map, ``{kind: Figure}`` in the order of :data:`FIGURES` (the
     meshing regime only for models with contact edges), each with its caption line;
@@ -190,11 +215,22 @@ def map_figures(
     opens the caption instead of the model's name (say what a derived variant is);
     ``kinds``: which of :data:`FIGURES` to write.  Colours: :data:`MOTION_CLASSES` and
     :data:`MESHING_CLASSES` (no colour in both); runs that left the valid range or
-    diverged are a class of their own in the categorical maps and hatched in the others."""
+    diverged are a class of their own in the categorical maps and hatched in the others.
+    ``units="physical"`` (needs ``system``, the map's model): extremes of the mesh
+    deflections in µm and the exponent per second, each cell with its own scales; omega or
+    the speed with the other (``units.parameter_axis``)."""
     unknown = sorted(set(kinds) - set(FIGURES))
     if unknown:
         raise ValueError(f"kinds: {', '.join(unknown)} unknown; known: {', '.join(FIGURES)}")
+    if units == "physical" and system is None:
+        raise ValueError("units='physical' needs the map's system (system=)")
+    phys = Units.of(system, units) if units == "physical" else None
+    cells = _cell_units(m, system, units) if phys else None
     caption = _caption(m, title)
+    if phys and not {m.x, m.y} & {"speed_rpm", phys.forcing}:  # else an axis says it
+        caption += f"; {phys.operating_point()}"
+    elif phys and phys.forcing in (m.x, m.y):
+        caption += f"; mesh frequency = {phys.frequency(1.0):.5g} Hz × {phys.forcing}"
     out = {}
     coords, nc = m.coordinates, len(m.coordinates)
     xe, ye = _edges(m.x_values), _edges(m.y_values)
@@ -203,7 +239,7 @@ def map_figures(
 
     def categorical_panel(ax, labels, classes, text):
         categorical(ax, xe, ye, labels, classes)
-        _label(ax, m, ticks)
+        _label(ax, m, ticks, phys)
         ax.set_title(text)
 
     if "motion" in kinds:
@@ -225,10 +261,14 @@ def map_figures(
     if "lyapunov" in kinds:
         fig, ax = plt.subplots(figsize=(6.5, 4.5))
         lam = m.grid("lyapunov")
+        per = "per unit τ"
+        if phys:
+            lam = lam * np.vectorize(lambda u: u.scales["omega_n_rad_per_s"])(cells)
+            per = "per second: per unit τ × ω_n"
         lim = np.nanmax(np.abs(lam)) if np.any(np.isfinite(lam)) else 1.0
         im = ax.pcolormesh(xe, ye, lam, cmap="RdBu_r", vmin=-lim, vmax=lim)
-        fig.colorbar(im, ax=ax, label="largest Lyapunov exponent (per unit τ)")
-        _label(ax, m, ticks)
+        fig.colorbar(im, ax=ax, label=f"largest Lyapunov exponent ({per})")
+        _label(ax, m, ticks, phys)
         _hatch(ax, m, failed, "no exponent")
         ax.set_title("largest Lyapunov exponent (> 0: chaos); blank: no estimate")
         out["lyapunov"] = _captioned(fig, caption)
@@ -240,7 +280,7 @@ def map_figures(
         cmap = plt.get_cmap("viridis", top + 1)
         im = ax.pcolormesh(xe, ye, count, cmap=cmap, vmin=-0.5, vmax=top + 0.5)
         fig.colorbar(im, ax=ax, ticks=range(0, top + 1), label="attractors found")
-        _label(ax, m, ticks)
+        _label(ax, m, ticks, phys)
         _hatch(ax, m, _outcomes(m, every=True), "some starts; not counted")
         ax.set_title(f"attractors found from {m.settings['initial_states']} initial states")
         out["attractors"] = _captioned(fig, _caption(m, title, "all"))
@@ -250,9 +290,13 @@ def map_figures(
         for k, c in enumerate(coords):
             for row, field in enumerate(("max", "min")):
                 ax = axes[row][k]
-                im = ax.pcolormesh(xe, ye, m.grid(field, c), cmap="viridis")
-                fig.colorbar(im, ax=ax, label=f"{field.capitalize()}({c}) / half backlash")
-                _label(ax, m, ticks)
+                grid, unit = m.grid(field, c), "/ half backlash"
+                if phys:
+                    grid = grid * np.vectorize(lambda u, c=c: u.deflection(c, 1.0))(cells)
+                    unit = f"in {phys.deflection_unit(c)}"
+                im = ax.pcolormesh(xe, ye, grid, cmap="viridis")
+                fig.colorbar(im, ax=ax, label=f"{field.capitalize()}({c}) {unit}")
+                _label(ax, m, ticks, phys)
                 _hatch(ax, m, failed, "extremes up to the exit")
                 ax.set_title(f"{field.capitalize()}({c}) over the sampled window")
         out["extremes"] = _captioned(fig, caption)

@@ -125,7 +125,7 @@ def operating_point(system, parameter: str | None = None, values=None) -> str:
 
     loads = ", ".join(text(name, name) for name in c.loads.values())
     out = text(c.forcing_frequency, "ω̄") + (f"; {loads}" if loads else "")
-    if ends is not None:
+    if ends is not None and parameter != c.forcing_frequency:  # else the ω̄ range says it
         out += f" over {parameter} {lo:.4g} to {hi:.4g}"
     backlash = getattr(system.module, "FEATURES", {}).get("backlash")
     return out + (f"; {backlash} backlash" if backlash else "")

@@ -21,7 +21,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-__all__ = ["UNITS", "Units"]
+__all__ = [
+    "UNITS",
+    "InUnits",
+    "Units",
+    "in_units",
+    "orbit_in_units",
+    "parameter_axis",
+    "point_in_units",
+]
 
 UNITS = ("model", "physical")
 
@@ -33,12 +41,14 @@ class Units:
     kind: str
     scales: dict
     omega: float  # the system's non-dimensional excitation frequency
+    forcing: str = "omega"  # its name (the contract's forcing frequency)
 
     @classmethod
     def of(cls, system, kind: str = "physical") -> Units:
         if kind not in UNITS:
             raise ValueError(f"units '{kind}': not one of {', '.join(UNITS)}")
-        return cls(kind, system.scales(), system.omega)
+        forcing = getattr(getattr(system, "contract", None), "forcing_frequency", "omega")
+        return cls(kind, system.scales(), system.omega, forcing)
 
     @property
     def physical(self) -> bool:
@@ -132,3 +142,239 @@ def point_in_units(result, units: Units) -> dict:
             row["dynamic_factor"] = float(np.max(np.abs(f)) / abs(s)) if s else None
         out["coordinates"][c] = row
     return out
+
+
+# -- parameters, tables and figures in units ---------------------------------------------
+SPEED, MESH_HZ = "speed_rpm", "mesh_frequency_hz"
+
+
+def at(system, kind: str, values: dict) -> Units:
+    """The units of ``system`` with ``values`` set (a swept backlash moves the µm per half
+    backlash, a swept inertia omega_n); the system's own where a value is not one of its
+    parameters (an open value: a model of its own, with the scales of the first)."""
+    try:
+        return Units.of(system.with_values(**values), kind)
+    except (KeyError, ValueError):
+        return Units.of(system, kind)
+
+
+def along(system, kind: str, name: str, values) -> list[Units]:
+    """:func:`at` for each value of the parameter ``name``."""
+    return [at(system, kind, {name: float(v)}) for v in values]
+
+
+def coordinate_of(units: Units, column: str) -> str | None:
+    """The mesh coordinate whose deflection ``column`` holds (``u``, ``max_u``, ``min_u``),
+    else None (velocities and everything else stay as they are)."""
+    for c in units.scales["half_backlash_m"]:
+        if column in (c, f"max_{c}", f"min_{c}"):
+            return c
+    return None
+
+
+def parameter_axis(units: Units, name: str):
+    """How a figure shows the parameter ``name``: ``(label, top)``, ``top`` None or
+    ``(label, forward, inverse)`` for a secondary axis.  Physical: omega stays the axis
+    (the model's frequency) with the mesh frequency's scale in its label and the speed in
+    rpm on top; the speed in rpm gets the mesh frequency in Hz on top.  Both are linear in
+    the value: the speed is ``omega omega_n 30 / (z pi)`` (the audit page's closed form)."""
+    s = units.scales
+    if not units.physical or SPEED not in s or not s[SPEED] or not units.omega:
+        return name, None
+    gear = s.get("speed_gear", "?")
+    if name == units.forcing:
+        k = s[SPEED] / units.omega
+        hz = s["omega_n_rad_per_s"] / (2 * math.pi)
+        label = f"{name} = mesh frequency / ω_n (1 is {hz:.5g} Hz)"
+        return label, (f"speed of gear '{gear}' (rpm)", lambda w: w * k, lambda r: r / k)
+    if name == SPEED:
+        k = s[MESH_HZ] / s[SPEED]
+        label = f"{name}: speed of gear '{gear}' (rpm)"
+        return label, ("mesh frequency (Hz)", lambda r: r * k, lambda f: f / k)
+    return name, None
+
+
+def secondary_axis(ax, top) -> None:
+    """Draw ``top`` of :func:`parameter_axis` (if any) as the axes' top x axis."""
+    if top is not None:
+        label, forward, inverse = top
+        ax.secondary_xaxis("top", functions=(forward, inverse)).set_xlabel(label, fontsize=8)
+
+
+@dataclass(frozen=True)
+class InUnits:
+    """A result (sweep, map, branches: anything with ``to_dict`` and ``to_table``) with its
+    table in physical units beside the model's: ``to_table`` appends columns, never
+    replacing one (``<col>_um`` for each deflection column, ``lyapunov_per_s``, and the
+    row's ``speed_rpm`` and ``mesh_frequency_hz``), and ``to_dict`` adds the block
+    ``in_units`` (the operating point, each added column's meaning and its values).  The
+    scales of a row are those with its ``parameters`` (columns) set."""
+
+    result: object
+    system: object
+    parameters: tuple = ()
+    kind: str = "physical"
+
+    def _units(self, values: tuple) -> Units:
+        return at(self.system, self.kind, dict(zip(self.parameters, values, strict=True)))
+
+    def to_table(self) -> tuple[list, list]:
+        columns, rows = self.result.to_table()
+        base = Units.of(self.system, self.kind)
+        if not base.physical:
+            return list(columns), [list(r) for r in rows]
+        where = [list(columns).index(p) for p in self.parameters if p in columns]
+        added = [(c, coordinate_of(base, c)) for c in columns if coordinate_of(base, c)]
+        memo: dict = {}
+        extra_names = [f"{c}_um" for c, _ in added]
+        lyapunov = "lyapunov" in columns
+        extra_names += ["lyapunov_per_s"] * lyapunov
+        speeds = [k for k in (SPEED, MESH_HZ) if k not in columns and k in base.scales]
+        out = []
+        for row in rows:
+            key = tuple(float(row[k]) for k in where)
+            u = memo.get(key) or memo.setdefault(key, self._units(key) if where else base)
+            extra = [_times(_num(row[columns.index(c)]), u.deflection(q, 1.0)) for c, q in added]
+            if lyapunov:
+                omega_n = u.scales["omega_n_rad_per_s"]
+                extra.append(_times(_num(row[columns.index("lyapunov")]), omega_n))
+            extra += [u.scales[k] for k in speeds]
+            out.append([*row, *extra])
+        return [*columns, *extra_names, *speeds], out
+
+    def block(self) -> dict:
+        """The ``in_units`` block (``{}`` in model units)."""
+        base = Units.of(self.system, self.kind)
+        if not base.physical:
+            return {}
+        columns, rows = self.to_table()
+        first = len(self.result.to_table()[0])
+        meaning = {
+            "lyapunov_per_s": "largest Lyapunov exponent per second (lyapunov x omega_n)",
+            SPEED: f"speed of gear '{base.scales.get('speed_gear', '?')}' in rpm at the row",
+            MESH_HZ: "mesh frequency in Hz at the row (omega omega_n / 2 pi)",
+        }
+        about = {
+            c: meaning.get(c, f"{c[:-3]} in µm (half backlashes x b x 1e6, b at the row)")
+            for c in columns[first:]
+        }
+        return {
+            "units": base.kind,
+            "operating_point": base.operating_point(),
+            "columns": about,
+            "table": {c: [r[k] for r in rows] for k, c in enumerate(columns) if k >= first},
+        }
+
+    def to_dict(self) -> dict:
+        block = self.block()
+        return self.result.to_dict() | ({"in_units": block} if block else {})
+
+    def save(self, path, **extra):
+        """Write to ``path``: ``.json``, ``.csv`` or ``.mat`` (``solver/export.py``)."""
+        from .export import save
+
+        return save(self, path, **extra)
+
+
+def _num(v) -> float | None:
+    """A finite number, else None (text, a missing value, NaN)."""
+    if v is None or isinstance(v, str):
+        return None
+    v = float(v)
+    return v if math.isfinite(v) else None
+
+
+def _times(v: float | None, factor: float) -> float | None:
+    return None if v is None else v * factor
+
+
+def in_units(result, system, kind: str = "physical") -> InUnits:
+    """``result`` with its table in ``kind`` units (:class:`InUnits`); the parameters that
+    set each row's scales are the result's own (a sweep's parameter, a map's x and y)."""
+    if kind not in UNITS:
+        raise ValueError(f"units '{kind}': not one of {', '.join(UNITS)}")
+    if hasattr(result, "x") and hasattr(result, "y"):
+        names = (result.x, result.y)
+    else:
+        name = getattr(result, "parameter", None) or result.to_dict().get("parameter")
+        names = (name,) if name else ()
+    return InUnits(result, system, tuple(names), kind)
+
+
+def state_unit(system, kind: str, state: str) -> str:
+    """The unit a figure gives ``state`` in (:func:`state_factors`)."""
+    if system is None:
+        return "half backlashes"
+    if state not in system.coordinates:
+        return "half backlashes per unit τ" if state in system.states else ""
+    return Units.of(system, kind).deflection_unit(state)
+
+
+def state_factors(system, kind: str, name: str, values, state: str):
+    """Per value of the parameter ``name``: the factor that turns ``state`` into ``kind``
+    units (µm for a mesh deflection, with the half backlash at that value); and the unit
+    (:func:`state_unit`).  Velocities stay in half backlashes per unit τ."""
+    import numpy as np
+
+    unit = state_unit(system, kind, state)
+    if unit != "µm":
+        return np.ones(len(values)), unit
+    return np.array([u.deflection(state, 1.0) for u in along(system, kind, name, values)]), unit
+
+
+def parameter_span(system, kind: str, name: str, values) -> str:
+    """What a run over ``values`` of ``name`` covers in physical terms, e.g. ``omega 0.3 to
+    1.2: gear 'p' at 634 to 2.54e+03 rpm, mesh frequency 528 to 2.11e+03 Hz``; "" in
+    model units or for a model without a speed."""
+    if kind != "physical" or not len(values):
+        return ""
+    ends = [at(system, kind, {name: float(v)}).scales for v in (min(values), max(values))]
+    if SPEED not in ends[0]:
+        return ""
+
+    def span(key: str) -> str:
+        a, b = (float(e[key]) for e in ends)
+        return f"{a:.4g}" if a == b else f"{a:.4g} to {b:.4g}"
+
+    gear = ends[0].get("speed_gear", "?")
+    lo, hi = min(values), max(values)
+    shown = f"{lo:.4g}" if lo == hi else f"{lo:.4g} to {hi:.4g}"
+    return f"{name} {shown}: gear '{gear}' at {span(SPEED)} rpm, mesh frequency {span(MESH_HZ)} Hz"
+
+
+def poincare_range(system, kind: str, name: str, values, points, state: str) -> str:
+    """The range of ``state``'s Poincaré values ``points`` (one array per value of
+    ``name``) in ``kind`` units, e.g. ``[-12.1, 48.3] µm``; "" when there are none."""
+    import numpy as np
+
+    scale, unit = state_factors(system, kind, name, values, state)
+    pts = [np.asarray(p, float).ravel() * k for p, k in zip(points, scale, strict=True)]
+    pts = np.concatenate(pts) if pts else np.zeros(0)
+    pts = pts[np.isfinite(pts)]
+    return f"[{pts.min():.4g}, {pts.max():.4g}] {unit}" if pts.size else ""
+
+
+def orbit_in_units(orbit, kind: str = "physical") -> dict:
+    """A periodic orbit (``Orbit``) in ``kind`` units: the operating point, its period
+    n T in s (``tau / omega_n``) and x0 of each mesh coordinate in µm (velocities stay
+    in half backlashes per unit τ)."""
+    system = orbit.system
+    u = Units.of(system, kind)
+    x0 = {c: u.deflection(c, float(orbit.x0[system.index(c)])) for c in system.coordinates}
+    return {
+        "units": kind,
+        "operating_point": u.operating_point(),
+        "period": u.time(orbit.period),
+        "period_unit": u.time_unit,
+        "x0": x0,
+        "x0_unit": {c: u.deflection_unit(c) for c in system.coordinates},
+    }
+
+
+def orbit_line(block: dict) -> str:
+    """:func:`orbit_in_units` in one printed line."""
+    x0 = ", ".join(f"{c} = {v:.6g} {block['x0_unit'][c]}" for c, v in block["x0"].items())
+    return (
+        f"  {block['operating_point']}; period {block['period']:.6g} {block['period_unit']}; "
+        f"x0: {x0}"
+    )

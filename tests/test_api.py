@@ -60,8 +60,9 @@ def test_a_trajectory_exports_to_csv_json_and_mat(tmp_path):
     run = gearsym.simulate(system, method="cvodes", transient=10, periods=2, samples_per_period=8)
     path = run.save(tmp_path / "run.csv")
     with open(path, newline="") as fh:
-        rows = list(csv.reader(fh))
+        rows = list(csv.reader(line for line in fh if not line.startswith("#")))
     assert rows[0] == ["tau", *system.states] and len(rows) == 1 + run.t.size
+    assert path.read_text().startswith("# gearsym_version: ")  # the header block first
     assert float(rows[1][1]) == run.x[0, 0]  # repr round trip: no digits lost
     assert gearsym.save(run, tmp_path / "run.json").stat().st_size > 0
     assert run.save(tmp_path / "run.mat").stat().st_size > 0

@@ -10,7 +10,11 @@ References, each a closed form of gear kinematics or statics, not the model:
 
 from __future__ import annotations
 
+import json
+import math
+
 import gearsym
+import numpy as np
 import pytest
 from gearsym.solver.units import Units
 
@@ -53,3 +57,184 @@ def test_a_point_in_physical_units():
     u = point.trajectory.coordinate("u")
     assert row["range"] == pytest.approx([u.min() * b_um, u.max() * b_um], rel=1e-12)
     assert row["dynamic_factor"] is not None and row["dynamic_factor"] >= 1.0 - 1e-9
+
+
+# -- --units physical on sweep, map, continue and shoot (issue 25, point 3) --------------
+# Closed forms: reference-light's pinion p (the speed gear) has Z_P = 50 teeth and both
+# meshes a half backlash of 50 µm (scenes/topologies/diso.toml); its audit page
+# (docs/derivation/reference_light.md) gives omega = z n pi / 30 / omega_n, so the speed is
+# n = 30 omega omega_n / (z pi) rpm and the mesh frequency z n / 60 Hz; a period T of the
+# mesh is 60 / (z n) s; x half backlashes are x b; an exponent per unit tau is omega_n
+# times that per second (tau = omega_n t).
+Z_P, B_UM = 50, 50.0
+
+
+def _rpm(omega: float, omega_n: float) -> float:
+    return 30.0 * omega * omega_n / (Z_P * math.pi)
+
+
+def test_a_table_in_physical_units_adds_columns_and_keeps_the_model_ones():
+    from gearsym.solver.export import Document
+    from gearsym.solver.units import InUnits
+
+    system = gearsym.load("reference-light")
+    omega_n = system.scales()["omega_n_rad_per_s"]  # inertias and stiffness: not swept here
+    columns = ["omega", "half_backlash_um", "motion_u", "u", "max_v", "du", "lyapunov"]
+    rows = [
+        [0.4, 30.0, "period-1", 0.5, -1.2, 0.3, -0.01],
+        [0.9, 60.0, "chaotic", 2.0, 1.0, 1.0, None],
+    ]
+    table = InUnits(
+        Document({"parameter": "omega"}, columns, rows), system, ("omega", "half_backlash_um")
+    )
+    names, out = table.to_table()
+    assert names[: len(columns)] == columns and [r[: len(columns)] for r in out] == rows
+    added = dict(
+        zip(names[len(columns) :], zip(*(r[len(columns) :] for r in out), strict=True), strict=True)
+    )
+    assert set(added) == {"u_um", "max_v_um", "lyapunov_per_s", "speed_rpm", "mesh_frequency_hz"}
+    assert added["u_um"] == pytest.approx((0.5 * 30.0, 2.0 * 60.0), rel=1e-12)  # b is the row's
+    assert added["max_v_um"] == pytest.approx((-1.2 * 30.0, 1.0 * 60.0), rel=1e-12)
+    assert added["lyapunov_per_s"][0] == pytest.approx(-0.01 * omega_n, rel=1e-12)
+    assert added["lyapunov_per_s"][1] is None  # missing stays missing
+    rpm = [_rpm(0.4, omega_n), _rpm(0.9, omega_n)]
+    assert added["speed_rpm"] == pytest.approx(rpm, rel=1e-12)
+    assert added["mesh_frequency_hz"] == pytest.approx([Z_P * n / 60 for n in rpm], rel=1e-12)
+    block = table.to_dict()["in_units"]
+    assert block["table"]["u_um"] == list(added["u_um"]) and block["units"] == "physical"
+    assert table.to_dict()["parameter"] == "omega"  # the model's keys stay
+    model = InUnits(Document({}, columns, rows), system, ("omega",), "model")
+    assert model.to_table() == (columns, rows) and "in_units" not in model.to_dict()
+
+
+def test_the_parameter_axes_say_the_speed_and_the_mesh_frequency():
+    from gearsym.solver.units import Units, parameter_axis
+
+    system = gearsym.load("reference-light")
+    omega_n = system.scales()["omega_n_rad_per_s"]
+    label, (top, forward, inverse) = parameter_axis(Units.of(system), "omega")
+    assert f"{omega_n / (2 * math.pi):.5g} Hz" in label and "rpm" in top
+    assert forward(0.8) == pytest.approx(_rpm(0.8, omega_n), rel=1e-12)
+    assert inverse(forward(0.8)) == pytest.approx(0.8, rel=1e-12)
+    _, (top, forward, _) = parameter_axis(Units.of(system), "speed_rpm")
+    assert top == "mesh frequency (Hz)" and forward(1200.0) == pytest.approx(Z_P * 1200.0 / 60)
+    assert parameter_axis(Units.of(system, "model"), "omega") == ("omega", None)
+
+
+def test_a_bifurcation_diagram_in_um(tmp_path):
+    from gearsym.solver import plots
+
+    system = gearsym.load("reference-light")
+    sw = gearsym.sweep(
+        system, "half_backlash_um", [40.0, 60.0], transient=50, periods=8, executor="serial"
+    )
+    fig = plots.bifurcation_diagram([sw], ["u", "du"], system=system, units="physical")
+    u_ax, du_ax = fig.axes[:2]
+    assert u_ax.get_ylabel().endswith("µm") and "per unit τ" in du_ax.get_ylabel()
+    ys = np.concatenate([line.get_ydata() for line in u_ax.get_lines() if len(line.get_xdata())])
+    expected = np.concatenate(
+        [np.asarray(p) * v for p, v in zip(sw.poincare("u"), sw.values, strict=True)]
+    )
+    # each value's distinct points (a period-1 orbit: one), times that value's b in µm
+    assert np.all(np.min(np.abs(ys[:, None] - expected[None, :]), axis=1) < 1e-9 * np.abs(ys).max())
+    assert du_ax.get_xlabel() == "half_backlash_um"
+
+
+def _csv(path) -> dict:
+    """The numeric columns of a result CSV (header lines start with #)."""
+    import csv
+
+    lines = [line for line in path.read_text().splitlines() if not line.startswith("#")]
+    names, *rows = list(csv.reader(lines))
+    out = {}
+    for k, name in enumerate(names):
+        try:
+            out[name] = np.array([float(r[k]) if r[k] else np.nan for r in rows])
+        except ValueError:
+            continue  # text
+    return out
+
+
+def _run(argv, capsys):
+    from gearsym.cli import main
+
+    code = main(argv)
+    return code, capsys.readouterr().out
+
+
+def test_sweep_and_shoot_write_and_print_physical_units(tmp_path, capsys):
+    from scipy.io import loadmat
+
+    out = tmp_path / "sw"
+    code, text = _run(
+        ["sweep", "reference-light", "--param", "speed_rpm", "--range", "900:1500:3"]
+        + ["--transient", "60", "--periods", "16", "--lyapunov-periods", "16"]
+        + ["--executor", "serial", "--quiet", "--units", "physical", "--out", str(out)],
+        capsys,
+    )
+    assert code == 0
+    hz = ", ".join(f"{Z_P * n / 60:.4g}" for n in (900, 1500))
+    assert f"mesh frequency {hz.replace(', ', ' to ')} Hz" in text
+    table = _csv(out / "sweep.csv")
+    assert table["max_u_um"] == pytest.approx(table["max_u"] * B_UM, rel=1e-12)
+    assert table["mesh_frequency_hz"] == pytest.approx(table["speed_rpm"] * Z_P / 60)
+    mat = loadmat(out / "sweep.mat", simplify_cells=True)
+    assert mat["table"]["min_v_um"] == pytest.approx(table["min_v_um"], rel=1e-12)
+    assert "max_u" in mat["table"] and "in_units" in mat["result"]
+    data = json.loads((out / "sweep.json").read_text())
+    assert data["in_units"]["table"]["max_u_um"] == pytest.approx(list(table["max_u_um"]))
+    assert data["parameter"] == "speed_rpm" and len(data["points"]) == 3  # as before
+
+    code, text = _run(
+        ["shoot", "reference-light", "--set", "speed_rpm=1200", "--units", "physical", "--json"],
+        capsys,
+    )
+    orbit = json.loads(text)
+    assert orbit["in_units"]["period"] == pytest.approx(60.0 / (Z_P * 1200.0), rel=1e-9)
+    assert orbit["in_units"]["x0"]["u"] == pytest.approx(orbit["x0"]["u"] * B_UM, rel=1e-12)
+    assert "in_units" not in json.loads(
+        _run(["shoot", "reference-light", "--set", "speed_rpm=1200", "--json"], capsys)[1]
+    )
+
+
+def test_map_and_continue_write_physical_columns(tmp_path, capsys):
+    out = tmp_path / "map"
+    code, text = _run(
+        ["map", "reference-light", "--x", "speed_rpm=900:1500:3", "--y", "half_backlash_um=40:60:2"]
+        + ["--initial-states", "1", "--transient", "60", "--periods", "16"]
+        + ["--lyapunov-periods", "16", "--budget", "0", "--executor", "serial", "--quiet"]
+        + ["--units", "physical", "--out", str(out)],
+        capsys,
+    )
+    assert code == 0 and " µm" in text
+    table = _csv(out / "map.csv")
+    b = table["half_backlash_um"]  # the row's half backlash
+    assert table["max_u_um"] == pytest.approx(table["max_u"] * b, rel=1e-12)
+    assert table["min_v_um"] == pytest.approx(table["min_v"] * b, rel=1e-12)
+    assert "max_du_um" not in table  # velocities stay non-dimensional
+    from gearsym.solver.plots_maps import map_figures
+    from gearsym.solver.sweep.maps_result import RegimeMap
+
+    m = RegimeMap.load(out / "map.json")
+    fig = map_figures(
+        m, kinds=("extremes",), system=gearsym.load("reference-light"), units="physical"
+    )["extremes"]
+    cells = fig.axes[0].collections[0].get_array().reshape(len(m.y_values), len(m.x_values))
+    b_um = np.asarray(m.y_values, float)[:, None]  # the y axis is the half backlash in µm
+    assert np.asarray(cells) == pytest.approx(m.grid("max", "u") * b_um, rel=1e-12)
+    assert "Max(u) in µm" in [ax.get_ylabel() for ax in fig.axes]  # its colour bar
+    assert fig.axes[0].get_xlabel().startswith("speed_rpm: speed of gear 'p' (rpm)")
+
+    out = tmp_path / "co"
+    code, text = _run(
+        ["continue", "reference-light", "--param", "omega", "--from", "0.5", "--to", "0.54"]
+        + ["--step", "0.02", "--settle", "60", "--units", "physical", "--out", str(out)],
+        capsys,
+    )
+    assert code == 0
+    omega_n = gearsym.load("reference-light").scales()["omega_n_rad_per_s"]
+    assert f"gear 'p' at {_rpm(0.5, omega_n):.4g} to" in text
+    table = _csv(out / "branches.csv")
+    assert table["u_um"] == pytest.approx(table["u"] * B_UM, rel=1e-12)
+    rpm = [_rpm(w, omega_n) for w in table["omega"]]
+    assert table["speed_rpm"] == pytest.approx(rpm, rel=1e-12)

@@ -115,6 +115,16 @@ def register(sub) -> None:
         help="print one JSON record per (grid point, attractor) on stdout",
     )
     mp.add_argument("--quiet", action="store_true", help="no progress bar")
+    mp.add_argument(
+        "--units",
+        choices=("model", "physical"),
+        default="model",
+        help="physical: the extremes in µm and the exponent per second (figures and "
+        "printed), omega with the speed in rpm (or the speed with the mesh frequency in Hz) "
+        "on the figures' axes, and the result files with added columns (max_<coordinate>_um, "
+        "min_<coordinate>_um, lyapunov_per_s, speed_rpm, mesh_frequency_hz) and an in_units "
+        "block; model: the model's non-dimensional units (default: %(default)s)",
+    )
     mp.set_defaults(func=_cmd_map)
 
 
@@ -258,9 +268,12 @@ def _cmd_map(args) -> int:
     except ValueError as err:
         raise Fail(f"map: {err}") from None
     from gearsym.solver.provenance import provenance
+    from gearsym.solver.units import in_units
 
-    written = write_result(out, "map", result, args, **provenance(system))
-    figures = write_map_figures(result, out)
+    physical = args.units == "physical"
+    table = in_units(result, system, args.units) if physical else result
+    written = write_result(out, "map", table, args, **provenance(system))
+    figures = write_map_figures(result, out, system=system, units=args.units)
     if args.json:
         from gearsym.solver._json import dumps
 
@@ -270,6 +283,8 @@ def _cmd_map(args) -> int:
     if result.resumed:
         print(f"resumed: {result.resumed} finished runs came from {out / 'store'}")
     _summary(result)
+    if physical:
+        _physical(result, system, table)
     print(f"wrote {', '.join(p.name for p in written)} and {len(figures)} figures in {out}")
     return 0
 
@@ -301,3 +316,22 @@ def _summary(m) -> None:
         f"{m.settings['transient'] + m.settings['periods']} periods, {looked} re-examined at a "
         "border with the long budget"
     )
+
+
+def _physical(m, system, table) -> None:
+    """The map's span and the extremes of its mesh deflections in physical units."""
+    from gearsym.solver.units import parameter_span
+
+    for name, values in ((m.x, m.x_values), (m.y, m.y_values)):
+        span = parameter_span(system, "physical", name, values)
+        if span:
+            print(f"  {span}")
+    columns, rows = table.to_table()
+    for c in m.coordinates:
+        found = []
+        for field in (f"min_{c}_um", f"max_{c}_um"):
+            if field in columns:
+                k = columns.index(field)
+                found += [r[k] for r in rows if r[k] is not None]
+        if found:
+            print(f"  {c} over the grid (all attractors): [{min(found):.4g}, {max(found):.4g}] µm")

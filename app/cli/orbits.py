@@ -41,16 +41,7 @@ def register(sub) -> None:
     )
     sh.add_argument("scene", metavar="SCENE", help="a scene path or built-in name")
     sh.add_argument(
-        "--set",
-        action="append",
-        metavar="KEY=VALUE",
-        help="set a scene or model parameter (repeatable)",
-    )
-    sh.add_argument(
-        "--period",
-        type=int,
-        default=1,
-        help=f"n: the orbit's period is n T (1 to {MAX_PERIOD})",
+        "--period", type=int, default=1, help=f"n: the orbit's period is n T (1 to {MAX_PERIOD})"
     )
     sh.add_argument(
         "--tries",
@@ -62,10 +53,7 @@ def register(sub) -> None:
     sh.add_argument("--seed", type=int, default=0, help="seed of those guesses' random starts")
     start_options(sh)
     sh.add_argument(
-        "--segments",
-        type=int,
-        default=1,
-        help=f"multiple shooting segments (1 to {MAX_SEGMENTS})",
+        "--segments", type=int, default=1, help=f"multiple shooting segments (1 to {MAX_SEGMENTS})"
     )
     sh.add_argument(
         "--monodromy",
@@ -76,7 +64,7 @@ def register(sub) -> None:
     sh.add_argument(
         "--compare-monodromy",
         action="store_true",
-        help="also compute the monodromy the other two ways and compare",
+        help="also compute the monodromy the other two ways; compare",
     )
     sh.add_argument(
         "--settle",
@@ -88,9 +76,7 @@ def register(sub) -> None:
     )
     sh.add_argument("--json", action="store_true", help="print the orbit as JSON")
     sh.add_argument(
-        "--out",
-        metavar="DIR",
-        help="also write orbit.json, .csv, .mat (--format) and multipliers.png",
+        "--out", metavar="DIR", help="also write orbit.json, .csv, .mat (--format), multipliers.png"
     )
     format_option(sh, "orbit")
     sh.set_defaults(func=_cmd_shoot)
@@ -105,9 +91,7 @@ def register(sub) -> None:
     )
     co.add_argument("scene", metavar="SCENE", help="a scene path or built-in name")
     co.add_argument(
-        "--param",
-        required=True,
-        help="the parameter to continue: a scene or model parameter (not an open value)",
+        "--param", required=True, help="a scene or model parameter to continue (not an open value)"
     )
     co.add_argument(
         "--from", dest="from_", type=float, required=True, help="start (inside its valid range)"
@@ -124,21 +108,13 @@ def register(sub) -> None:
         "four times this)",
     )
     co.add_argument(
-        "--switch",
-        action="store_true",
-        help="switch onto the period-2n branch at each period doubling",
+        "--switch", action="store_true", help="switch to the period-2n branch at a period doubling"
     )
     co.add_argument(
         "--settle",
         type=int,
         default=300,
         help=f"periods n T simulated for the first guess (N x n at most {MAX_SETTLED:,})",
-    )
-    co.add_argument(
-        "--set",
-        action="append",
-        metavar="KEY=VALUE",
-        help="set a scene or model parameter (repeatable)",
     )
     co.add_argument(
         "--out",
@@ -148,6 +124,18 @@ def register(sub) -> None:
     )
     format_option(co, "branches")
     co.set_defaults(func=_cmd_continue)
+    for parser in (sh, co):
+        parser.add_argument(
+            "--set", action="append", metavar="KEY=VALUE", help="set a parameter (repeatable)"
+        )
+        parser.add_argument(
+            "--units",
+            choices=("model", "physical"),
+            default="model",
+            help="physical: deflections in µm, the period in s, the speed in rpm and the mesh "
+            "frequency in Hz, printed, in the figure and the files (docs/user-guide.md); model: "
+            "the model's non-dimensional units (default: %(default)s)",
+        )
 
 
 def _guesses(system, n: int, first, tries: int, seed: int, settle: int):
@@ -173,6 +161,7 @@ def _cmd_shoot(args) -> int:
     from gearsym.solver.integrate import SimulationError, simulate
     from gearsym.solver.periodic import ShootingError
     from gearsym.solver.periodic.shooting import search
+    from gearsym.solver.units import orbit_in_units, orbit_line
 
     if args.period < 1 or args.segments < 1:
         raise Fail("--period and --segments must be whole numbers >= 1")
@@ -221,6 +210,8 @@ def _cmd_shoot(args) -> int:
     data["found_requested_period"] = found.found
     data["attempts"] = found.attempts
     data["initial_state"] = start.describe()
+    if args.units == "physical":
+        data["in_units"] = orbit_in_units(orbit, args.units)
     if args.out:
         from gearsym.solver import plots
         from gearsym.solver.export import Document
@@ -253,6 +244,8 @@ def _cmd_shoot(args) -> int:
     if start.x0 is not None:
         print(f"  guess from {start.source}" + (f", settled {settle} periods" if settle else ""))
     print("  x0: " + ", ".join(f"{k} = {v:.10g}" for k, v in data["x0"].items()))
+    if "in_units" in data:
+        print(orbit_line(data["in_units"]))
     fl = orbit.floquet
     print(
         "  multipliers: "
@@ -288,6 +281,7 @@ def _cmd_continue(args) -> int:
         continue_orbit,
         switch_period_doubling,
     )
+    from gearsym.solver.units import in_units, parameter_span
 
     for name in ("from_", "to"):
         if not math.isfinite(getattr(args, name)):
@@ -373,9 +367,12 @@ def _cmd_continue(args) -> int:
                     )
                 except ShootingError as err:
                     print(f"  branch switching at {bif.value:.6g} failed: {err}")
-    written = write_result(out, "branches", branches_document(system, branches), args)
+    doc = in_units(branches_document(system, branches), system, args.units)
+    written = write_result(out, "branches", doc, args)
     title = f"{system.name}: continuation in {args.param}"
-    fig = plots.branch_figure(branches, system.coordinates, title=title, system=system)
+    fig = plots.branch_figure(
+        branches, system.coordinates, title=title, system=system, units=args.units
+    )
     plots.save_figure(fig, out / "branches.png")
     for k, br in enumerate(branches):
         smap = StroboscopicMap(system, br.n)
@@ -389,10 +386,13 @@ def _cmd_continue(args) -> int:
     for br in branches:
         stable = sum(br.stable)
         print(f"period-{br.n} branch: {len(br.values)} points, {stable} stable; {br.message}")
+        if span := parameter_span(system, args.units, args.param, br.values):
+            print(f"  {span}")
         for b in br.bifurcations:
+            at = parameter_span(system, args.units, args.param, [b.value]).partition(": ")[2]
             print(
                 f"  {b.kind:<16} {args.param} = {b.value:.8g}  multiplier "
-                f"{b.multiplier.real:+.6f}{b.multiplier.imag:+.6f}i"
+                f"{b.multiplier.real:+.6f}{b.multiplier.imag:+.6f}i" + (f" ({at})" if at else "")
             )
     print(f"wrote {', '.join(p.name for p in written)} and branches.png in {out}")
     return 0

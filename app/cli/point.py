@@ -89,6 +89,16 @@ def register(sub) -> None:
     format_option(sw, "sweep")
     sw.add_argument("--quiet", action="store_true", help="no progress bar")
     sw.add_argument(
+        "--units",
+        choices=("model", "physical"),
+        default="model",
+        help="physical: the figure's deflections in µm with omega's speed (rpm) or the "
+        "speed's mesh frequency (Hz) on a top axis, the printed ranges in µm, rpm and Hz, "
+        "and the result files with added columns (<coordinate>_um, speed_rpm, "
+        "mesh_frequency_hz, lyapunov_per_s) and an in_units block; model: the model's "
+        "non-dimensional units (default: %(default)s)",
+    )
+    sw.add_argument(
         "--no-figure",
         action="store_true",
         help="write the data only (sweep.json, .csv, .mat), not bifurcation.png",
@@ -263,19 +273,36 @@ def _cmd_sweep(args) -> int:
     failed = [p.value for p in result.points if not p.ok]
     if result.resumed:
         print(f"resumed: {result.resumed} of {len(values)} points came from {out / 'store'}")
-    path, *_ = write_result(out, "sweep", result, args)
+    from gearsym.solver.units import in_units, parameter_span, poincare_range
+
+    physical = args.units == "physical"
+    path, *_ = write_result(
+        out, "sweep", in_units(result, system, args.units) if physical else result, args
+    )
     if figure:
         from gearsym.solver import plots
 
         fig = plots.save_figure(
             plots.bifurcation_diagram(
-                [result], list(system.coordinates), title=f"{system.name}: {args.param} sweep"
+                [result],
+                list(system.coordinates),
+                title=f"{system.name}: {args.param} sweep",
+                system=system,
+                units=args.units,
             ),
             out / "bifurcation.png",
         )
         print(f"wrote {path} and {fig}")
     else:
         print(f"wrote {path}")
+    if physical:
+        span = parameter_span(system, args.units, args.param, result.values)
+        print(f"  {span or system.name + ': no speed to give in rpm'}")
+        for c in system.coordinates:
+            shown = poincare_range(
+                system, args.units, args.param, result.values, result.poincare(c), c
+            )
+            print(f"  {c} (Poincaré values, dynamic transmission error): {shown or 'none'}")
     motions = [result.motion(c) for c in system.coordinates]
     if all(m == motions[0] for m in motions):  # one verdict per attractor: said once
         print(f"  attractor: {runs_text(values, motions[0])}")
