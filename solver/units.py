@@ -164,12 +164,16 @@ def along(system, kind: str, name: str, values) -> list[Units]:
 
 
 def coordinate_of(units: Units, column: str) -> str | None:
-    """The mesh coordinate whose deflection ``column`` holds (``u``, ``max_u``, ``min_u``),
-    else None (velocities and everything else stay as they are)."""
+    """The mesh coordinate whose deflection ``column`` holds (``u``, ``max_u``, ``min_u``;
+    a frequency response's ``u_mean``, ``u_amplitude``, ``u_rms``, ``u_min``, ``u_max``),
+    else None (velocities, dynamic factors and everything else stay as they are)."""
     for c in units.scales["half_backlash_m"]:
-        if column in (c, f"max_{c}", f"min_{c}"):
+        if column in (c, f"max_{c}", f"min_{c}") or column in _RESPONSE.format(c=c).split():
             return c
     return None
+
+
+_RESPONSE = "{c}_mean {c}_amplitude {c}_rms {c}_min {c}_max"  # frequency-response columns
 
 
 def parameter_axis(units: Units, name: str):

@@ -238,3 +238,41 @@ def test_map_and_continue_write_physical_columns(tmp_path, capsys):
     assert table["u_um"] == pytest.approx(table["u"] * B_UM, rel=1e-12)
     rpm = [_rpm(w, omega_n) for w in table["omega"]]
     assert table["speed_rpm"] == pytest.approx(rpm, rel=1e-12)
+
+
+def test_frequency_response_files_in_physical_units(tmp_path, capsys):
+    """The issue's complaint: `frequency-response --physical` wrote non-dimensional CSV and
+    MAT.  Now the model's columns stay and µm, rpm and Hz columns are added; references:
+    x b with b = 50 µm (scenes/topologies/diso.toml), the mesh frequency teeth x speed / 60
+    with 50 teeth on p, and the speed omega omega_n 30 / (z pi)."""
+    from gearsym.cli import main
+    from scipy.io import loadmat
+
+    argv = ["frequency-response", "reference-light", "--param=omega=0.4:0.6:5", "--no-figure"]
+    assert main([*argv, "--units", "physical", "--out", str(tmp_path)]) == 0
+    said = capsys.readouterr().out
+    assert "frequency_response.csv" in said and "frequency_response.mat" in said
+    doc = json.loads((tmp_path / "frequency_response.json").read_text(encoding="utf-8"))
+    lines = [ln for ln in (tmp_path / "frequency_response.csv").read_text().splitlines()]
+    names, *rows = [ln.split(",") for ln in lines if not ln.startswith("#")]
+    omega_n = doc["scales"]["omega_n_rad_per_s"]
+    for row in rows:
+        r = dict(zip(names, row, strict=True))
+        omega, rpm = float(r["omega"]), float(r["speed_rpm"])
+        assert rpm == pytest.approx(omega * omega_n * 30 / (50 * math.pi), rel=1e-12)
+        assert float(r["mesh_frequency_hz"]) == pytest.approx(50 * rpm / 60, rel=1e-12)
+        for c in ("u", "v"):
+            for q in ("mean", "amplitude", "min", "max"):
+                um = float(r[f"{c}_{q}_um"])
+                assert um == pytest.approx(50.0 * float(r[f"{c}_{q}"]), rel=1e-12)
+    mat = loadmat(tmp_path / "frequency_response.mat", simplify_cells=True)
+    assert np.allclose(
+        mat["table"]["u_amplitude_um"],
+        [float(r[names.index("u_amplitude_um")]) for r in rows],
+        rtol=1e-15,
+    )
+    assert doc["in_units"]["columns"]["speed_rpm"].startswith("speed of gear 'p'")
+    # model units: the table as it always was
+    assert main([*argv, "--out", str(tmp_path / "model")]) == 0
+    head = (tmp_path / "model" / "frequency_response.csv").read_text().splitlines()
+    assert not any("_um" in ln for ln in head if not ln.startswith("#"))

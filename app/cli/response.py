@@ -250,7 +250,13 @@ def _cmd_response(args) -> int:
         )
     except (HarmonicBalanceError, ShootingError) as err:
         raise RunFailed(f"frequency-response: {err}") from None
-    written = write_result(out, "frequency_response", resp, args)
+    physical = args.physical or args.units == "physical"
+    if physical:  # the model's columns and keys kept; µm, rpm and Hz columns added
+        from gearsym.solver.units import in_units
+
+        written = write_result(out, "frequency_response", in_units(resp, system), args)
+    else:
+        written = write_result(out, "frequency_response", resp, args)
     figure = None
     if not args.no_figure:
         from gearsym.solver.plots_response import frequency_response_figure
@@ -259,7 +265,7 @@ def _cmd_response(args) -> int:
         figure = save_figure(
             frequency_response_figure(
                 resp,
-                physical=args.physical or args.units == "physical",
+                physical=physical,
                 title=f"{system.name}: period-{args.period} response over {name}",
             ),
             out / "frequency_response.png",
@@ -304,6 +310,7 @@ def _cmd_response(args) -> int:
             print(f"  note: {note}")
         if c.details.get("status") in ("boundary", "max-points"):
             print(f"  {c.details['message']}")
-    print(f"wrote {written[0]}" + (f" and {figure}" if figure else ""))
+    names = ", ".join(p.name for p in [*written, *([figure] if figure else [])])
+    print(f"wrote {names} in {out}")
     sys.stdout.flush()
     return 0
