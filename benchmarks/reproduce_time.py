@@ -4,8 +4,9 @@ Run: ``python benchmarks/reproduce_time.py [--only quick|full] [--repeats 3] [--
 (default: both resolutions, 3 repeats, ``docs/reproduce-time.md`` of the checkout).  Each
 repeat makes a new empty model cache (``GEARSYM_CACHE``) and runs, each in a fresh process
 and a fresh output folder: the first run (every model derived and compiled) and then the
-repeated run (the same cache, so only the runs themselves; a new output folder, so no
-stored sweep is resumed).  The table gives the median over the repeats of the wall time of
+repeated run (the same cache: every model compiled, every unit of work in its result
+store, ``gearsym.studies.memo``; a new output folder, so no sweep of the first run's
+folder is resumed).  The table gives the median over the repeats of the wall time of
 the whole process, and per stage (``gearsym.studies.reproduce.STAGES``) the median of the
 seconds each took.  Floors (issue 25, point 7): the full reproduce at most 90 s on a first
 run and 30 s on a repeated run, on 2 cores of a quiet machine.
@@ -35,7 +36,8 @@ from pathlib import Path
 from gearsym.studies.reproduce import reproduce
 out, quick, result = Path(sys.argv[1]), sys.argv[2] == "quick", Path(sys.argv[3])
 done = reproduce(out, quick=quick, progress=False)
-result.write_text(json.dumps({"stages": done.stages, "verdicts": done.verdicts}))
+said = {"stages": done.stages, "verdicts": done.verdicts, "stored": done.stored}
+result.write_text(json.dumps(said))
 """
 FLOORS = {"full": (90.0, 30.0)}  # first, repeated (s), issue 25 point 7
 RUNS = ("first", "repeated")
@@ -102,6 +104,10 @@ def table(results: dict, when: str, machine: str) -> str:
         for k, name in enumerate(names):
             cells = [statistics.median(r["stages"][k][1] for r in runs[run]) for run in RUNS]
             lines.append(f"| {name} | {cells[0]:.1f} | {cells[1]:.1f} |")
+        for run in RUNS:
+            stored = runs[run][0].get("stored")
+            if stored:
+                lines += ["", f"Result store, {run} run: {stored}."]
         verdicts = runs["first"][0]["verdicts"]
         said = "; ".join(f"{model}: {verdict_words(c)}" for model, c in verdicts.items())
         lines += ["", f"Verdicts of the study's findings (first run): {said}."]

@@ -146,12 +146,45 @@ def _bind_to_parent(parent: int | None) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # discards a pending Ctrl-C too
     if hasattr(signal, "pthread_sigmask"):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    _one_blas_thread()
     watched = os.getppid() if parent is None else parent
     if not _death_signal(signal.SIGKILL):
         threading.Thread(target=_watch_parent, args=(watched,), daemon=True).start()
     # The parent may have ended between the fork and the prctl: then nothing would come.
     if os.getppid() != watched:
         os._exit(1)
+
+
+# OpenBLAS's setters under the names its builds export (plain, 64-bit integer, SciPy's)
+_BLAS_THREADS = (
+    "openblas_set_num_threads",
+    "openblas_set_num_threads64_",
+    "scipy_openblas_set_num_threads",
+    "scipy_openblas_set_num_threads64_",
+)
+
+
+def _one_blas_thread() -> None:
+    """One BLAS thread in this worker.  The pool has a worker per core already; each
+    worker's OpenBLAS starting a thread per core as well made the small dense solves of
+    harmonic balance and Newton (about 125 unknowns) wait on each other: 13x the CPU
+    time of one thread per solve on 2 cores (issue 25, point 7).  A library it does not
+    know (MKL, Accelerate) is left as it is."""
+    os.environ["OPENBLAS_NUM_THREADS"] = "1"  # a library loaded later in this worker
+    try:
+        with open("/proc/self/maps", encoding="utf-8", errors="replace") as fh:
+            paths = {line.split()[-1] for line in fh if "openblas" in line.lower()}
+    except OSError:  # not Linux
+        return
+    for path in sorted(paths):
+        try:
+            lib = ctypes.CDLL(path)
+        except OSError:
+            continue
+        for name in _BLAS_THREADS:
+            setter = getattr(lib, name, None)
+            if setter is not None:
+                setter(1)
 
 
 def _death_signal(signum: int) -> bool:

@@ -25,6 +25,12 @@ def register(sub) -> None:
     rp.add_argument("--quick", action="store_true", help="coarse resolution (under a minute)")
     rp.add_argument("--serial", action="store_true", help="one process only")
     rp.add_argument(
+        "--fresh",
+        action="store_true",
+        help="compute every unit of work again instead of loading those a run with the same "
+        "code and inputs kept in the result store of the model cache (default: load them)",
+    )
+    rp.add_argument(
         "--quiet", action="store_true", help="no progress lines on stderr (otherwise one per stage)"
     )
     rp.set_defaults(func=_cmd_reproduce)
@@ -63,6 +69,7 @@ def _cmd_reproduce(args) -> int:
         quick=args.quick,
         executor="serial" if args.serial else "processes",
         progress=not args.quiet,
+        fresh=args.fresh,
     )
     print(done.summary())  # the report itself is in its file only
     return 0

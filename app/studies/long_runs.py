@@ -28,7 +28,9 @@ def _long_enough(r) -> bool:
     return int(seen.get("budget") or 0) >= LONG_BUDGET
 
 
-def lengthen(pairs, settings: dict, *, executor: str, workers: int | None, progress=None) -> list:
+def lengthen(
+    pairs, settings: dict, *, executor: str, workers: int | None, progress=None, memo=None
+) -> list:
     """Each run of ``pairs`` continued with the long budget where it needs it.
 
     Parameters
@@ -40,6 +42,8 @@ def lengthen(pairs, settings: dict, *, executor: str, workers: int | None, progr
     progress : callable, optional
         ``progress(total)`` -> a :class:`~gearsym.solver.sweep.progress.Progress` of the
         runs continued (called once, before they start).
+    memo : ResultStore, optional
+        Where runs continued before are loaded from (:mod:`gearsym.studies.memo`).
 
     Returns
     -------
@@ -66,7 +70,8 @@ def lengthen(pairs, settings: dict, *, executor: str, workers: int | None, progr
     ]
     bar = progress(len(looks)) if progress is not None else None
     if looks:
-        done = map_tasks(run_look, looks, executor=executor, workers=workers, on_result=bar)
+        run = map_tasks if memo is None else memo.map
+        done = run(run_look, looks, executor=executor, workers=workers, on_result=bar)
         for k, r in zip(todo, done, strict=True):
             out[k] = r
     return out
@@ -83,7 +88,7 @@ def periods_run(records) -> str:
 
 
 def lengthen_sweeps(
-    items, select, settings: dict, *, executor: str, workers: int | None, progress=None
+    items, select, settings: dict, *, executor: str, workers: int | None, progress=None, memo=None
 ):
     """Sweeps with the runs ``select`` picks continued with the long budget (one batch
     over every sweep, so the workers share it).
@@ -94,7 +99,7 @@ def lengthen_sweeps(
         Each sweep and its model (at the sweep's base values).
     select : callable (SweepResult, value, RunRecord) -> bool
         Whether a run carries a claim.
-    progress : callable, optional
+    progress, memo : optional
         As for :func:`lengthen`.
 
     Returns
@@ -108,7 +113,9 @@ def lengthen_sweeps(
             if select(sw, float(v), r):
                 pairs.append((system.with_values(**{sw.parameter: float(v)}), r))
                 where.append((j, k))
-    done = lengthen(pairs, settings, executor=executor, workers=workers, progress=progress)
+    done = lengthen(
+        pairs, settings, executor=executor, workers=workers, progress=progress, memo=memo
+    )
     points = [list(sw.points) for sw, _ in items]
     changed = set()
     for (j, k), r, (_, before) in zip(where, done, pairs, strict=True):

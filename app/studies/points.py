@@ -50,7 +50,9 @@ def analyse_all(sweeps: dict, models: dict, settings: dict, out, files: dict, **
         ``quick``, ``executor``, ``workers``; optional ``progress``: ``progress(total)`` ->
         a :class:`~gearsym.solver.sweep.progress.Progress` of the tasks; optional
         ``figures``: ``(function, args)`` pairs (module-level functions that draw and save
-        a figure from data the batch does not change), drawn by the workers beside the runs.
+        a figure from data the batch does not change), drawn by the workers beside the runs;
+        optional ``memo``: a :class:`~gearsym.studies.memo.ResultStore` the tasks are loaded
+        from where it keeps them, and kept in.
 
     Returns
     -------
@@ -111,9 +113,9 @@ def analyse_all(sweeps: dict, models: dict, settings: dict, out, files: dict, **
         tasks.append(("call", call))
     progress = batch.get("progress")
     bar = progress(len(tasks)) if progress is not None else None
-    done = map_tasks(
-        _run, tasks, executor=batch["executor"], workers=batch["workers"], on_result=bar
-    )
+    memo = batch.get("memo")  # a ResultStore: the tasks it keeps are loaded from it
+    run = map_tasks if memo is None else memo.map
+    done = run(_run, tasks, executor=batch["executor"], workers=batch["workers"], on_result=bar)
     return {k: r for k, r in zip(keys, done, strict=True) if k[0] != "figure"}
 
 

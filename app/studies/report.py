@@ -54,6 +54,8 @@ def _segment_distance(q, a, b) -> float:
 
 
 FIGURES_MARK = "<!-- the figures written, listed by reproduce.py -->"
+# replaced by reproduce.py with how many units of work came from the result store
+STORED_MARK = "<!-- units of work loaded from the result store -->"
 
 
 def _cell(text: str) -> str:
@@ -145,7 +147,9 @@ def report(
         f"at most; 8,000 for border runs and for every run a claim rests on); integrator "
         f"{method}, rtol 1e-8). Model hashes: light `{light.model_hash[:12]}`, heavy "
         f"`{systems['heavy'].model_hash[:12]}`, dead zone "
-        f"`{dead.files['model_hash'][:12]}`.",
+        f"`{dead.files['model_hash'][:12]}`. Result store (each sweep, run, map and its "
+        f"figures kept in the model cache under the hash of the code and its inputs): "
+        f"{STORED_MARK} (`gearsym reproduce --fresh` computes every one again).",
         "",
         "Nothing is tuned toward the study. The values it leaves open (flywheel, half "
         "backlash, transmission error, pinion layout, stiffness harmonics, sign of f2) are "

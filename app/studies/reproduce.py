@@ -28,9 +28,11 @@ from .cases import CASES, DEAD_ZONE, RESOLUTIONS, TOLERANCES
 from .claims import Bundle
 from .figures import figure_list
 from .long_runs import lengthen_sweeps
+from .memo import ResultStore
 from .points import analyse_all, pick
-from .report import FIGURES_MARK, graded, report, tally
+from .report import FIGURES_MARK, STORED_MARK, graded, report, tally
 from .sensitivity import STAGES as SENSITIVITY_STAGES
+from .sensitivity import preparations as prepare_sensitivity
 
 __all__ = ["STAGES", "Reproduced", "reproduce", "verdict_words"]
 
@@ -55,12 +57,14 @@ def verdict_words(counts: dict) -> str:
 class Reproduced:
     """What a run of :func:`reproduce` wrote and how it went: the report's path, the
     count of each verdict per model (``{"polynomial": {"agrees": 3, ...}, ...}``), the
-    wall time and ``(stage, seconds)`` per stage."""
+    wall time, ``(stage, seconds)`` per stage and how many units of work were loaded from
+    the result store (:mod:`gearsym.studies.memo`)."""
 
     report: Path
     verdicts: dict
     seconds: float
     stages: tuple
+    stored: str = ""  # how many units of work came from the result store
 
     def summary(self) -> str:
         """A few lines for the end of a run: the verdicts, the time, where things are."""
@@ -69,7 +73,7 @@ class Reproduced:
             lines.append(f"findings of the study, {model}: {verdict_words(counts)}")
         folder = self.report.parent
         lines += [
-            f"time: {fmt_seconds(self.seconds)}",
+            f"time: {fmt_seconds(self.seconds)}" + (f" ({self.stored})" if self.stored else ""),
             f"report: {self.report}",
             f"figures: {folder}/*.png, {folder / 'sensitivity'}/; data: {folder / 'data'}/",
         ]
@@ -83,15 +87,20 @@ def reproduce(
     executor: str = "processes",
     workers: int | None = None,
     progress: bool = True,
+    fresh: bool = False,
 ) -> Reproduced:
     """Run everything, write figures, data and ``report.md`` under ``out``; return the
     report's path, the verdicts' tally and how long each stage took.  Progress goes to
-    stderr, one line per stage (:class:`~gearsym.solver.sweep.progress.Stages`)."""
+    stderr, one line per stage (:class:`~gearsym.solver.sweep.progress.Stages`).  Each
+    unit of work is kept in the result store of the model cache and loaded from there
+    by a run with the same code and inputs (:mod:`gearsym.studies.memo`); ``fresh``:
+    compute every unit again (and keep the new results)."""
     res = RESOLUTIONS["quick" if quick else "full"]
     stages = Stages(len(STAGES), "reproduce", enabled=progress)
     out = Path(out)
     (out / "data").mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
+    memo = ResultStore.in_cache(out, fresh=fresh)
     method = fastest_method(TOLERANCES["rtol"])
     settings = dict(
         TOLERANCES,
@@ -137,9 +146,9 @@ def reproduce(
     bar = stages.stage(
         STAGES[0], sum(len(j.values) for j in jobs), after="now the border runs, re-examined"
     )
-    done = iter(sweep_many(jobs, executor=executor, workers=workers, progress=bar))
+    done = iter(_sweeps(jobs, memo, executor, workers, bar))
     got = {name: [next(done) for _ in group] for name, group in groups.items()}
-    got = _lengthen_claims(got, groups, settings, executor, workers, stages)
+    got = _lengthen_claims(got, groups, settings, executor, workers, stages, memo)
     by_case = {case: got["cases"][2 * k : 2 * k + 2] for k, (case, _, _) in enumerate(CASES)}
     dead_case = {case: got["dead cases"][2 * k : 2 * k + 2] for k, (case, _, _) in enumerate(CASES)}
     bearing_sweeps, maps = got["bearings"], got["maps"]
@@ -188,6 +197,9 @@ def reproduce(
         (backlash_figure, (systems["light"], out / "backlash.png", plain)),
         (stiffness_figure, (systems["light"], out / "stiffness.png", plain)),
     ]
+    # the sensitivity maps' models, derived and compiled while the responses run (its
+    # own stage then finds them in the cache)
+    drawn += prepare_sensitivity(quick)
     sweeps = {"polynomial": by_case, "dead zone": dead_case}
     models = {"polynomial": systems, "dead zone": dead}
     done = analyse_all(
@@ -201,6 +213,7 @@ def reproduce(
         workers=workers,
         progress=lambda total: stages.stage(STAGES[2], total),
         figures=drawn,
+        memo=memo,
     )
     bar = stages.stage(STAGES[3], 6)  # the f1 map, 2 x 2 of the branches, the responses
     from .mechanisms import mechanisms_section
@@ -255,7 +268,14 @@ def reproduce(
     from .sensitivity import SCENES, physical_scales, run_sensitivity
 
     rows = run_sensitivity(
-        out, res, settings, quick=quick, executor=executor, workers=workers, stages=stages
+        out,
+        res,
+        settings,
+        quick=quick,
+        executor=executor,
+        workers=workers,
+        stages=stages,
+        memo=memo,
     )
     bar = stages.stage(STAGES[6], 5)
     scales = physical_scales(SCENES["light"][0])
@@ -270,6 +290,7 @@ def reproduce(
     }
     found = graded(bundles, lam, res)
     text = report(res, lam, bundles, elapsed, quick, systems, branches, method, found=found)
+    text = text.replace(STORED_MARK, memo.summary(), 1)
     head, sep, tail = text.partition("## Figures")
     bar.step()
     forward = [by_case[case][0] for case, _, _ in CASES]
@@ -300,10 +321,25 @@ def reproduce(
     path = out / "report.md"
     path.write_text(text, encoding="utf-8")
     stages.end()
-    return Reproduced(path, tally(found), time.perf_counter() - started, tuple(stages.times))
+    took = time.perf_counter() - started
+    return Reproduced(path, tally(found), took, tuple(stages.times), memo.summary())
 
 
-def _lengthen_claims(got: dict, groups: dict, settings, executor, workers, stages) -> dict:
+def _sweeps(jobs: list, memo, executor, workers, bar) -> list:
+    """The sweep jobs' results: those the result store keeps loaded (their points counted
+    on ``bar`` at once), the rest run by one :func:`sweep_many` and kept."""
+    keys = [memo.key(sweep_many, replace(job, store=None)) for job in jobs]
+    out, todo = memo.kept(keys, lambda k, _: bar.step("(result store)", n=len(jobs[k].values)))
+    run = [jobs[k] for k in todo]
+    ran = sweep_many(run, executor=executor, workers=workers, progress=bar) if run else []
+    for k, result in zip(todo, ran, strict=True):
+        memo.keep(keys[k], (result, None))
+        memo.computed += 1
+        out[k] = result
+    return out
+
+
+def _lengthen_claims(got: dict, groups: dict, settings, executor, workers, stages, memo) -> dict:
     """The sweeps with every run a claim may rest on continued with the long budget:
     the forward case sweeps' non-periodic runs in the study's low-lambda ranges (u
     quasi-periodic up to 0.57 light, 0.13 heavy; v chaotic up to 0.3) and the maps'
@@ -328,6 +364,7 @@ def _lengthen_claims(got: dict, groups: dict, settings, executor, workers, stage
             executor=executor,
             workers=workers,
             progress=lambda total: stages.stage(STAGES[1], total),
+            memo=memo,
         )
     )
     out = dict(got)

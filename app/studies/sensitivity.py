@@ -15,7 +15,14 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["OPEN_SPREAD", "FINDINGS", "Sensitivity", "run_sensitivity", "physical_scales"]
+__all__ = [
+    "OPEN_SPREAD",
+    "FINDINGS",
+    "Sensitivity",
+    "physical_scales",
+    "preparations",
+    "run_sensitivity",
+]
 
 # key -> (values tried, stated value of the built-in scenes, unit); text values (a damping
 # normalisation, a backlash model) are mapped over their index and labelled by name
@@ -111,6 +118,31 @@ def _prepare(args: tuple) -> None:
         pass
 
 
+def preparations(quick: bool) -> list:
+    """``(function, args)`` pairs that derive and compile every model of the maps, one per
+    scene and load reading (module-level, for a worker): ``gearsym reproduce`` hands them
+    to its batch of operating points, where they keep a worker busy while the frequency
+    responses run (derived here, one after another in the main process, they left both
+    workers idle for about 40 s of a first run)."""
+    spread = QUICK_SPREAD if quick else OPEN_SPREAD
+    return [
+        (_prepare_reading, (scene, f1, reading, spread))
+        for scene, f1 in SCENES.values()
+        for reading in READINGS
+    ]
+
+
+def _prepare_reading(scene: str, f1: float, reading: str, spread: dict) -> None:
+    """Worker: the scene's model in ``reading`` and every model its maps derive, each
+    derived and compiled into the caches (:func:`_prepare`)."""
+    _prepare((scene, f1, reading, None, None))
+    base = _load_value(scene, f1, reading, None, None).module
+    for key, (values, _, _) in spread.items():
+        for value in values:
+            if _derives(base, key, value):
+                _prepare((scene, f1, reading, key, value))
+
+
 def _resolver(scene: str, f1: float, reading: str, key: str, values: tuple):
     """The System of one map point: one derivation per value of ``key`` (cached), in
     ``reading``; a text value arrives as its index in ``values``."""
@@ -160,10 +192,14 @@ def _derives(module, key: str, value) -> bool:
     return bool(split_open_values({key: value}, module)[0])
 
 
-def run_sensitivity(out: Path, res, settings: dict, *, quick, executor, workers, stages=None):
+def run_sensitivity(
+    out: Path, res, settings: dict, *, quick, executor, workers, stages=None, memo=None
+):
     """Regime maps over lambda by each open value at both loads, in both load readings;
     figures and data under ``out``; a list of :class:`Sensitivity` rows.  ``stages``: a
-    :class:`~gearsym.solver.sweep.progress.Stages` the two stages (models, maps) report to."""
+    :class:`~gearsym.solver.sweep.progress.Stages` the two stages (models, maps) report to;
+    ``memo``: a :class:`~gearsym.studies.memo.ResultStore` the maps are loaded from where
+    it keeps them (then their models are not prepared) and kept in."""
     from gearsym.resolve import load
     from gearsym.solver.sweep import map_tasks
     from gearsym.solver.sweep.progress import Stages
@@ -172,33 +208,39 @@ def run_sensitivity(out: Path, res, settings: dict, *, quick, executor, workers,
     spread = QUICK_SPREAD if quick else OPEN_SPREAD
     lam = np.round(np.linspace(0.0, 1.0, 6 if quick else 11), 10)
     (out / "sensitivity").mkdir(parents=True, exist_ok=True)
-    # Every model of every map derived and compiled first, side by side (one at a time in
-    # this process they kept the workers idle for about half of the stage); a value that
-    # is a parameter of the generated model needs no model of its own.
-    base = {(s, r): load(s, load_reading=r).module for s, _ in SCENES.values() for r in READINGS}
-    every = dict.fromkeys(
-        (scene, f1, reading, key, value)
-        if _derives(base[scene, reading], key, value)
-        else (scene, f1, reading, None, None)  # the scene's own model
-        for case, (scene, f1) in SCENES.items()
-        for reading in READINGS
-        for key, (values, _, _) in spread.items()
-        for value in values
-    )
-    bar = stages.stage(STAGES[0], len(every))
-    map_tasks(_prepare, list(every), executor=executor, workers=workers, on_result=bar)
-    # Then each map, its long runs and its figures as one task of a worker (serial inside):
-    # the workers share the maps, not the columns of one map, so no core waits for the
-    # end of a map's chains, and no process pool is started per map.  The largest first.
     tasks = [
         (out, res, settings, lam, case, scene, f1, reading, key, spread[key])
         for case, (scene, f1) in SCENES.items()
         for reading in READINGS
         for key in spread
     ]
+    # Every model of every map derived and compiled first, side by side (one at a time in
+    # this process they kept the workers idle for about half of the stage); a value that
+    # is a parameter of the generated model needs no model of its own.  A repeated run
+    # that loads every map from the result store needs none of them.
+    every: dict = {}
+    if memo is None or not all(memo.has(memo.key(_map_task, t)) for t in tasks):
+        base = {
+            (s, r): load(s, load_reading=r).module for s, _ in SCENES.values() for r in READINGS
+        }
+        every = dict.fromkeys(
+            (scene, f1, reading, key, value)
+            if _derives(base[scene, reading], key, value)
+            else (scene, f1, reading, None, None)  # the scene's own model
+            for case, (scene, f1) in SCENES.items()
+            for reading in READINGS
+            for key, (values, _, _) in spread.items()
+            for value in values
+        )
+    bar = stages.stage(STAGES[0], len(every))
+    map_tasks(_prepare, list(every), executor=executor, workers=workers, on_result=bar)
+    # Then each map, its long runs and its figures as one task of a worker (serial inside):
+    # the workers share the maps, not the columns of one map, so no core waits for the
+    # end of a map's chains, and no process pool is started per map.  The largest first.
     order = sorted(range(len(tasks)), key=lambda k: -len(tasks[k][-1][0]))
     bar = stages.stage(STAGES[1], len(tasks))
-    done = map_tasks(
+    run = map_tasks if memo is None else memo.map
+    done = run(
         _map_task, [tasks[k] for k in order], executor=executor, workers=workers, on_result=bar
     )
     rows = [None] * len(tasks)

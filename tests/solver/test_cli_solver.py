@@ -86,7 +86,8 @@ def test_sweep_refuses_a_bad_range(capsys):
 
 @pytest.mark.slow
 def test_reproduce_quick_writes_the_report(tmp_path, capsys):
-    assert main(["reproduce", "--quick", "--out", str(tmp_path), "--quiet"]) == 0
+    # --fresh: every unit computed, none loaded from a result store an earlier run kept
+    assert main(["reproduce", "--quick", "--fresh", "--out", str(tmp_path), "--quiet"]) == 0
     report = (tmp_path / "report.md").read_text()
     # stdout: the short summary, not the report (issue 25, point 7)
     said = capsys.readouterr().out

@@ -45,7 +45,9 @@ SWEEP = [
     "--quiet",
     "--no-figure",
 ]
-REPRODUCE = [sys.executable, "-m", "gearsym.cli", "reproduce", "--quick", "--quiet", "--out"]
+# --fresh: every unit computed by the workers, none loaded from a result store
+REPRODUCE = [sys.executable, "-m", "gearsym.cli", "reproduce", "--quick", "--fresh", "--quiet"]
+REPRODUCE += ["--out"]
 
 
 def _stat(pid: str) -> list[str]:
