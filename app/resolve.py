@@ -61,6 +61,37 @@ def module_for(target: str | Path, open_values: dict | None = None) -> ModuleTyp
     module = None if open_values else _known_current(target)
     if module is not None:
         return module
+    # a variant this process loaded already, while its files are unchanged (parsing the
+    # scene for its inputs hash recomputes the mesh stiffness: 0.1 s a call, which a map
+    # over open values pays per value and per task)
+    seen = _fingerprint(target) if open_values else None
+    if seen is not None:
+        seen = (seen, str(model_cache()), json.dumps(open_values, sort_keys=True, default=str))
+        module, stamp = _VARIANTS.get(seen, (None, None))
+        if module is not None and _stamp(module) == stamp:
+            return module
+    module = _derived(target, open_values)
+    if seen is not None:
+        _VARIANTS[seen] = (module, _stamp(module))
+    return module
+
+
+# (fingerprint of the files, cache folder, open values) -> (module, the stamp of its file),
+# in this process: a module file changed or removed since is looked up again
+_VARIANTS: dict = {}
+
+
+def _stamp(module: ModuleType) -> tuple | None:
+    try:
+        st = os.stat(module.__file__)
+    except (OSError, TypeError):
+        return None
+    return st.st_mtime_ns, st.st_size
+
+
+def _derived(target, open_values: dict | None) -> ModuleType:
+    """:func:`module_for` without its fast paths: the scene parsed, its inputs hash, the
+    shipped or cached module of that hash, else a derivation into the cache."""
     from gearsym.derive import derive_model, load_target, resolve_target
     from gearsym.derive.emit.python import emit_module
     from gearsym.derive.input.open_values import with_open_values

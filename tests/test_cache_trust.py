@@ -304,3 +304,17 @@ def test_a_worker_that_loads_a_cached_model_by_path_verifies_it(cache):
     module.write_text(module.read_text(encoding="utf-8") + "\nraise SystemExit(99)\n", "utf-8")
     with pytest.raises(ValueError, match="does not match the digest"):
         load_generated(module)
+
+
+def test_a_variant_loaded_again_in_one_process_is_not_parsed_again(cache, monkeypatch):
+    """A map over open values loads each variant once per value and task: the second
+    load of the same variant, files unchanged, must not parse the scene again (the mesh
+    stiffness it recomputes costs 0.1 s).  A module file changed since is checked again."""
+    scene, _, _ = cache
+    first = resolve.module_for(scene, {"load_reading": "both-driving"})
+    calls = []
+    monkeypatch.setattr(resolve, "_derived", lambda *a: calls.append(a) or first)
+    assert resolve.module_for(scene, {"load_reading": "both-driving"}) is first and not calls
+    path = Path(first.__file__)
+    path.write_bytes(path.read_bytes() + b"\n")  # edited: the stamp differs
+    assert resolve.module_for(scene, {"load_reading": "both-driving"}) is first and calls
