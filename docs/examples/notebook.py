@@ -2,8 +2,9 @@
 
 It uses ``import gearsym`` alone: load a model, look at one operating point, sweep the
 load ratio, map two parameters, find a periodic orbit with its Floquet multipliers and
-continue it, compute a short frequency response and the modes, and draw each result with
-``gearsym.plot`` (each function returns a matplotlib Figure; a notebook shows it).
+continue it, compute a short frequency response and the modes, sweep the speed in rpm with
+results in µm and Hz, and draw each result with ``gearsym.plot`` (each function returns a
+matplotlib Figure; a notebook shows it).
 
 Run: ``python docs/examples/notebook.py [OUTDIR]``: with OUTDIR the figures are saved
 there as PNG; without, nothing is written.  About half a minute on one core.
@@ -83,6 +84,26 @@ figures["frequency-response"] = gearsym.plot.frequency_response(response)
 modes = gearsym.modes(system)
 print(modes.summary())
 figures["campbell"] = gearsym.plot.campbell(modes)
+
+# %% [markdown]
+# ## In the engineer's units
+# The same pair at 1,200 rpm of pinion p (a physical quantity of the generated model:
+# no new derivation), swept over the speed; the figure in µm with the mesh frequency in
+# Hz on its top axis, and the sweep's table with µm, rpm and Hz columns beside the
+# model's own.
+
+# %%
+at_speed = gearsym.load("reference-light", speed_rpm=1200.0, **{"lambda": 0.8})
+print(gearsym.Units.of(at_speed).operating_point())
+speeds = [900.0, 1050.0, 1200.0]
+by_speed = gearsym.sweep(
+    at_speed, "speed_rpm", speeds, transient=60, periods=16, lyapunov_periods=20
+)
+columns, rows = gearsym.in_units(by_speed, at_speed).to_table()
+print([c for c in columns if c.endswith(("_um", "_rpm", "_hz"))])
+figures["bifurcation-physical"] = gearsym.plot.bifurcation(
+    by_speed, system=at_speed, units="physical"
+)
 
 # %% [markdown]
 # ## Saving is the caller's choice
