@@ -109,6 +109,7 @@ def test_notebook_builds_figures_from_the_api_alone(tmp_path, monkeypatch):
             "branch",
             "frequency-response",
             "campbell",
+            "bifurcation-physical",
         ]
         assert all(isinstance(f, Figure) and f.axes for f in figures.values())
         assert not list(tmp_path.iterdir())  # saving is the caller's choice
