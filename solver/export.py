@@ -29,7 +29,7 @@ import numpy as np
 from ._json import clean, dumps
 from .provenance import KEYS
 
-__all__ = ["FORMATS", "Document", "document", "save"]
+__all__ = ["FORMATS", "Document", "document", "save", "save_all"]
 
 FORMATS = (".json", ".csv", ".mat")
 
@@ -81,6 +81,14 @@ def save(result, path, **extra) -> Path:
     return write_atomic(
         path, lambda fh: savemat(fh, content, long_field_names=True, do_compression=True)
     )
+
+
+def save_all(result, path, **extra) -> list[Path]:
+    """``result`` in every format (:data:`FORMATS`) beside ``path``, whose suffix is
+    replaced: ``sweep.json`` -> ``sweep.json``, ``sweep.csv``, ``sweep.mat``."""
+    path = Path(path)
+    write = getattr(result, "save", None) or (lambda p, **kw: save(result, p, **kw))
+    return [write(path.with_suffix(suffix), **extra) for suffix in FORMATS]
 
 
 def write_atomic(path, content) -> Path:

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 from gearsym.solver._json import dumps
+from gearsym.solver.export import save_all
 from gearsym.solver.integrate import fastest_method
 from gearsym.solver.sweep import SweepJob, sweep_many
 from gearsym.solver.sweep.progress import Stages, fmt_seconds
@@ -156,7 +157,7 @@ def reproduce(
     files["dead zone"] = {"sweep": {}, "point": {}, "bifurcation": {}}
     for sw in got["cases"] + maps + bearing_sweeps:
         tag = f"{sw.model}_{sw.direction}_f1_{sw.base_values.get('f1', 'scene')}"
-        sw.save(out / "data" / f"sweep_{tag}.json")
+        save_all(sw, out / "data" / f"sweep_{tag}.json")
     for case, _, _ in CASES:
         files["polynomial"]["sweep"][case] = tuple(
             f"data/sweep_{sw.model}_{sw.direction}_f1_scene.json" for sw in by_case[case]
@@ -165,11 +166,11 @@ def reproduce(
             f"data/sweep_{sw.model}_{sw.direction}_{case}.json" for sw in dead_case[case]
         )
         for sw, name in zip(dead_case[case], files["dead zone"]["sweep"][case], strict=True):
-            sw.save(out / name)
+            save_all(sw, out / name)
     files["polynomial"]["map"] = "map_f1_lambda.png"
     files["dead zone"]["map"] = f"data/sweep_{DEAD_ZONE}_map_f1_*.json"
     for sw, f1 in zip(got["dead maps"], res.map_f1, strict=True):
-        sw.save(out / "data" / f"sweep_{DEAD_ZONE}_map_f1_{f1}.json")
+        save_all(sw, out / "data" / f"sweep_{DEAD_ZONE}_map_f1_{f1}.json")
     files["dead zone"]["model_hash"] = dead["light"].model_hash
     from gearsym.solver import plots
 

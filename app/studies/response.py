@@ -97,6 +97,7 @@ def run_response(
     """The frequency responses (figures and data under ``out``), one per (case, lambda);
     ``done``: ``(case, lambda) -> FrequencyResponse`` already computed (the rest are
     computed here)."""
+    from gearsym.solver.export import save_all
     from gearsym.solver.sweep.frequency import frequency_response
 
     from .figures import response_figure
@@ -113,7 +114,8 @@ def run_response(
             resp = done.get((case, lam))
             if resp is None:
                 resp = frequency_response(s, "omega", *RANGE, points=num, harmonics=harmonics)
-            resp.save(out / "data" / f"response_{case}_lambda_{lam}.json")
+            # JSON, CSV and MATLAB, as every command writes (solver/export.py)
+            save_all(resp, out / "data" / f"response_{case}_lambda_{lam}.json")
             sols = _at(resp.curves[0], OMEGA, coords)
             att = _attractor(points.get((case, lam)), sols, coords)
             rows.append(ResponseCase(case, f1, lam, resp, sols, att))

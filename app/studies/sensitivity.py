@@ -253,6 +253,7 @@ def _map_task(args: tuple) -> Sensitivity:
     """Worker: one regime map over lambda by one open value (serial), its claim-carrying
     runs continued, its data and figures written; its :class:`Sensitivity` row."""
     from gearsym.resolve import load
+    from gearsym.solver.export import save_all
     from gearsym.solver.sweep.atlas import regime_map
 
     out, res, settings, lam, case, scene, f1, reading, key, (values, stated, unit) = args
@@ -277,7 +278,7 @@ def _map_task(args: tuple) -> Sensitivity:
         resolve=resolve,
     )
     m, carriers = _lengthen_carriers(m, FINDINGS[case], key, resolve, settings, "serial", None)
-    m.save(out / "data" / f"sensitivity_{name}.json")
+    save_all(m, out / "data" / f"sensitivity_{name}.json")  # and .csv, .mat
     figures = _draw(
         (
             m,

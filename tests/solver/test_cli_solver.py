@@ -115,6 +115,15 @@ def test_reproduce_quick_writes_the_report(tmp_path, capsys):
     assert "| heavy (f1 = 0.5) | both driving | `te_amplitude_um` (µm) |" in report
     assert "## Frequency response around the study's operating point" in report
     assert "### Physical scales" in report
+    # the sweeps, maps and responses in every result format, as every command writes them
+    tables = [p for p in (tmp_path / "data").glob("*.json") if p.stem.startswith(TABLES)]
+    assert len(tables) > 10
+    for path in tables:
+        assert path.with_suffix(".csv").stat().st_size > 0, path.name
+        assert path.with_suffix(".mat").stat().st_size > 0, path.name
+
+
+TABLES = ("sweep_", "sensitivity_", "response_")
 
 
 BAD_COMMANDS = [
