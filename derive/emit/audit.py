@@ -19,6 +19,7 @@ from ..input.paths import display_path
 from ..input.readings import reading_section
 from ..mesh.backlash import ForceSign, fit_dead_zone
 from ..model import Model
+from .audit_internal import INDEX_SECTION, internal_section
 from .audit_physical import physical_section
 from .audit_structure import structure_sections
 from .audit_torsion import torsional_sections
@@ -106,6 +107,8 @@ def audit_page(model: Model, command: str) -> str:
             f"{_num(me.phase)} ({me.phase_source}) |"
         )
     w("")
+    if any(me.pair.internal for me in topo.meshes):
+        w(internal_section(model))
 
     if model.structure is not None:
         w(structure_sections(model))
@@ -322,6 +325,7 @@ def index_page(models: list[Model], command: str) -> str:
         "bearing's tilting spring, and the axial force's moments about the contact point "
         "(lumped at the pitch point, face centre) tilt it. "
         "`gearsym modes` solves $R^T K R\\,v = \\omega^2 M v$ at the mean stiffness.\n",
+        INDEX_SECTION,
         "## Backlash polynomial\n",
         "The reference study prints $g(x) = 0.0017x^7 - 0.0366x^5 + 0.2833x^3 - 0.1555x$ "
         "without its set-up. A discrete least-squares fit of the odd powers to the unit dead "

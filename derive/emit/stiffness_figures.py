@@ -14,6 +14,7 @@ import warnings
 
 import numpy as np
 
+from ..input.reader import InputError
 from ..input.topology import Mesh, Topology
 from ..mesh.iso6336 import iso_stiffness
 from ..mesh.pem import PemResult, foundation_parameters, pair_compliance, pem_stiffness
@@ -48,8 +49,18 @@ def mesh_report(
     harmonics: int = 3,
     convergence: tuple[int, ...] = CONVERGENCE_SLICES,
 ) -> tuple[dict, PemResult]:
-    """JSON-ready figures of one mesh, and the :class:`PemResult` behind them."""
+    """JSON-ready figures of one mesh, and the :class:`PemResult` behind them; an
+    :class:`InputError` for an internal mesh (the sliced potential-energy method models
+    external teeth only)."""
     pair = mesh.pair
+    if pair.internal:
+        raise InputError(
+            topology.source,
+            f"mesh '{mesh.id}'",
+            "is internal (a pinion and ring): the potential-energy stiffness report covers "
+            "external teeth only; its ISO 6336-1 stiffness is on its derivation audit page "
+            "(gearsym derive)",
+        )
     g1, g2 = topology.gear(mesh.driver), topology.gear(mesh.driven)
     res = mesh_pem(topology, mesh, slices, harmonics)
     iso = iso_stiffness(pair, youngs=(g1.material.youngs_modulus, g2.material.youngs_modulus))

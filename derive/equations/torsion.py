@@ -10,6 +10,11 @@ gear ``k`` counted positive in its operating direction:
   flank loaded = positive) and ``-1`` for one measured the other way (``derive.readings``),
   and ``e_i`` the composite transmission error (positive = excess material, which presses
   the flanks together);
+  the same for an internal mesh (a pinion driving a ring): pinion and ring turn the same
+  way, but each ``theta_k`` is counted in its own gear's operating direction, so in one
+  frame for all gears (``theta_k = epsilon_k phi_k``, ``Topology.senses``) the deflection
+  is ``r_b1 phi_1 + r_b2 phi_2`` for an external pair and ``r_b1 phi_1 - r_b2 phi_2`` for
+  an internal one (the audit prints both forms);
 * mesh force:  ``F_i = k_i(t) b_i g(x_i / b_i) + c_i x_i'`` along the normal line of action;
   its transverse component ``F_i cos(beta_b,i)`` acts at the base radius.
 

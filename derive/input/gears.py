@@ -3,7 +3,8 @@
 Each gear is a helical gear of ISO 21771 geometry (``derive/mesh/geometry.py``) with its
 material and bore; any inertia or mass attached to it (a flywheel, a coupling) is lumped
 with it.  ``parse_gear`` reads one ``[[gear]]`` table (``_mm``, ``_deg``, ``_kg_m2``,
-``_kg`` keys), converts it to SI (m, rad, kg) and checks it; ``parse_material`` reads one
+``_kg`` keys), converts it to SI (m, rad, kg) and checks it (``internal = true``: a ring,
+``derive/mesh/internal.py``, whose inertia is given); ``parse_material`` reads one
 ``[materials.<name>]`` table (``_Pa``, ``_kg_m3``).
 """
 
@@ -14,6 +15,7 @@ import warnings
 from dataclasses import dataclass
 
 from ..mesh.geometry import GearGeometry, gear_geometry, with_tip_radius
+from ..mesh.internal import ring_geometry, ring_with_tip_radius
 from .reader import Table, nearest
 
 __all__ = ["STEEL", "Gear", "Material", "parse_gear", "parse_material"]
@@ -90,6 +92,11 @@ class Gear:
     def base_radius(self) -> float:
         return self.geometry.base_radius
 
+    @property
+    def internal(self) -> bool:
+        """True for a ring (internal teeth)."""
+        return self.geometry.internal
+
 
 def parse_material(t: Table, name: str) -> Material:
     """One ``[materials.<name>]`` table: Young's modulus (Pa), Poisson's ratio, density
@@ -128,6 +135,14 @@ def parse_gear(t: Table, materials: dict[str, Material]) -> Gear:
         )
     dedendum = t.number("rack_dedendum", 1.25, low=1.0, high=1.6)
     rack_root = t.number("rack_root_radius", 0.38, low=0.0, high=0.6)
+    if t.boolean("internal", False):
+        return _parse_ring(
+            t,
+            gid,
+            teeth,
+            (mn, alpha_n, beta, width, shift, dedendum, rack_root),
+            materials[mat_name],
+        )
     try:
         geometry = gear_geometry(teeth, mn, alpha_n, beta, shift, 1.0, dedendum, rack_root)
     except ValueError as err:
@@ -190,4 +205,42 @@ def parse_gear(t: Table, materials: dict[str, Material]) -> Gear:
         mass,
         attached_mass,
         diametral,
+    )
+
+
+def _parse_ring(t: Table, gid: str, teeth: int, data: tuple, material: Material) -> Gear:
+    """The rest of a ``[[gear]]`` table with ``internal = true``: a ring's geometry
+    (``derive/mesh/internal.py``) and its given inertia (a ring's rim and housing are not
+    a cylinder that the gear data fix)."""
+    mn, alpha_n, beta, width, shift, dedendum, rack_root = data
+    for key in ("bore_radius_mm", "mass_kg", "diametral_inertia_kg_m2"):
+        if t.has(key):
+            raise t.error(key, "is not used for a ring (internal = true); remove it")
+    try:
+        geometry = ring_geometry(teeth, mn, alpha_n, beta, shift, dedendum, rack_root)
+    except ValueError as err:
+        raise t.error("teeth", str(err)) from None
+    tip_diameter = t.number("tip_diameter_mm", None, low=0, low_open=True)
+    if tip_diameter is not None:
+        try:
+            geometry = ring_with_tip_radius(geometry, tip_diameter * 0.5e-3)
+        except ValueError as err:
+            raise t.error("tip_diameter_mm", str(err)) from None
+    if geometry.tip_thickness <= 0.0:
+        raise t.error(
+            "profile_shift",
+            f"the ring's teeth are pointed at their tip (thickness "
+            f"{geometry.tip_thickness * 1e3:.3f} mm); raise its profile shift",
+        )
+    if not t.has("inertia_kg_m2"):
+        raise t.error(
+            "inertia_kg_m2",
+            "a ring (internal = true) needs its polar moment of inertia (rim, web and housing "
+            "together); give inertia_kg_m2",
+        )
+    inertia = t.number("inertia_kg_m2", low=1e-15, high=1e9)
+    attached = t.number("attached_inertia_kg_m2", 0.0, low=0.0, high=1e9)
+    t.finish()
+    return Gear(
+        gid, teeth, mn, alpha_n, beta, width, shift, material, 0.0, inertia, attached, geometry
     )

@@ -3,7 +3,8 @@
 ``parse_mesh`` reads one ``[[mesh]]`` table: its two gears, the pair geometry (ISO 21771,
 ``derive/mesh/geometry.py``) with its contact checks, the mesh coordinate's name, the half
 backlash (``_um``), the stiffness (given harmonics, the contact-line model, or the sliced
-potential-energy method of ``derive/mesh/pem.py``), the transmission error and the phase
+potential-energy method of ``derive/mesh/pem.py``, or ISO 6336-1 method B's mean with the
+contact-line waveform), the transmission error and the phase
 lag against the first mesh (given, or from the layout).
 """
 
@@ -14,7 +15,9 @@ import re
 import warnings
 from dataclasses import dataclass
 
-from ..mesh.geometry import CentreDistanceError, PairGeometry, pair_geometry
+from ..mesh.geometry import CentreDistanceError, PairGeometry
+from ..mesh.internal import internal_pair_problem, mesh_pair
+from ..mesh.iso6336 import iso_stiffness
 from ..mesh.pem import pem_stiffness
 from ..mesh.stiffness import MeshStiffness, contact_line_stiffness
 from .gears import Gear
@@ -82,7 +85,7 @@ def parse_mesh(mt: Table, meshes: list[Mesh], by_id: dict[str, Gear]) -> Mesh:
     g1, g2 = by_id[ends[0]], by_id[ends[1]]
     a_w = mt.number("centre_distance_mm", None, low=0, low_open=True)
     try:
-        pair = pair_geometry(
+        pair = mesh_pair(
             g1.geometry,
             g2.geometry,
             min(g1.face_width, g2.face_width),
@@ -92,7 +95,12 @@ def parse_mesh(mt: Table, meshes: list[Mesh], by_id: dict[str, Gear]) -> Mesh:
         raise mt.error("centre_distance_mm", str(err)) from None
     except ValueError as err:
         raise mt.error("driven", f"'{ends[0]}' and '{ends[1]}' cannot mesh: {err}") from None
-    _check_contact(mt, pair, ends)
+    if pair.internal:
+        problem = internal_pair_problem(pair, (ends[0], ends[1]))
+        if problem:
+            raise mt.error("driven", problem)
+    else:
+        _check_contact(mt, pair, ends)
     coordinate = mt.identifier("coordinate")
     if coordinate in RESERVED_NAMES or BACKLASH_NAME.fullmatch(coordinate):
         raise mt.error(
@@ -145,9 +153,19 @@ def _stiffness(t: Table, pair: PairGeometry, gears: tuple[Gear, Gear]) -> MeshSt
 
 
 def _stiffness_of(t: Table, pair: PairGeometry, gears: tuple[Gear, Gear]) -> MeshStiffness:
-    source = t.string("source", choices=("harmonics", "contact-line", "potential-energy"))
+    source = t.string(
+        "source", choices=("harmonics", "contact-line", "potential-energy", "iso-6336")
+    )
     if source == "potential-energy":
+        if pair.internal:
+            raise t.error(
+                "source",
+                "the potential-energy method here is for external teeth; for a pinion and "
+                'ring use "iso-6336", "contact-line" or "harmonics"',
+            )
         return _pem_stiffness(t, pair, gears)
+    if source == "iso-6336":
+        return _iso_stiffness(t, pair, gears)
     # 1 kN/mm-scale plastics down to 1e3 N/m, steel's 1e8-1e10 N/m up to 1e13 N/m.
     mean = t.number("mean_N_per_m", low=1e3, high=1e13)
     if source == "harmonics":
@@ -161,6 +179,26 @@ def _stiffness_of(t: Table, pair: PairGeometry, gears: tuple[Gear, Gear]) -> Mes
     t.finish()
     return contact_line_stiffness(
         mean, pair.transverse_contact_ratio, pair.axial_contact_ratio, harmonics
+    )
+
+
+def _iso_stiffness(t: Table, pair: PairGeometry, gears: tuple[Gear, Gear]) -> MeshStiffness:
+    """ISO 6336-1 method B mean stiffness ``c_gamma_alpha b`` (``derive/mesh/iso6336.py``;
+    solid blanks, no low-load reduction) with the contact-line waveform of the pair's
+    contact ratios (``derive/mesh/stiffness.py``: for spur teeth the rectangular
+    single/double contact wave), rounded to 9 significant digits."""
+    harmonics = t.integer("harmonics", 10, low=0, high=64)
+    t.finish()
+    iso = iso_stiffness(pair, youngs=tuple(g.material.youngs_modulus for g in gears))
+    mean = float(f"{iso.mesh_stiffness:.9g}")
+    wave = contact_line_stiffness(
+        mean, pair.transverse_contact_ratio, pair.axial_contact_ratio, harmonics
+    )
+    return MeshStiffness(
+        mean,
+        tuple(float(f"{c:.9g}") for c in wave.cos),
+        tuple(float(f"{c:.9g}") for c in wave.sin),
+        "iso-6336",
     )
 
 

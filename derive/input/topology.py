@@ -73,9 +73,10 @@ class Topology:
     def senses(self) -> dict[str, int]:
         """Each gear's turning sense seen from +z: +1 counter-clockwise.  The first mesh's
         driver turns counter-clockwise (a convention: its mirror image is the same train);
-        an external mesh reverses the sense, a shaft keeps it."""
+        an external mesh reverses the sense, an internal one (pinion and ring) and a shaft
+        keep it."""
         sense = {self.reference.driver: 1}
-        links = [(m.driver, m.driven, -1) for m in self.meshes]
+        links = [(m.driver, m.driven, 1 if m.pair.internal else -1) for m in self.meshes]
         links += [(s.gears[0], s.gears[1], 1) for s in self.shafts]
         while len(sense) < len(self.gears):
             for a, b, flip in links:
@@ -114,6 +115,12 @@ class Topology:
                     continue
                 pending.remove(m)
         return speed
+
+    def signed_speed_ratios(self, gear_id: str) -> dict[str, Fraction]:
+        """w_gear / w_(gear_id) with the turning senses: ``-z1/z2`` across an external mesh,
+        ``+z1/z2`` across an internal one (pinion and ring turn the same way)."""
+        sense = self.senses()
+        return {g: r * sense[g] * sense[gear_id] for g, r in self.speed_ratios(gear_id).items()}
 
     def mesh_frequency_ratios(self) -> dict[str, Fraction]:
         """Mesh frequency ``z_driver |w_driver|`` of each mesh over the reference mesh's."""
@@ -169,6 +176,13 @@ def parse_topology(data: dict, source: str) -> Topology:
     shafts = parse_shafts(top, by_id)
     _check_tree(top, gears, meshes, shafts)
     bearings = parse_bearings(top, by_id)
+    ring = next((g.id for g in gears if g.internal), None)
+    if ring is not None and (bearings or shafts):
+        raise top.error(
+            "bearing" if bearings else "shaft",
+            f"gear '{ring}' is a ring: internal gears are supported in torsional models "
+            "without bearings or shafts; remove the [[bearing]] and [[shaft]] tables",
+        )
 
     torques: dict[str, float] = {}
     for tt in top.tables("torque") if top.has("torque") else []:

@@ -6,6 +6,10 @@ principles, introduction and general influence factors", clause 9 (method B):
 * virtual teeth ``z_n = z / (cos^2(beta_b) cos(beta))``;
 * ``q' = C1 + C2/z_n1 + C3/z_n2 + C4 x1 + C5 x1/z_n1 + C6 x2 + C7 x2/z_n2 + C8 x1^2 + C9 x2^2``
   (mm um / N), ``c'_th = 1 / q'``;
+* for an internal pair (``derive/mesh/internal.py``) the ring counts as a rack:
+  ``z_n2 = infinity`` (the ``C3`` and ``C7`` terms vanish), method B's rule for internal
+  gears (the clause is not quoted here: check it against the edition in use), with ``x2``
+  in the standard's sign (the opposite of this program's ring shift);
 * ``c' = c'_th C_M C_R C_B cos(beta)`` with ``C_M = 0.8`` (solid discs), the gear blank factor
   ``C_R = 1 + ln(b_s/b) / (5 exp(s_R / (5 m_n)))`` (1 for solid discs; ``b_s/b`` within
   [0.2, 1.2], ``s_R / m_n >= 1``) and the basic rack factor ``C_B = (C_B1 + C_B2)/2``,
@@ -90,7 +94,8 @@ def iso_stiffness(
     line_load: float | None = None,
     youngs: tuple[float, float] = (_E_STEEL, _E_STEEL),
 ) -> IsoStiffness:
-    """ISO 6336-1 method B single and mesh stiffness of an external pair.
+    """ISO 6336-1 method B single and mesh stiffness of a pair (external, or a pinion and
+    ring: module docstring).
 
     Parameters
     ----------
@@ -112,8 +117,8 @@ def iso_stiffness(
     g1, g2 = pair.driver, pair.driven
     cb, beta = math.cos(g1.base_helix_angle), abs(g1.helix_angle)
     zn1 = g1.teeth / (cb**2 * math.cos(beta))
-    zn2 = g2.teeth / (cb**2 * math.cos(beta))
-    x1, x2 = g1.profile_shift, g2.profile_shift
+    zn2 = math.inf if g2.internal else g2.teeth / (cb**2 * math.cos(beta))
+    x1, x2 = g1.profile_shift, -g2.profile_shift if g2.internal else g2.profile_shift
     c = Q_COEFFICIENTS
     q = (
         c[0]

@@ -21,6 +21,7 @@ NAMES = [
     "diso_bearings",
     "helical_pair_bearings",
     "two_stage",
+    "ring_pinion",
 ]
 
 
