@@ -13,7 +13,14 @@ from pathlib import Path
 
 from ._common import Fail
 
-__all__ = ["FORMATS", "branches_document", "format_option", "result_formats", "write_result"]
+__all__ = [
+    "FORMATS",
+    "branches_document",
+    "format_option",
+    "result_formats",
+    "units_option",
+    "write_result",
+]
 
 FORMATS = ("json", "csv", "mat")
 
@@ -26,6 +33,18 @@ def format_option(parser, stem: str) -> None:
         help=f"result files written under --out: {stem}.json, {stem}.csv and/or {stem}.mat, "
         "comma-separated (default: %(default)s); each carries the gearsym version, model, "
         "model hash, scales, overrides and command (docs/user-guide.md, Result files)",
+    )
+
+
+def units_option(parser, physical: str) -> None:
+    """``--units model|physical``; ``physical`` says what the command then gives in the
+    engineer's units (``solver/units.py``)."""
+    parser.add_argument(
+        "--units",
+        choices=("model", "physical"),
+        default="model",
+        help=f"physical: {physical}; model: the model's non-dimensional units "
+        "(default: %(default)s)",
     )
 
 

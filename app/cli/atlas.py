@@ -18,7 +18,7 @@ from ._common import (
     require,
     system_of,
 )
-from ._output import format_option, write_result
+from ._output import format_option, units_option, write_result
 
 __all__ = ["register"]
 
@@ -115,15 +115,12 @@ def register(sub) -> None:
         help="print one JSON record per (grid point, attractor) on stdout",
     )
     mp.add_argument("--quiet", action="store_true", help="no progress bar")
-    mp.add_argument(
-        "--units",
-        choices=("model", "physical"),
-        default="model",
-        help="physical: the extremes in µm and the exponent per second (figures and "
-        "printed), omega with the speed in rpm (or the speed with the mesh frequency in Hz) "
-        "on the figures' axes, and the result files with added columns (max_<coordinate>_um, "
-        "min_<coordinate>_um, lyapunov_per_s, speed_rpm, mesh_frequency_hz) and an in_units "
-        "block; model: the model's non-dimensional units (default: %(default)s)",
+    units_option(
+        mp,
+        "the extremes in µm and the exponent per second (figures and printed), omega with the"
+        " speed in rpm (or the speed with the mesh frequency in Hz) on the figures' axes, and"
+        " the result files with added columns (max_<coordinate>_um, min_<coordinate>_um, "
+        "lyapunov_per_s, speed_rpm, mesh_frequency_hz) and an in_units block",
     )
     mp.set_defaults(func=_cmd_map)
 

@@ -18,7 +18,7 @@ from ._common import (
     system_of,
 )
 from ._limits import MAX_PERIOD, MAX_SEGMENTS, MAX_SETTLED, MAX_TRIES, MIN_STEP, bounded_shoot
-from ._output import branches_document, format_option, write_result
+from ._output import branches_document, format_option, units_option, write_result
 from ._start import resolve_start, start_options
 
 __all__ = ["register"]
@@ -128,13 +128,10 @@ def register(sub) -> None:
         parser.add_argument(
             "--set", action="append", metavar="KEY=VALUE", help="set a parameter (repeatable)"
         )
-        parser.add_argument(
-            "--units",
-            choices=("model", "physical"),
-            default="model",
-            help="physical: deflections in µm, the period in s, the speed in rpm and the mesh "
-            "frequency in Hz, printed, in the figure and the files (docs/user-guide.md); model: "
-            "the model's non-dimensional units (default: %(default)s)",
+        units_option(
+            parser,
+            "deflections in µm, the period in s, the speed in rpm and the mesh frequency in Hz, "
+            "printed, in the figure and the files (docs/user-guide.md)",
         )
 
 

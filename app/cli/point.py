@@ -17,7 +17,7 @@ from ._common import (
     require,
     system_of,
 )
-from ._output import format_option, write_result
+from ._output import format_option, units_option, write_result
 from ._start import resolve_start, start_options
 
 __all__ = ["register"]
@@ -37,13 +37,10 @@ def register(sub) -> None:
     analysis_options(si)
     start_options(si)
     si.add_argument("--json", action="store_true", help="print everything as JSON")
-    si.add_argument(
-        "--units",
-        choices=("model", "physical"),
-        default="model",
-        help="physical: deflections (dynamic transmission error) in µm, mesh forces in N with "
-        "the dynamic factor, frequencies in Hz and orders of the mesh frequency, the speed "
-        "in rpm; model: the model's non-dimensional units",
+    units_option(
+        si,
+        "deflections (dynamic transmission error) in µm, mesh forces in N with the dynamic "
+        "factor, frequencies in Hz and orders of the mesh frequency, the speed in rpm",
     )
     si.add_argument(
         "--out", metavar="DIR", help="also write point.json, .csv, .mat (--format) and point.png"
@@ -88,15 +85,12 @@ def register(sub) -> None:
     sw.add_argument("--out", metavar="DIR", help="output folder (default sweep_<model>_<param>)")
     format_option(sw, "sweep")
     sw.add_argument("--quiet", action="store_true", help="no progress bar")
-    sw.add_argument(
-        "--units",
-        choices=("model", "physical"),
-        default="model",
-        help="physical: the figure's deflections in µm with omega's speed (rpm) or the "
-        "speed's mesh frequency (Hz) on a top axis, the printed ranges in µm, rpm and Hz, "
-        "and the result files with added columns (<coordinate>_um, speed_rpm, "
-        "mesh_frequency_hz, lyapunov_per_s) and an in_units block; model: the model's "
-        "non-dimensional units (default: %(default)s)",
+    units_option(
+        sw,
+        "the figure's deflections in µm with omega's speed (rpm) or the speed's mesh "
+        "frequency (Hz) on a top axis, the printed ranges in µm, rpm and Hz, and the result "
+        "files with added columns (<coordinate>_um, speed_rpm, mesh_frequency_hz, "
+        "lyapunov_per_s) and an in_units block",
     )
     sw.add_argument(
         "--no-figure",

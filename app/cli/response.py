@@ -17,7 +17,7 @@ from ._common import (
     system_of,
 )
 from ._limits import MAX_PERIOD
-from ._output import format_option, write_result
+from ._output import format_option, units_option, write_result
 
 __all__ = ["register"]
 
@@ -117,12 +117,11 @@ def register(sub) -> None:
         metavar="N",
         help=f"integration: periods sampled at each frequency (at most {MAX_SETTLE:,})",
     )
-    fr.add_argument(
-        "--units",
-        choices=("model", "physical"),
-        default="model",
-        help="physical: the figure in mesh frequency (Hz) and dynamic transmission-error "
-        "amplitude (µm); model: the model's non-dimensional units",
+    units_option(
+        fr,
+        "the figure in mesh frequency (Hz) and dynamic transmission-error amplitude (µm), "
+        "and the result files with added columns (<coordinate>_amplitude_um and the other "
+        "deflections in µm, speed_rpm, mesh_frequency_hz) and an in_units block",
     )
     fr.add_argument("--physical", action="store_true", help="the same as --units physical")
     fr.add_argument("--out", metavar="DIR", help="output folder (default response_<model>)")
