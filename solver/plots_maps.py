@@ -29,6 +29,7 @@ from .plots_style import (
     operating_point,
     period_colour,
     plt,
+    put_caption,
     save_figure,
     sweep_marker,
 )
@@ -167,7 +168,7 @@ def _captioned(fig, caption: str):
     # the caption under everything drawn (axis labels, legends below the axes)
     box = fig.get_tightbbox(fig.canvas.get_renderer())
     bottom = box.y0 / fig.get_figheight()
-    fig.text(0.01, bottom - 0.01, caption, fontsize=7, ha="left", va="top", wrap=True)
+    put_caption(fig, bottom - 0.01, caption)
     return fig
 
 

@@ -21,7 +21,7 @@ from __future__ import annotations
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
-from ..escape import code_names, text
+from ..escape import code_names
 from ..model import Model
 
 __all__ = ["c_source"]
@@ -389,8 +389,9 @@ def c_source(model: Model, variational: bool = False) -> str:
     printer.hoist = None
     what = " with the variational equations" if variational else ""
     head = [
-        f"/* {text(model.name)}: right-hand side{what} for the compiled integrators "
-        "(gearsym derive). */",
+        # no name in the C text: two models with the same equations (the light and heavy
+        # reference scenes, a variant and the scene it varies) share one compiled library
+        f"/* right-hand side{what} for the compiled integrators (gearsym derive). */",
         f"#define GS_NX {n}",
         f"#define GS_NP {m}",
         f"#define GS_NQ {max(hoist.n_q, 1)}",

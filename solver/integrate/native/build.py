@@ -280,7 +280,9 @@ def library(module, variational: bool = False, shared=()) -> tuple[ctypes.CDLL, 
     ).hexdigest()[:20]
     if key in _failed:
         raise NativeUnavailable(_failed[key])
-    path = cache_dir() / f"{module.NAME}{'-var' if variational else ''}-{key}.so"
+    # named by what it is built from, not by the model: models whose C is the same (the
+    # light and heavy reference scenes, a variant and its scene) share the one library
+    path = cache_dir() / f"rhs{'-var' if variational else ''}-{key}.so"
     facts["path"] = str(path)
     if str(path) in _loaded:
         _paths[memo] = path
