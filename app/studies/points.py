@@ -51,6 +51,9 @@ def analyse_all(sweeps: dict, models: dict, settings: dict, out, files: dict, **
         a :class:`~gearsym.solver.sweep.progress.Progress` of the tasks; optional
         ``figures``: ``(function, args)`` pairs (module-level functions that draw and save
         a figure from data the batch does not change), drawn by the workers beside the runs;
+        optional ``first``: ``(function, args)`` pairs called by the workers before every
+        run (work that is long on a clean cache, such as deriving and compiling models,
+        which at the end of the batch kept one worker busy while the other waited);
         optional ``memo``: a :class:`~gearsym.studies.memo.ResultStore` the tasks are loaded
         from where it keeps them, and kept in.
 
@@ -65,6 +68,9 @@ def analyse_all(sweeps: dict, models: dict, settings: dict, out, files: dict, **
     from .response import LAMBDAS, RANGE, resolution
 
     keys, tasks = [], []
+    for k, call in enumerate(batch.get("first", ())):  # long on a clean cache: first
+        keys.append(("figure", "first", k))
+        tasks.append(("call", call))
     step = 0.05 if batch["quick"] else 0.02
     long = dict(settings, budget=LONG_BUDGET)
     for case, module, _ in CASES:  # the longest tasks first

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import hashlib
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -98,6 +99,14 @@ def reproduce(
     compute every unit again (and keep the new results)."""
     res = RESOLUTIONS["quick" if quick else "full"]
     stages = Stages(len(STAGES), "reproduce", enabled=progress)
+    writer = _Writer()
+    try:
+        return _reproduce(out, quick, executor, workers, fresh, res, stages, writer)
+    finally:
+        writer.finish()
+
+
+def _reproduce(out, quick, executor, workers, fresh, res, stages, writer) -> Reproduced:
     out = Path(out)
     (out / "data").mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
@@ -157,7 +166,7 @@ def reproduce(
     files["dead zone"] = {"sweep": {}, "point": {}, "bifurcation": {}}
     for sw in got["cases"] + maps + bearing_sweeps:
         tag = f"{sw.model}_{sw.direction}_f1_{sw.base_values.get('f1', 'scene')}"
-        save_all(sw, out / "data" / f"sweep_{tag}.json")
+        writer.submit(save_all, sw, out / "data" / f"sweep_{tag}.json")
     for case, _, _ in CASES:
         files["polynomial"]["sweep"][case] = tuple(
             f"data/sweep_{sw.model}_{sw.direction}_f1_scene.json" for sw in by_case[case]
@@ -166,11 +175,11 @@ def reproduce(
             f"data/sweep_{sw.model}_{sw.direction}_{case}.json" for sw in dead_case[case]
         )
         for sw, name in zip(dead_case[case], files["dead zone"]["sweep"][case], strict=True):
-            save_all(sw, out / name)
+            writer.submit(save_all, sw, out / name)
     files["polynomial"]["map"] = "map_f1_lambda.png"
     files["dead zone"]["map"] = f"data/sweep_{DEAD_ZONE}_map_f1_*.json"
     for sw, f1 in zip(got["dead maps"], res.map_f1, strict=True):
-        save_all(sw, out / "data" / f"sweep_{DEAD_ZONE}_map_f1_{f1}.json")
+        writer.submit(save_all, sw, out / "data" / f"sweep_{DEAD_ZONE}_map_f1_{f1}.json")
     files["dead zone"]["model_hash"] = dead["light"].model_hash
     from gearsym.solver import plots
 
@@ -198,11 +207,13 @@ def reproduce(
         (backlash_figure, (systems["light"], out / "backlash.png", plain)),
         (stiffness_figure, (systems["light"], out / "stiffness.png", plain)),
     ]
-    # the sensitivity maps' models, derived and compiled while the responses run (its
-    # own stage then finds them in the cache)
-    drawn += prepare_sensitivity(quick)
     sweeps = {"polynomial": by_case, "dead zone": dead_case}
     models = {"polynomial": systems, "dead zone": dead}
+    # the light scene's Model (SymPy, about a second) for the model check and the
+    # physical scales of the report, derived beside the batch rather than after it
+    from .model_check import _model
+
+    derived = writer.submit(_model, systems["light"].module.SCENE)
     done = analyse_all(
         sweeps,
         models,
@@ -214,8 +225,15 @@ def reproduce(
         workers=workers,
         progress=lambda total: stages.stage(STAGES[2], total),
         figures=drawn,
+        # the sensitivity maps' models, derived and compiled while the branches and
+        # responses run (its own stage then finds them in the cache)
+        first=prepare_sensitivity(quick),
         memo=memo,
     )
+    # the writer's files done before the figures: both are Python-heavy, and a thread
+    # switching with the figures' text layout at every interval slowed them by half
+    # (a repeated run, whose batch above is loaded in a second, met the writer here)
+    writer.wait()
     bar = stages.stage(STAGES[3], 6)  # the f1 map, 2 x 2 of the branches, the responses
     from .mechanisms import mechanisms_section
 
@@ -263,7 +281,15 @@ def reproduce(
     from .response import response_section, run_response
 
     responses = {k[1:]: r for k, r in done.items() if k[0] == "response"}
-    response_rows = run_response(out, systems, CASES, points, quick=quick, done=responses)
+    response_rows = run_response(
+        out,
+        systems,
+        CASES,
+        points,
+        quick=quick,
+        done=responses,
+        save=lambda result, path: writer.submit(save_all, result, path),
+    )
     bar.step()
     from .report_sensitivity import sensitivity_section
     from .sensitivity import SCENES, physical_scales, run_sensitivity
@@ -279,6 +305,7 @@ def reproduce(
         memo=memo,
     )
     bar = stages.stage(STAGES[6], 5)
+    derived.result()  # the light scene's Model, derived by the writer's thread
     scales = physical_scales(SCENES["light"][0])
     section = sensitivity_section(rows, scales, {c: f1 for c, (_, f1) in SCENES.items()}, points)
     bar.step()
@@ -319,11 +346,41 @@ def reproduce(
         + tail
     )
     text = text.replace(FIGURES_MARK, figure_list(out))
+    writer.finish()  # every data file written before the report that names them
     path = out / "report.md"
     path.write_text(text, encoding="utf-8")
     stages.end()
     took = time.perf_counter() - started
     return Reproduced(path, tally(found), took, tuple(stages.times), memo.summary())
+
+
+class _Writer:
+    """One thread beside the stages for what only the main process did while both
+    workers waited for it: the result files of the sweeps and responses (their MATLAB
+    files alone took 2 to 3 s) and a derivation the report needs.  Each file is written
+    atomically (``export.write_atomic``); :meth:`finish` waits for every one and raises
+    the first error."""
+
+    def __init__(self):
+        self._pool = ThreadPoolExecutor(1, thread_name_prefix="gearsym-writer")
+        self._pending: list = []
+
+    def submit(self, fn, *args):
+        future = self._pool.submit(fn, *args)
+        self._pending.append(future)
+        return future
+
+    def wait(self) -> None:
+        """Wait for everything submitted so far (its first error raised)."""
+        pending, self._pending = self._pending, []
+        for future in pending:
+            future.result()
+
+    def finish(self) -> None:
+        try:
+            self.wait()
+        finally:
+            self._pool.shutdown(wait=True)
 
 
 def _sweeps(jobs: list, memo, executor, workers, bar) -> list:

@@ -92,11 +92,19 @@ def resolution(quick: bool) -> tuple[int, int]:
 
 
 def run_response(
-    out: Path, systems: dict, cases, points: dict, *, quick: bool, done: dict | None = None
+    out: Path,
+    systems: dict,
+    cases,
+    points: dict,
+    *,
+    quick: bool,
+    done: dict | None = None,
+    save=None,
 ) -> list:
     """The frequency responses (figures and data under ``out``), one per (case, lambda);
     ``done``: ``(case, lambda) -> FrequencyResponse`` already computed (the rest are
-    computed here)."""
+    computed here); ``save(response, path)`` writes a response's files (default
+    ``export.save_all`` here and now)."""
     from gearsym.solver.export import save_all
     from gearsym.solver.sweep.frequency import frequency_response
 
@@ -115,7 +123,7 @@ def run_response(
             if resp is None:
                 resp = frequency_response(s, "omega", *RANGE, points=num, harmonics=harmonics)
             # JSON, CSV and MATLAB, as every command writes (solver/export.py)
-            save_all(resp, out / "data" / f"response_{case}_lambda_{lam}.json")
+            (save or save_all)(resp, out / "data" / f"response_{case}_lambda_{lam}.json")
             sols = _at(resp.curves[0], OMEGA, coords)
             att = _attractor(points.get((case, lam)), sols, coords)
             rows.append(ResponseCase(case, f1, lam, resp, sols, att))

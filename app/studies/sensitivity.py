@@ -59,7 +59,11 @@ FINDINGS = {
         ("u period-3 at high λ", "u", "period-3", (0.13, 1.0)),
     ),
 }
-SCENES = {"light": ("reference-light", 0.1), "heavy": ("reference-heavy", 0.5)}
+# Both loads on the light scene's model, f1 set: the reference-heavy scene differs from
+# reference-light only in its stated f1 (a parameter), so one derivation of each variant
+# and one compiled library serve both loads (the heavy scene's own variants were the
+# same equations derived and compiled a second time)
+SCENES = {"light": ("reference-light", 0.1), "heavy": ("reference-light", 0.5)}
 # the stages of run_sensitivity, as its progress lines name them
 STAGES = (
     "sensitivity: models derived and compiled (models)",
@@ -98,24 +102,49 @@ def _load_value(scene: str, f1: float, reading: str, key: str, value):
     from gearsym.resolve import load
 
     if key is None:
-        return load(scene, load_reading=reading)
+        return load(scene, load_reading=reading, f1=f1)
     if key == "backlash":
         return load(BACKLASH_SCENES[value] or scene, load_reading=reading, f1=f1)
-    return load(scene, load_reading=reading, **{key: value})
+    return load(scene, load_reading=reading, f1=f1, **{key: value})
 
 
 def _prepare(args: tuple) -> None:
-    """Worker: derive one model of the sensitivity maps and compile its library (with the
-    variational system the exponent needs) into the caches, so that the maps find both
-    there.  A missing compiler is left to the map, which decides and warns once."""
+    """Worker: derive one model of the sensitivity maps and compile the libraries its
+    runs take (with the variational system the exponent needs) into the caches, so that
+    the maps find them there: one per kind of map column the model has rows in (its
+    y values at one lambda: :func:`_column_shares`) and the one-point library of the
+    re-examined runs.  A missing compiler is left to the map, which decides and warns
+    once.  ``args``: ``(scene, f1, reading, key, value, quick)``."""
     from gearsym.solver.integrate.native.build import NativeUnavailable, library, single_point
 
-    module = _load_value(*args).module
-    try:  # the map's check, and the one-point runs of its re-examinations
-        library(module, variational=True)
+    *which, quick = args
+    system = _load_value(*which)
+    module = system.module
+    try:
+        for shared in _column_shares(system, which, quick):
+            library(module, variational=True, shared=shared)
         library(module, variational=True, shared=single_point(module))
     except NativeUnavailable:
         pass
+
+
+def _column_shares(system, which: tuple, quick: bool) -> list:
+    """The parameters shared by the rows of each kind of map column the model of
+    ``which`` = ``(scene, f1, reading, key, value)`` has more than one row in: the
+    scene's own model holds a whole column of every map whose value is a parameter of
+    it; a model derived for one value holds one row (the one-point library)."""
+    from gearsym.solver.integrate.native.engine import shared_parameters
+
+    scene, f1, reading, key, _ = which
+    if key is not None:
+        return []
+    out = []
+    for k, (values, _, _) in (QUICK_SPREAD if quick else OPEN_SPREAD).items():
+        if is_text(values) or _derives(system.module, k, values[0]):
+            continue
+        P = [_load_value(scene, f1, reading, k, v).with_values(**{"lambda": 0.5}).p for v in values]
+        out.append(shared_parameters(np.array(P)))
+    return list(dict.fromkeys(out))
 
 
 def preparations(quick: bool) -> list:
@@ -124,23 +153,24 @@ def preparations(quick: bool) -> list:
     to its batch of operating points, where they keep a worker busy while the frequency
     responses run (derived here, one after another in the main process, they left both
     workers idle for about 40 s of a first run)."""
-    spread = QUICK_SPREAD if quick else OPEN_SPREAD
+    scenes = dict((scene, f1) for scene, f1 in reversed(SCENES.values()))  # one per scene
     return [
-        (_prepare_reading, (scene, f1, reading, spread))
-        for scene, f1 in SCENES.values()
+        (_prepare_reading, (scene, f1, reading, quick))
+        for scene, f1 in scenes.items()
         for reading in READINGS
     ]
 
 
-def _prepare_reading(scene: str, f1: float, reading: str, spread: dict) -> None:
+def _prepare_reading(scene: str, f1: float, reading: str, quick: bool) -> None:
     """Worker: the scene's model in ``reading`` and every model its maps derive, each
     derived and compiled into the caches (:func:`_prepare`)."""
-    _prepare((scene, f1, reading, None, None))
+    spread = QUICK_SPREAD if quick else OPEN_SPREAD
+    _prepare((scene, f1, reading, None, None, quick))
     base = _load_value(scene, f1, reading, None, None).module
     for key, (values, _, _) in spread.items():
         for value in values:
             if _derives(base, key, value):
-                _prepare((scene, f1, reading, key, value))
+                _prepare((scene, f1, reading, key, value, quick))
 
 
 def _resolver(scene: str, f1: float, reading: str, key: str, values: tuple):
@@ -223,21 +253,21 @@ def run_sensitivity(
         base = {
             (s, r): load(s, load_reading=r).module for s, _ in SCENES.values() for r in READINGS
         }
-        every = dict.fromkeys(
-            (scene, f1, reading, key, value)
-            if _derives(base[scene, reading], key, value)
-            else (scene, f1, reading, None, None)  # the scene's own model
-            for case, (scene, f1) in SCENES.items()
-            for reading in READINGS
-            for key, (values, _, _) in spread.items()
-            for value in values
-        )
+        for scene, f1 in SCENES.values():
+            for reading in READINGS:
+                for key, (values, _, _) in spread.items():
+                    for value in values:
+                        own = not _derives(base[scene, reading], key, value)
+                        k, v = (None, None) if own else (key, value)  # own: the scene's model
+                        # one per model: the two loads differ only in f1, a parameter
+                        every.setdefault((scene, reading, k, v), (scene, f1, reading, k, v, quick))
     bar = stages.stage(STAGES[0], len(every))
-    map_tasks(_prepare, list(every), executor=executor, workers=workers, on_result=bar)
+    map_tasks(_prepare, list(every.values()), executor=executor, workers=workers, on_result=bar)
     # Then each map, its long runs and its figures as one task of a worker (serial inside):
     # the workers share the maps, not the columns of one map, so no core waits for the
-    # end of a map's chains, and no process pool is started per map.  The largest first.
-    order = sorted(range(len(tasks)), key=lambda k: -len(tasks[k][-1][0]))
+    # end of a map's chains, and no process pool is started per map.  The costliest
+    # first (:func:`_cost`), so that no long map is left to run alone at the end.
+    order = sorted(range(len(tasks)), key=lambda k: -_cost(tasks[k][-1][0]))
     bar = stages.stage(STAGES[1], len(tasks))
     run = map_tasks if memo is None else memo.map
     done = run(
@@ -249,10 +279,21 @@ def run_sensitivity(
     return rows
 
 
+# A row of the exact dead zone costs about four rows of the polynomial in these maps: a
+# piecewise force law runs each point alone, not in lock-step groups (integrate.run).
+# Measured on a first reproduce: the light scene's backlash map (one row each) 5.8 s, its
+# transmission-error map (nine polynomial rows) 10.9 s.
+DEAD_ZONE_ROW_COST = 4
+
+
+def _cost(values) -> float:
+    """A map's expected cost in polynomial rows (the order the maps are handed out)."""
+    return sum(DEAD_ZONE_ROW_COST if v == "dead-zone" else 1 for v in values)
+
+
 def _map_task(args: tuple) -> Sensitivity:
     """Worker: one regime map over lambda by one open value (serial), its claim-carrying
     runs continued, its data and figures written; its :class:`Sensitivity` row."""
-    from gearsym.resolve import load
     from gearsym.solver.export import save_all
     from gearsym.solver.sweep.atlas import regime_map
 
@@ -262,7 +303,7 @@ def _map_task(args: tuple) -> Sensitivity:
     name = f"{case}_{reading}_{key}"
     resolve = _resolver(scene, f1, reading, key, values)
     m = regime_map(
-        load(scene, load_reading=reading),
+        _load_value(scene, f1, reading, None, None),
         ("lambda", lam),
         (key, axis),
         initial_states=3,

@@ -87,11 +87,16 @@ class _Task:
     backend: str
 
 
-def decide_backend(module: ModuleType, spec: RunSpec, backend: str = "auto") -> str:
+def decide_backend(
+    module: ModuleType, spec: RunSpec, backend: str = "auto", shared: tuple = ()
+) -> str:
     """``"native"`` when the compiled library of ``module`` builds or is cached (with the
     variational system when the spec collects the exponent), else ``"numpy"`` after the
     one warning line (``backend="auto"``); ``"native"`` raises
-    :class:`~.native.build.NativeUnavailable` instead, ``"numpy"`` is taken as given."""
+    :class:`~.native.build.NativeUnavailable` instead, ``"numpy"`` is taken as given.
+    ``shared``: the parameters equal across the batch the run takes (``library``'s), so
+    that the library checked is the one the run uses (the library for any batch, built
+    only to be checked, cost about a second of compiling per model and was never run)."""
     from .native.build import NativeUnavailable, library
     from .native.fallback import fallback_warning
 
@@ -100,7 +105,7 @@ def decide_backend(module: ModuleType, spec: RunSpec, backend: str = "auto") -> 
     if backend == "numpy":
         return backend
     try:
-        library(module, variational="exponent" in spec.collect)
+        library(module, variational="exponent" in spec.collect, shared=shared)
     except NativeUnavailable as err:
         if backend == "native":
             raise
@@ -152,13 +157,17 @@ def integrate(
     P = np.ascontiguousarray(np.asarray(P, dtype=float))
     X0 = _check_inputs(Contract.of(module), P, x0, spec)
     started = time.perf_counter()
-    backend = decide_backend(module, spec, backend)
     N = P.shape[0]
+    chunks = [c for c in np.array_split(np.arange(N), min(workers, N)) if c.size]
+    if backend != "numpy":
+        from .native.engine import shared_parameters
+
+        # the library the (first) share of the batch runs with
+        backend = decide_backend(module, spec, backend, shared_parameters(P[chunks[0]]))
     if workers > 1 and N > 1:
         from ..executor import map_tasks
 
         batch = batch or Batch.of(module, P)
-        chunks = [c for c in np.array_split(np.arange(N), workers) if c.size]
         tasks = [_Task(batch[c], X0[c], spec, backend) for c in chunks]
         parts = map_tasks(_run_task, tasks, executor="processes", workers=len(chunks))
         return _join(parts, time.perf_counter() - started)

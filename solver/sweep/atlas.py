@@ -36,6 +36,7 @@ from ..analysis.record import RunRecord
 from ..analysis.settle import BUDGET
 from ..contract import Contract, load_generated
 from ..executor import map_tasks
+from ..integrate.native.engine import shared_parameters
 from ..integrate.run import Batch, decide_backend, integrate
 from ..integrate.simulate import default_initial_state
 from ..integrate.spec import RunSpec
@@ -255,8 +256,17 @@ def regime_map(
         return _Column(ix, kind, files, P, None, (kind,) * ny, named, first_key[kind] + ix * ny)
 
     # the compiled library of every model, built once here (or the fallback, warned once)
+    # (checked with the library of the model's rows of its first column: a column's
+    # rows share every parameter but the y axis's, and so do every column's)
     models = {g.module.__file__: g.module for col in grid for g in col}
-    backends = {f: decide_backend(m, spec) for f, m in models.items()}
+    rows = {}
+    for col in grid:
+        for g in col:
+            rows.setdefault(g.module.__file__, {}).setdefault(id(col), []).append(g.p)
+    backends = {
+        f: decide_backend(m, spec, shared=shared_parameters(np.array(next(iter(rows[f].values())))))
+        for f, m in models.items()
+    }
     where = {"native": "compiled", "numpy": "NumPy fallback"}
     engine = ", ".join(sorted({f"{where[b]} {method.upper()}" for b in backends.values()}))
     run_opts = {**opts, "spec": spec, "backends": backends}

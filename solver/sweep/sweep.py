@@ -92,13 +92,12 @@ def _decide_native(chains: list[Chain], executor: str, workers: int | None) -> N
         if get_method(method).family != "native" or (chain.module, tangent) in seen:
             continue
         seen[(chain.module, tangent)] = System.load(chain.module, **chain.base_values).module
-    # the libraries of the check below and those of the chains' one-point runs
+    # the libraries of the chains' one-point runs (the check below is made on them)
     prebuild(
         [
-            (module.__file__, v, shared)
+            (module.__file__, v, single_point(module))
             for (_, tangent), module in seen.items()
             for v in (False, True)[: 1 + tangent]
-            for shared in ((), single_point(module))
         ],
         executor=executor,
         workers=workers,

@@ -30,9 +30,11 @@ __all__ = ["map_backend"]
 def map_backend(module, lyapunov: bool) -> str:
     """The backend of a map run: "native" when the library of ``module`` (with the
     tangent vector's variational system when ``lyapunov``) compiles or is cached, else
-    "numpy" after the one warning line (``run.decide_backend``)."""
+    "numpy" after the one warning line (``run.decide_backend``).  The library checked
+    is the one-point library the runs of a sweep use (``build.single_point``)."""
     from ..run import decide_backend
+    from .build import single_point
 
     collect = ("samples", "exponent") if lyapunov else ("samples",)
     spec = RunSpec(collect=collect, lyapunov_periods=int(lyapunov))
-    return decide_backend(module, spec)
+    return decide_backend(module, spec, shared=single_point(module))
