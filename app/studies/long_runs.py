@@ -17,7 +17,14 @@ from gearsym.solver.analysis.point import classification_tolerance
 from gearsym.solver.sweep import map_tasks
 from gearsym.solver.sweep.borders import BORDER_BUDGET, Look, needs_look, run_look
 
-__all__ = ["LONG_BUDGET", "lengthen", "lengthen_sweeps", "periods_run"]
+__all__ = [
+    "LONG_BUDGET",
+    "lengthen",
+    "lengthen_carriers",
+    "lengthen_claims",
+    "lengthen_sweeps",
+    "periods_run",
+]
 
 LONG_BUDGET = BORDER_BUDGET  # periods a claim-carrying run's verdict may take
 
@@ -126,3 +133,80 @@ def lengthen_sweeps(
         replace(sw, points=points[j], texts=None) if j in changed else sw
         for j, (sw, _) in enumerate(items)
     ]
+
+
+def lengthen_claims(
+    got: dict, groups: dict, settings, *, executor, workers, progress, memo
+) -> dict:
+    """The sweeps with every run a claim may rest on continued with the long budget:
+    the forward case sweeps' non-periodic runs in the study's low-lambda ranges (u
+    quasi-periodic up to 0.57 light, 0.13 heavy; v chaotic up to 0.3) and the maps'
+    non-periodic runs (the trend of Min(v) over chaotic points).  One batch for all, so
+    that the workers share it."""
+    low = {0.1: 0.57, 0.5: 0.3}  # f1 -> the largest lambda of a low-lambda claim
+    names = ("cases", "dead cases", "maps", "dead maps")
+    on_maps = {id(sw) for n in names[2:] for sw in got[n]}
+
+    def select(sw, value, r):
+        if id(sw) in on_maps:
+            return True
+        f1 = float(sw.base_values.get("f1", 0.1 if "light" in sw.model else 0.5))
+        return sw.direction == "forward" and value <= low.get(f1, 0.57) + 1e-9
+
+    items = [(sw, job.system) for n in names for sw, job in zip(got[n], groups[n], strict=True)]
+    longer = iter(
+        lengthen_sweeps(
+            items,
+            select,
+            settings,
+            executor=executor,
+            workers=workers,
+            progress=progress,
+            memo=memo,
+        )
+    )
+    out = dict(got)
+    for n in names:
+        out[n] = [next(longer) for _ in got[n]]
+    return out
+
+
+def lengthen_carriers(m, findings, resolve, settings, executor, workers, matches):
+    """The map ``m`` with every attractor that carries a finding (inside the finding's lambda
+    range, with its motion) continued with the long budget (``long_runs``), and per
+    finding the runs that still carry it: (count, the periods they were run).
+    ``matches(motion, test)``: whether a run's motion carries a finding's test."""
+
+    def carries(run, coord, test, lo, hi):
+        return lo <= run.values["lambda"] <= hi and run.ok and matches(run.motion(coord), test)
+
+    where = [
+        (ix, iy, k)
+        for ix, column in enumerate(m.cells)
+        for iy, cell in enumerate(column)
+        for k, a in enumerate(cell.attractors)
+        if any(carries(a.run, c, t, lo, hi) for _, c, t, (lo, hi) in findings)
+    ]
+    runs = [m.cells[ix][iy].attractors[k].run for ix, iy, k in where]
+    pairs = [(resolve(dict(r.values)), r) for r in runs]
+    longer = lengthen(pairs, settings, executor=executor, workers=workers)
+    longer = dict(zip(where, longer, strict=True))
+    cells = tuple(
+        tuple(
+            replace(
+                cell,
+                attractors=tuple(
+                    replace(a, run=longer.get((ix, iy, k), a.run))
+                    for k, a in enumerate(cell.attractors)
+                ),
+            )
+            for iy, cell in enumerate(column)
+        )
+        for ix, column in enumerate(m.cells)
+    )
+    m = replace(m, cells=cells)
+    carriers = {}
+    for finding, coord, test, (lo, hi) in findings:
+        held = [r for r in longer.values() if carries(r, coord, test, lo, hi)]
+        carriers[finding] = (len(held), periods_run(held))
+    return m, carriers

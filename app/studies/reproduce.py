@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import hashlib
 import time
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -29,12 +28,13 @@ from .bearings import bearing_jobs, bearings_section
 from .cases import CASES, DEAD_ZONE, RESOLUTIONS, TOLERANCES
 from .claims import Bundle
 from .figures import figure_list
-from .long_runs import lengthen_sweeps
+from .long_runs import lengthen_claims
 from .memo import ResultStore
 from .points import analyse_all, pick
 from .report import FIGURES_MARK, STORED_MARK, graded, report, tally
 from .sensitivity import STAGES as SENSITIVITY_STAGES
 from .sensitivity import preparations as prepare_sensitivity
+from .writer import Writer
 
 __all__ = ["STAGES", "Reproduced", "reproduce", "verdict_words"]
 
@@ -99,7 +99,7 @@ def reproduce(
     compute every unit again (and keep the new results)."""
     res = RESOLUTIONS["quick" if quick else "full"]
     stages = Stages(len(STAGES), "reproduce", enabled=progress)
-    writer = _Writer()
+    writer = Writer()
     try:
         return _reproduce(out, quick, executor, workers, fresh, res, stages, writer)
     finally:
@@ -158,7 +158,15 @@ def _reproduce(out, quick, executor, workers, fresh, res, stages, writer) -> Rep
     )
     done = iter(_sweeps(jobs, memo, executor, workers, bar))
     got = {name: [next(done) for _ in group] for name, group in groups.items()}
-    got = _lengthen_claims(got, groups, settings, executor, workers, stages, memo)
+    got = lengthen_claims(
+        got,
+        groups,
+        settings,
+        executor=executor,
+        workers=workers,
+        progress=lambda total: stages.stage(STAGES[1], total),
+        memo=memo,
+    )
     by_case = {case: got["cases"][2 * k : 2 * k + 2] for k, (case, _, _) in enumerate(CASES)}
     dead_case = {case: got["dead cases"][2 * k : 2 * k + 2] for k, (case, _, _) in enumerate(CASES)}
     bearing_sweeps, maps = got["bearings"], got["maps"]
@@ -354,35 +362,6 @@ def _reproduce(out, quick, executor, workers, fresh, res, stages, writer) -> Rep
     return Reproduced(path, tally(found), took, tuple(stages.times), memo.summary())
 
 
-class _Writer:
-    """One thread beside the stages for what only the main process did while both
-    workers waited for it: the result files of the sweeps and responses (their MATLAB
-    files alone took 2 to 3 s) and a derivation the report needs.  Each file is written
-    atomically (``export.write_atomic``); :meth:`finish` waits for every one and raises
-    the first error."""
-
-    def __init__(self):
-        self._pool = ThreadPoolExecutor(1, thread_name_prefix="gearsym-writer")
-        self._pending: list = []
-
-    def submit(self, fn, *args):
-        future = self._pool.submit(fn, *args)
-        self._pending.append(future)
-        return future
-
-    def wait(self) -> None:
-        """Wait for everything submitted so far (its first error raised)."""
-        pending, self._pending = self._pending, []
-        for future in pending:
-            future.result()
-
-    def finish(self) -> None:
-        try:
-            self.wait()
-        finally:
-            self._pool.shutdown(wait=True)
-
-
 def _sweeps(jobs: list, memo, executor, workers, bar) -> list:
     """The sweep jobs' results: those the result store keeps loaded (their points counted
     on ``bar`` at once), the rest run by one :func:`sweep_many` and kept."""
@@ -394,40 +373,6 @@ def _sweeps(jobs: list, memo, executor, workers, bar) -> list:
         memo.keep(keys[k], (result, None))
         memo.computed += 1
         out[k] = result
-    return out
-
-
-def _lengthen_claims(got: dict, groups: dict, settings, executor, workers, stages, memo) -> dict:
-    """The sweeps with every run a claim may rest on continued with the long budget:
-    the forward case sweeps' non-periodic runs in the study's low-lambda ranges (u
-    quasi-periodic up to 0.57 light, 0.13 heavy; v chaotic up to 0.3) and the maps'
-    non-periodic runs (the trend of Min(v) over chaotic points).  One batch for all, so
-    that the workers share it."""
-    low = {0.1: 0.57, 0.5: 0.3}  # f1 -> the largest lambda of a low-lambda claim
-    names = ("cases", "dead cases", "maps", "dead maps")
-    on_maps = {id(sw) for n in names[2:] for sw in got[n]}
-
-    def select(sw, value, r):
-        if id(sw) in on_maps:
-            return True
-        f1 = float(sw.base_values.get("f1", 0.1 if "light" in sw.model else 0.5))
-        return sw.direction == "forward" and value <= low.get(f1, 0.57) + 1e-9
-
-    items = [(sw, job.system) for n in names for sw, job in zip(got[n], groups[n], strict=True)]
-    longer = iter(
-        lengthen_sweeps(
-            items,
-            select,
-            settings,
-            executor=executor,
-            workers=workers,
-            progress=lambda total: stages.stage(STAGES[1], total),
-            memo=memo,
-        )
-    )
-    out = dict(got)
-    for n in names:
-        out[n] = [next(longer) for _ in got[n]]
     return out
 
 

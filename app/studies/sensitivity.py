@@ -10,10 +10,12 @@ before any run.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from .long_runs import lengthen_carriers
 
 __all__ = [
     "OPEN_SPREAD",
@@ -318,7 +320,7 @@ def _map_task(args: tuple) -> Sensitivity:
         store=out / "store" / f"sensitivity_{name}",
         resolve=resolve,
     )
-    m, carriers = _lengthen_carriers(m, FINDINGS[case], key, resolve, settings, "serial", None)
+    m, carriers = lengthen_carriers(m, FINDINGS[case], resolve, settings, "serial", None, _matches)
     save_all(m, out / "data" / f"sensitivity_{name}.json")  # and .csv, .mat
     figures = _draw(
         (
@@ -365,47 +367,6 @@ def _draw(args: tuple) -> list:
     from gearsym.solver.plots_maps import write_map_figures
 
     return write_map_figures(*args)
-
-
-def _lengthen_carriers(m, findings, key, resolve, settings, executor, workers):
-    """The map with every attractor that carries a finding (inside the finding's lambda
-    range, with its motion) continued with the long budget (``long_runs``), and per
-    finding the runs that still carry it: (count, the periods they were run)."""
-    from .long_runs import lengthen, periods_run
-
-    def carries(run, coord, test, lo, hi):
-        return lo <= run.values["lambda"] <= hi and run.ok and _matches(run.motion(coord), test)
-
-    where = [
-        (ix, iy, k)
-        for ix, column in enumerate(m.cells)
-        for iy, cell in enumerate(column)
-        for k, a in enumerate(cell.attractors)
-        if any(carries(a.run, c, t, lo, hi) for _, c, t, (lo, hi) in findings)
-    ]
-    runs = [m.cells[ix][iy].attractors[k].run for ix, iy, k in where]
-    pairs = [(resolve(dict(r.values)), r) for r in runs]
-    longer = lengthen(pairs, settings, executor=executor, workers=workers)
-    longer = dict(zip(where, longer, strict=True))
-    cells = tuple(
-        tuple(
-            replace(
-                cell,
-                attractors=tuple(
-                    replace(a, run=longer.get((ix, iy, k), a.run))
-                    for k, a in enumerate(cell.attractors)
-                ),
-            )
-            for iy, cell in enumerate(column)
-        )
-        for ix, column in enumerate(m.cells)
-    )
-    m = replace(m, cells=cells)
-    carriers = {}
-    for finding, coord, test, (lo, hi) in findings:
-        held = [r for r in longer.values() if carries(r, coord, test, lo, hi)]
-        carriers[finding] = (len(held), periods_run(held))
-    return m, carriers
 
 
 def physical_scales(scene: str) -> dict:
