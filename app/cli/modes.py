@@ -46,9 +46,14 @@ def _speeds(text: str | None, scene_rpm: float) -> tuple[float, float]:
 
 
 def _cmd_modes(args) -> int:
+    from gearsym.derive.input.planetary import is_planetary
+    from gearsym.derive.input.scene import resolve_target
     from gearsym.resolve import module_for
     from gearsym.solver.analysis.modes import modes
 
+    path = resolve_target(args.target)
+    if is_planetary(path):
+        return _planetary(path, args)
     if args.plot:
         figure_file(args.plot, "--plot")
     module = module_for(args.target)
@@ -98,4 +103,76 @@ def _cmd_modes(args) -> int:
         )
     if args.plot:
         print(f"  resonance diagram: {args.plot}")
+    return 0
+
+
+def _planetary(path, args) -> int:
+    """``gearsym modes`` of a planetary set: the modes typed and counted as Lin and Parker
+    (1999) prove them (``planetary_modes``); no speed is known, so no resonance diagram."""
+    from gearsym.derive.equations.planetary import derive_planetary
+    from gearsym.derive.input.planetary import load_planetary
+    from gearsym.solver.analysis.modes import planetary_modes
+
+    for flag, value in (("--plot", args.plot), ("--speeds", args.speeds)):
+        if value:
+            raise Fail(
+                f"{flag}: a planetary set's file gives no speed or tooth counts, so there is "
+                "no mesh frequency to draw or meet; run without it"
+            )
+    ps = load_planetary(path)
+    st = derive_planetary(ps)
+    result = planetary_modes(st.as_structure(), ps.name)
+    data = {
+        "model": ps.name,
+        "source": str(path),
+        "degrees_of_freedom": ps.dofs,
+        "planets": ps.planets,
+        "planet_angles_deg": list(ps.angles_deg),
+        "equally_spaced": ps.equally_spaced,
+        "rigid_body_modes": st.rigid_body_modes,
+        "modes": [
+            {
+                "index": m.index,
+                "frequency_hz": m.frequency_hz,
+                "label": m.label,
+                "multiplicity": m.multiplicity,
+                "kinetic_shares": m.kinetic_shares,
+                "strain_shares": m.strain_shares,
+                "shape": m.shape,
+            }
+            for m in result.modes
+        ],
+    }
+    if args.out:
+        from gearsym.solver.export import Document
+
+        columns = ["index", "frequency_hz", "label", "multiplicity"]
+        rows = [[m.index, m.frequency_hz, m.label, m.multiplicity] for m in result.modes]
+        write_result(out_folder(args.out), "modes", Document(data, columns, rows), args)
+    if args.json:
+        from gearsym.solver._json import dumps
+
+        print(dumps(data, indent=1))
+        return 0
+    spacing = "equally spaced" if ps.equally_spaced else "unequally spaced"
+    print(
+        f"{ps.name}: {len(result.modes)} modes of the {ps.dofs} planetary model, "
+        f"{ps.planets} {spacing} planets, carrier speed 0 (no gyroscopic terms); "
+        f"{st.rigid_body_modes} rigid-body"
+    )
+    print(f"  {'#':>2}  {'Hz':>10}  {'type':<13}  {'x':>2}  kinetic energy")
+    seen = set()
+    for m in result.modes:
+        key = (m.label, round(m.frequency_hz, 6))
+        if key in seen:
+            continue  # a repeated frequency once, with its multiplicity
+        seen.add(key)
+        shares = ", ".join(f"{k} {v:.2f}" for k, v in m.kinetic_shares.items() if v >= 0.005)
+        print(
+            f"  {m.index:2d}  {m.frequency_hz:10.1f}  {m.label:<13}  {m.multiplicity:2d}  {shares}"
+        )
+    counts = {}
+    for m in result.modes:
+        counts[m.label] = counts.get(m.label, 0) + 1
+    print("  " + ", ".join(f"{n} {label}" for label, n in counts.items()))
     return 0

@@ -23,7 +23,7 @@ from pathlib import Path
 
 from .gears import STEEL, Gear, Material, parse_gear, parse_material
 from .meshes import Mesh, TransmissionError, parse_mesh
-from .reader import Table, nearest
+from .reader import InputError, Table, nearest
 from .readings import parse_readings
 from .supports import Bearing, Shaft, load_topology_data, parse_bearings, parse_shafts
 
@@ -140,6 +140,14 @@ class Topology:
 
 def parse_topology(data: dict, source: str) -> Topology:
     """Build and validate a :class:`Topology` from parsed TOML ``data``."""
+    if "planetary" in data:
+        raise InputError(
+            source,
+            "planetary",
+            "a planetary set (closed gear loops) has its linear model and modes so far: run "
+            "`gearsym modes` on it; simulate, sweep, map, shoot, continue and "
+            "frequency-response take trees of meshes only (issue 26)",
+        )
     top = Table(data, source)
     head = top.table("topology")
     name = head.target_name("name")

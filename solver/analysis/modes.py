@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-__all__ = ["DOMINANT", "Mode", "Modes", "modes"]
+__all__ = ["DOMINANT", "Mode", "Modes", "modes", "planetary_modes"]
 
 DOMINANT = 0.8  # kinetic-energy share of one group that names a mode
 _GROUPS = {
@@ -45,6 +45,7 @@ class Mode:
     kinetic_shares: dict  # rotation / lateral / axial -> share of the kinetic energy
     strain_shares: dict  # spring (coordinate) -> share of the strain energy
     shape: dict  # physical coordinate -> amplitude (largest |amplitude| = 1)
+    multiplicity: int = 1  # how many modes share this frequency (planetary sets)
 
 
 @dataclass(frozen=True)
@@ -107,6 +108,7 @@ class Modes:
                     "frequency_hz": m.frequency_hz,
                     "over_mesh_frequency": self.over_mesh(m),
                     "label": m.label,
+                    "multiplicity": m.multiplicity,
                     "kinetic_shares": m.kinetic_shares,
                     "strain_shares": m.strain_shares,
                     "shape": m.shape,
@@ -190,3 +192,70 @@ def modes(model, omega: float | None = None) -> Modes:
         int(s["reference_teeth"]),
         str(s.get("reference_driver", "")),
     )
+
+
+# A planetary set's modes (Lin and Parker 1999): a share of the kinetic energy below this
+# (relative) counts as none when a mode is typed; frequencies closer than this (relative to
+# the largest) are one repeated frequency.
+PLANETARY_TOLERANCE = 1e-7
+
+
+def planetary_modes(structure: dict, name: str) -> Modes:
+    """The modes of a planetary set's linear model (``derive.equations.planetary``'s
+    ``as_structure()``), each typed as Lin and Parker (1999) prove the modes of an equally
+    spaced set are: **rotational** (the central members only turn), **translational** (they
+    only translate), **planet** (they do not move: only the planets do), ``rigid-body``, or
+    ``coupled`` where none holds (unequally spaced planets); and each with the number of
+    modes at its frequency (translational modes come in pairs, planet modes N - 3 at a time,
+    N - 1 in the torsional model).  No mesh frequency is known (the set's file gives no
+    speed): ``mesh_frequency_hz`` is NaN."""
+    mass = np.asarray(structure["mass"], dtype=float)
+    R = np.asarray(structure["incidence"], dtype=float)
+    k = np.asarray(structure["stiffness"], dtype=float)
+    K = R.T @ (k[:, None] * R)
+    w2, vec = scipy.linalg.eigh(K, np.diag(mass))
+    rigid = np.abs(w2) <= 1e-10 * np.max(np.abs(w2))
+    f = np.where(rigid, 0.0, np.sqrt(np.abs(w2)) / (2 * math.pi))
+    central = np.array([m in ("carrier", "ring", "sun") for m in structure["members"]])
+    turning = np.array([m == "rotation" for m in structure["motions"]])
+    tol = PLANETARY_TOLERANCE
+    counts = [int(np.sum(np.abs(f - fi) <= tol * f.max())) for fi in f]
+    out = []
+    for i in range(len(w2)):
+        v = vec[:, i]
+        kinetic = mass * v**2
+        total = kinetic.sum()
+        shares = {
+            "central rotation": float(kinetic[central & turning].sum() / total),
+            "central translation": float(kinetic[central & ~turning].sum() / total),
+            "planets": float(kinetic[~central].sum() / total),
+        }
+        if rigid[i]:
+            label = "rigid-body"
+        elif shares["central rotation"] + shares["central translation"] <= tol:
+            label = "planet"
+        elif shares["central translation"] <= tol:
+            label = "rotational"
+        elif shares["central rotation"] <= tol:
+            label = "translational"
+        else:
+            label = "coupled"
+        strain = k * (R @ v) ** 2
+        strain_total = strain.sum()
+        strain_shares = {
+            c: 0.0 if rigid[i] else float(e / strain_total)
+            for c, e in zip(structure["coordinates"], strain, strict=True)
+        }
+        scale = v[np.argmax(np.abs(v))]
+        out.append(
+            Mode(
+                index=i,
+                frequency_hz=float(f[i]),
+                label=label,
+                kinetic_shares=shares,
+                strain_shares=strain_shares,
+                shape={n: float(a / scale) for n, a in zip(structure["physical"], v, strict=True)},
+                multiplicity=counts[i],
+            )
+        )
+    return Modes(name, tuple(out), float("nan"), 0, "")

@@ -1,0 +1,204 @@
+"""The linear, time-averaged model of a planetary set (issue 26, first the modes).
+
+Coordinates after Lin and Parker (1999): each central member ``j`` (carrier ``c``, ring
+``r``, sun ``s``) translates by ``x_j, y_j`` and turns by ``u_j = r_j theta_j`` (``r_j`` its
+base radius; the carrier's the radius of the planets' centres); planet ``n`` at the angle
+``psi_n`` round the carrier moves radially by ``zeta_n`` and tangentially by ``eta_n`` in the
+carrier's frame and turns by ``u_n``.  All rotations are counted in one sense (the
+torsional derivation's "one frame": an external mesh's deflection adds its gears' ``u``, an
+internal one subtracts the ring's partner).  The carrier's speed is taken as zero in the
+modes: the gyroscopic and centripetal terms of the rotating frame are left out, as in Lin
+and Parker's free-vibration analysis.
+
+**Springs** (each a row of ``R``, ``delta = R q``, and a stiffness ``k``):
+
+* sun-planet mesh ``n``: its line of action leaves the sun at ``psi_n - alpha_s`` from the
+  planet's radius (the direction ``d = (-sin(psi_n - alpha_s), cos(psi_n - alpha_s))``):
+  ``delta_sn = d . (x_s, y_s) + u_s - d . (zeta_n e_r + eta_n e_t) + u_n``;
+* ring-planet mesh ``n``, at ``psi_n + alpha_r``:
+  ``delta_rn = d . (x_r, y_r) + u_r - d . (zeta_n e_r + eta_n e_t) - u_n``;
+* planet ``n``'s bearing on the carrier, radial and tangential (the carrier's point under
+  the planet's centre moves by ``(x_c, y_c) + u_c e_t``);
+* each central member's bearing (``x_j``, ``y_j``) and torsional support (``u_j``), where
+  their stiffness is not zero.
+
+``e_r = (cos psi_n, sin psi_n)`` and ``e_t = (-sin psi_n, cos psi_n)``.  The projections are
+worked out here by SymPy (``delta_sn`` becomes ``-x_s sin(psi_n - alpha_s) + ... - zeta_n
+sin alpha_s - eta_n cos alpha_s + u_n``: Lin and Parker's sub-matrices ``K_s1, K_s2,
+K_s3`` are ``k_sp`` times the outer products of its coefficients).
+
+``M = diag(m, m, I / r^2)`` per body and ``K = R^T diag(k) R``.  The **torsional** model holds
+every translation and carries each planet's centre with the carrier (``zeta_n = 0``,
+``eta_n = u_c``): ``q = T q_t`` with ``q_t = (u_c, u_r, u_s, u_1, ..., u_N)``, ``M_t = T^T M T``
+(the carrier's entry gains ``N m_p``) and ``R_t = R T``.
+
+**Rigid-body modes**: the null space of ``R`` (its dimension found numerically, relative
+tolerance 1e-10 of the largest singular value): a member free to turn with nothing
+holding the set (``torsional_N_per_m = 0`` on all but one member) gives one.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+
+from ..input.planetary import CENTRAL, PlanetarySet
+
+__all__ = ["PlanetaryStructure", "derive_planetary"]
+
+_SHORT = {"carrier": "c", "ring": "r", "sun": "s"}
+
+
+@dataclass(frozen=True)
+class PlanetaryStructure:
+    """The model of one planetary set: SymPy deflections and the numeric matrices in the
+    form the modal analysis reads (``as_structure``)."""
+
+    planetary: PlanetarySet
+    physical: tuple[str, ...]  # q
+    members: tuple[str, ...]  # the body of each entry of q: carrier, ring, sun, planet1, ...
+    motions: tuple[str, ...]  # "translation" or "rotation" per entry of q
+    mass: tuple[float, ...]  # M's diagonal
+    springs: tuple[str, ...]  # the name of each row of R
+    kinds: tuple[str, ...]  # "mesh", "planet bearing", "bearing", "torsional support"
+    deflections: tuple[sp.Expr, ...]  # delta of each spring (lateral-torsional symbols)
+    incidence: np.ndarray  # R (springs x q)
+    stiffness: tuple[float, ...]
+    rigid_body_modes: int
+
+    def as_structure(self) -> dict:
+        """The ``STRUCTURE`` mapping of a generated module (``solver.analysis.modes``)."""
+        return {
+            "physical": self.physical,
+            "mass": self.mass,
+            "coordinates": self.springs,
+            "kinds": self.kinds,
+            "incidence": tuple(tuple(float(v) for v in row) for row in self.incidence),
+            "stiffness": self.stiffness,
+            "members": self.members,
+            "motions": self.motions,
+        }
+
+
+def _lateral(ps: PlanetarySet):
+    """Symbols, deflections and stiffness of every spring of the lateral-torsional model."""
+    q: list[sp.Symbol] = []
+    members: list[str] = []
+    motions: list[str] = []
+    mass: list[float] = []
+    sym = {}
+    for j in CENTRAL:
+        m = ps.members[j]
+        s = _SHORT[j]
+        for name, motion, value in (
+            (f"x_{s}", "translation", m.mass),
+            (f"y_{s}", "translation", m.mass),
+            (f"u_{s}", "rotation", m.inertia_over_r2),
+        ):
+            sym[name] = sp.Symbol(name, real=True)
+            q.append(sym[name])
+            members.append(j)
+            motions.append(motion)
+            mass.append(value)
+    p = ps.members["planet"]
+    for n in range(1, ps.planets + 1):
+        for name, motion, value in (
+            (f"zeta_{n}", "translation", p.mass),
+            (f"eta_{n}", "translation", p.mass),
+            (f"u_{n}", "rotation", p.inertia_over_r2),
+        ):
+            sym[name] = sp.Symbol(name, real=True)
+            q.append(sym[name])
+            members.append(f"planet{n}")
+            motions.append(motion)
+            mass.append(value)
+
+    alpha_s, alpha_r = sp.symbols("alpha_s alpha_r", real=True)
+    numbers = {alpha_s: math.radians(ps.alpha_s_deg), alpha_r: math.radians(ps.alpha_r_deg)}
+    springs, kinds, deflections, stiffness = [], [], [], []
+    for n, angle in enumerate(ps.angles_deg, start=1):
+        psi = sp.Symbol(f"psi_{n}", real=True)
+        numbers[psi] = math.radians(angle)
+        e_r = sp.Matrix([sp.cos(psi), sp.sin(psi)])
+        e_t = sp.Matrix([-sp.sin(psi), sp.cos(psi)])
+        planet = sym[f"zeta_{n}"] * e_r + sym[f"eta_{n}"] * e_t
+        u_n = sym[f"u_{n}"]
+        for mesh, centre, angle_loa, sense, k in (
+            ("s", "s", psi - alpha_s, 1, ps.k_sp),
+            ("r", "r", psi + alpha_r, -1, ps.k_rp),
+        ):
+            d = sp.Matrix([-sp.sin(angle_loa), sp.cos(angle_loa)])
+            central = sp.Matrix([sym[f"x_{centre}"], sym[f"y_{centre}"]])
+            delta = d.dot(central) + sym[f"u_{centre}"] - d.dot(planet) + sense * u_n
+            springs.append(f"{mesh}p{n}")
+            kinds.append("mesh")
+            deflections.append(sp.expand(sp.expand_trig(sp.simplify(delta))))
+            stiffness.append(k)
+        carrier = sp.Matrix([sym["x_c"], sym["y_c"]])
+        for name, delta in (
+            (f"bearing{n}_radial", e_r.dot(carrier) - sym[f"zeta_{n}"]),
+            (f"bearing{n}_tangential", e_t.dot(carrier) + sym["u_c"] - sym[f"eta_{n}"]),
+        ):
+            springs.append(name)
+            kinds.append("planet bearing")
+            deflections.append(sp.expand(delta))
+            stiffness.append(p.bearing)
+    for j in CENTRAL:
+        m, s = ps.members[j], _SHORT[j]
+        for name, kind, k in (
+            (f"x_{s}", "bearing", m.bearing),
+            (f"y_{s}", "bearing", m.bearing),
+            (f"u_{s}", "torsional support", m.torsional),
+        ):
+            if k > 0:
+                springs.append(f"{kind.split()[0]}_{name}")
+                kinds.append(kind)
+                deflections.append(sym[name])
+                stiffness.append(k)
+    R = np.array(
+        [[float(sp.diff(d, v).subs(numbers)) for v in q] for d in deflections], dtype=float
+    )
+    return q, members, motions, mass, springs, kinds, deflections, R, stiffness
+
+
+def derive_planetary(ps: PlanetarySet) -> PlanetaryStructure:
+    """The model of ``ps`` (module docstring)."""
+    q, members, motions, mass, springs, kinds, deflections, R, k = _lateral(ps)
+    names = [str(s) for s in q]
+    if ps.dofs == "torsional":
+        keep = ["u_c", "u_r", "u_s"] + [f"u_{n}" for n in range(1, ps.planets + 1)]
+        T = np.zeros((len(names), len(keep)))
+        for col, name in enumerate(keep):
+            T[names.index(name), col] = 1.0
+        for n in range(1, ps.planets + 1):  # each planet's centre carried by the carrier
+            T[names.index(f"eta_{n}"), keep.index("u_c")] = 1.0
+        M = T.T @ np.diag(mass) @ T
+        R = R @ T
+        live = [i for i in range(len(springs)) if np.any(np.abs(R[i]) > 1e-12)]
+        springs = [springs[i] for i in live]
+        kinds = [kinds[i] for i in live]
+        deflections = [deflections[i] for i in live]
+        k = [k[i] for i in live]
+        R = R[live]
+        members = [members[names.index(n)] for n in keep]
+        motions = ["rotation"] * len(keep)
+        mass = list(np.diag(M))
+        names = keep
+    sv = np.linalg.svd(R, compute_uv=False) if R.size else np.zeros(0)
+    rank = int(np.sum(sv > 1e-10 * (sv.max() if sv.size else 1.0)))
+    return PlanetaryStructure(
+        planetary=ps,
+        physical=tuple(names),
+        members=tuple(members),
+        motions=tuple(motions),
+        mass=tuple(float(v) for v in mass),
+        springs=tuple(springs),
+        kinds=tuple(kinds),
+        deflections=tuple(deflections),
+        incidence=R,
+        stiffness=tuple(float(v) for v in k),
+        rigid_body_modes=len(names) - rank,
+    )

@@ -1,0 +1,157 @@
+"""A planetary set as a topology file: sun, ring, carrier and N planets (issue 26).
+
+A planetary set closes gear loops (each planet meshes with both the sun and the ring), so
+it is not a tree of meshes and is not written with ``[[gear]]`` and ``[[mesh]]`` tables.
+Its file has a ``[planetary]`` table instead, in the lumped-parameter terms of Lin and
+Parker (1999, "Analytical characterization of the unique properties of planetary gear
+free vibration"): each central member (sun, ring, carrier) has a mass, a rotational
+inertia given as ``I / r^2`` on its displacement ``u = r theta`` (``r`` the base radius;
+for the carrier the radius of the planets' centres), a translational bearing and a
+torsional support; each planet sits on the carrier through a bearing; the sun-planet and
+ring-planet meshes have a mean stiffness and a pressure angle; the planets' angles round
+the carrier are equally spaced unless given.
+
+    [topology]
+    name = "lin-parker-1999-3"
+    [planetary]
+    degrees_of_freedom = "lateral-torsional"      # or "torsional"
+    planets = 3                                   # or planet_angles_deg = [0, 120, 240]
+    sun_planet = { stiffness_N_per_m = 5e8, pressure_angle_deg = 24.6 }
+    ring_planet = { stiffness_N_per_m = 5e8, pressure_angle_deg = 24.6 }
+    [planetary.sun]
+    mass_kg = 0.4
+    inertia_over_r2_kg = 0.39                     # or inertia_kg_m2 with radius_mm
+    bearing_N_per_m = 1e8                         # translational (x and y)
+    torsional_N_per_m = 0                         # on u = r theta; 0: free to turn
+    ...
+
+The ``torsional`` model keeps each member's rotation only: translations are held and
+each planet's centre moves with the carrier (its bearing rigid), as in the purely
+torsional model Lin and Parker compare with.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+from .reader import InputError, Table, load_toml
+
+__all__ = ["DOFS", "Member", "PlanetarySet", "is_planetary", "load_planetary"]
+
+DOFS = ("torsional", "lateral-torsional")
+CENTRAL = ("carrier", "ring", "sun")  # Lin and Parker's order of the central members
+
+
+@dataclass(frozen=True)
+class Member:
+    """One body: its mass (kg), ``I / r^2`` (kg) and supports (N/m; a planet's bearing
+    holds it on the carrier, a central member's bearing on the housing)."""
+
+    name: str
+    mass: float
+    inertia_over_r2: float
+    bearing: float
+    torsional: float
+
+
+@dataclass(frozen=True)
+class PlanetarySet:
+    name: str
+    description: str
+    source: str
+    dofs: str
+    angles_deg: tuple[float, ...]  # each planet's angle round the carrier
+    equally_spaced: bool
+    members: dict  # carrier, ring, sun, planet -> Member
+    k_sp: float  # sun-planet mean mesh stiffness, N/m
+    k_rp: float  # ring-planet
+    alpha_s_deg: float  # sun-planet pressure angle
+    alpha_r_deg: float  # ring-planet
+
+    @property
+    def planets(self) -> int:
+        return len(self.angles_deg)
+
+
+def is_planetary(path: Path | str) -> bool:
+    """Whether the TOML file at ``path`` is a planetary set (a ``[planetary]`` table)."""
+    path = Path(path)
+    if path.suffix != ".toml" or not path.is_file():
+        return False
+    try:
+        return "planetary" in load_toml(path)
+    except InputError:
+        return False
+
+
+def _member(t: Table, name: str, planet: bool) -> Member:
+    mass = t.number("mass_kg", low=0.0, low_open=True)
+    if t.has("inertia_over_r2_kg") == t.has("inertia_kg_m2"):
+        raise t.error(
+            "inertia_over_r2_kg",
+            "give exactly one of inertia_over_r2_kg (I / r^2 on u = r theta, kg) and "
+            "inertia_kg_m2 with radius_mm (the base radius; the carrier: its planets' centres)",
+        )
+    if t.has("inertia_over_r2_kg"):
+        j = t.number("inertia_over_r2_kg", low=0.0, low_open=True)
+    else:
+        inertia = t.number("inertia_kg_m2", low=0.0, low_open=True)
+        radius = t.number("radius_mm", low=0.0, low_open=True) * 1e-3
+        j = inertia / radius**2
+    bearing = t.number("bearing_N_per_m", low=0.0)
+    torsional = 0.0 if planet else t.number("torsional_N_per_m", low=0.0)
+    t.finish()
+    return Member(name, mass, j, bearing, torsional)
+
+
+def _mesh(t: Table) -> tuple[float, float]:
+    k = t.number("stiffness_N_per_m", low=0.0, low_open=True)
+    alpha = t.number("pressure_angle_deg", low=0.0, high=60.0, low_open=True)
+    t.finish()
+    return k, alpha
+
+
+def load_planetary(path: Path | str) -> PlanetarySet:
+    """Read and check a planetary set's topology file (module docstring)."""
+    path = Path(path)
+    source = str(path)
+    top = Table(load_toml(path), source)
+    head = top.table("topology")
+    name = head.target_name("name")
+    description = head.string("description", "")
+    head.finish()
+    p = top.table("planetary")
+    dofs = p.string("degrees_of_freedom", "lateral-torsional")
+    if dofs not in DOFS:
+        raise p.error("degrees_of_freedom", f"'{dofs}' is not one of {', '.join(DOFS)}")
+    if p.has("planets") == p.has("planet_angles_deg"):
+        raise p.error(
+            "planets",
+            "give exactly one of planets (that many, equally spaced) and planet_angles_deg",
+        )
+    if p.has("planets"):
+        n = p.integer("planets", low=1, high=64)
+        angles = tuple(360.0 * k / n for k in range(n))
+        equal = True
+    else:
+        angles = p.numbers("planet_angles_deg")
+        if not angles:
+            raise p.error("planet_angles_deg", "give at least one planet angle")
+        turn = sorted(a % 360.0 for a in angles)
+        gaps = [b - a for a, b in zip(turn, turn[1:] + [turn[0] + 360.0], strict=True)]
+        if min(gaps) <= 1e-9:
+            raise p.error("planet_angles_deg", f"two planets at the same angle: {list(angles)}")
+        equal = max(gaps) - min(gaps) <= 1e-9
+    k_sp, alpha_s = _mesh(p.table("sun_planet"))
+    k_rp, alpha_r = _mesh(p.table("ring_planet"))
+    members = {m: _member(p.table(m), m, False) for m in CENTRAL}
+    members["planet"] = _member(p.table("planet"), "planet", True)
+    p.finish()
+    top.finish()
+    if any(not math.isfinite(a) for a in angles):
+        raise InputError(source, "planetary.planet_angles_deg", "angles must be finite")
+    return PlanetarySet(
+        name, description, source, dofs, angles, equal, members, k_sp, k_rp, alpha_s, alpha_r
+    )
