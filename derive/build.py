@@ -30,6 +30,8 @@ __all__ = [
     "describe",
     "display_path",
     "project_root",
+    "planetary_files",
+    "shipped_planetary",
     "shipped_targets",
     "write_files",
     "write_stiffness_figure",
@@ -40,6 +42,26 @@ def shipped_targets() -> list[Path]:
     """Built-in scenes, then built-in topologies, in name order."""
     root = builtin_root()
     return sorted(root.glob("*.toml")) + sorted((root / "topologies").glob("*.toml"))
+
+
+def shipped_planetary() -> list[Path]:
+    """Built-in planetary sets (``scenes/planetary``): an audit page each, no module."""
+    return sorted((builtin_root() / "planetary").glob("*.toml"))
+
+
+def planetary_files(paths) -> dict[str, str]:
+    """``docs/derivation/<name>.md`` of each planetary set in ``paths``."""
+    from .emit.audit_planetary import planetary_name, planetary_page
+    from .equations.planetary import derive_planetary
+    from .input.planetary import load_planetary
+
+    files = {}
+    for path in paths:
+        st = derive_planetary(load_planetary(path))
+        command = f"gearsym derive {display_path(path)}"
+        page = planetary_page(st, command, display_path(path))
+        files[f"docs/derivation/{planetary_name(st.planetary.name)}.md"] = page
+    return files
 
 
 @dataclass(frozen=True)
@@ -55,11 +77,18 @@ def build_files(
     ``overrides`` set scene parameters, or open values (``derive.open_values``), which
     give each target's variant."""
     from .input.open_values import is_open_value, with_open_values
+    from .input.planetary import is_planetary
 
     models, files = [], {}
     opened = {k: v for k, v in (overrides or {}).items() if is_open_value(k)}
     rest = {k: v for k, v in (overrides or {}).items() if k not in opened}
-    for path in paths:
+    planetary = [p for p in paths if is_planetary(p)]
+    if planetary and overrides:
+        raise InputError(
+            str(planetary[0]), "--set", "a planetary set takes no --set yet; edit its file"
+        )
+    files.update(planetary_files(planetary + (shipped_planetary() if index else [])))
+    for path in [p for p in paths if p not in planetary]:
         scene = with_open_values(load_target(path, rest or None), **opened)
         model = derive_model(scene)
         command = f"gearsym derive {display_path(path)}"
@@ -76,7 +105,12 @@ def build_files(
             "give each scene or topology its own name",
         )
     if index:
-        files["docs/derivation.md"] = index_page(models, "gearsym derive")
+        from .emit.audit_planetary import planetary_index
+        from .equations.planetary import derive_planetary
+        from .input.planetary import load_planetary
+
+        sets = [derive_planetary(load_planetary(p)) for p in shipped_planetary()]
+        files["docs/derivation.md"] = index_page(models, "gearsym derive") + planetary_index(sets)
         files[STIFFNESS_PAGE] = stiffness_page(
             load_topology(_reference_topology()), "gearsym derive", Path(STIFFNESS_FIGURE).name
         )

@@ -137,9 +137,12 @@ def _cmd_derive(args) -> int:
                 file=sys.stderr,
             )
             return 1
+        from gearsym.derive.build import shipped_planetary
+
         print(
             "generated/ and docs/ match a fresh regeneration of "
-            f"{len(shipped_targets())} shipped targets"
+            f"{len(shipped_targets())} shipped targets and {len(shipped_planetary())} "
+            "planetary sets"
         )
         return 0
 
@@ -172,6 +175,11 @@ def _cmd_derive(args) -> int:
         return 0
     for model in built.models:
         _summary(model)
+    for rel in built.files:
+        if rel.startswith("docs/derivation/") and Path(rel).stem not in {
+            m.name for m in built.models
+        }:
+            print(f"{Path(rel).stem}  (a planetary set: its audit page; modes by gearsym modes)")
     if where is None:
         for path in written:
             print(f"wrote {path}")
@@ -184,16 +192,16 @@ def _as_shipped(paths, overrides) -> bool:
     """The shipped scenes and topologies as they are: their files belong in the project
     (that is what ``derive --check`` compares).  Anything else (a user's scene, or a
     shipped one with --set) never writes into the installed package."""
-    from gearsym.derive.build import shipped_targets
+    from gearsym.derive.build import shipped_planetary, shipped_targets
 
-    shipped = {Path(p).resolve() for p in shipped_targets()}
+    shipped = {Path(p).resolve() for p in [*shipped_targets(), *shipped_planetary()]}
     return not overrides and all(Path(p).resolve() in shipped for p in paths)
 
 
 def _cache_files(built) -> dict[str, str]:
     """The generated modules (and audit pages beside them) at the derivation cache's
     names, where the scene resolver finds them (absolute paths)."""
-    from gearsym.resolve import cached_module
+    from gearsym.resolve import cached_module, model_cache
 
     files = {}
     for model in built.models:
@@ -202,6 +210,10 @@ def _cache_files(built) -> dict[str, str]:
             if Path(rel).stem == model.name:
                 target = module if rel.endswith(".py") else module.with_suffix(".md")
                 files[str(target)] = text
+    models = {m.name for m in built.models}
+    for rel, text in built.files.items():  # a planetary set's page: no module beside it
+        if rel.startswith("docs/derivation/") and Path(rel).stem not in models:
+            files[str(model_cache() / Path(rel).name)] = text
     return files
 
 

@@ -23,9 +23,10 @@ and Parker's free-vibration analysis.
   their stiffness is not zero.
 
 ``e_r = (cos psi_n, sin psi_n)`` and ``e_t = (-sin psi_n, cos psi_n)``.  The projections are
-worked out here by SymPy (``delta_sn`` becomes ``-x_s sin(psi_n - alpha_s) + ... - zeta_n
-sin alpha_s - eta_n cos alpha_s + u_n``: Lin and Parker's sub-matrices ``K_s1, K_s2,
-K_s3`` are ``k_sp`` times the outer products of its coefficients).
+worked out here by SymPy (``delta_sn`` becomes ``-x_s sin(psi_n - alpha_s) + y_s cos(psi_n -
+alpha_s) + u_s - zeta_n sin alpha_s - eta_n cos alpha_s + u_n``: Lin and Parker's
+sub-matrices ``K_s1, K_s2, K_s3`` are ``k_sp`` times the outer products of its
+coefficients).
 
 ``M = diag(m, m, I / r^2)`` per body and ``K = R^T diag(k) R``.  The **torsional** model holds
 every translation and carries each planet's centre with the carrier (``zeta_n = 0``,
@@ -135,7 +136,9 @@ def _lateral(ps: PlanetarySet):
             delta = d.dot(central) + sym[f"u_{centre}"] - d.dot(planet) + sense * u_n
             springs.append(f"{mesh}p{n}")
             kinds.append("mesh")
-            deflections.append(sp.expand(sp.expand_trig(sp.simplify(delta))))
+            # each coordinate's coefficient in its simplest trigonometric form
+            # (the planet's: sin and cos of the pressure angle alone)
+            deflections.append(sum(sp.trigsimp(sp.diff(delta, v)) * v for v in q))
             stiffness.append(k)
         carrier = sp.Matrix([sym["x_c"], sym["y_c"]])
         for name, delta in (

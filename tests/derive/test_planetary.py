@@ -276,3 +276,22 @@ def test_cli_modes_and_refusals(tmp_path):
     assert done.returncode == 2
     assert len(done.stderr.strip().splitlines()) == 1
     assert "exactly one of planets" in done.stderr
+
+
+def test_audit_page():
+    """`gearsym derive` of a planetary set writes its audit page: the kinematic graph
+    (bodies, joints, independent loops E - V + 1), the rigid-body modes, every spring's
+    deflection; the shipped sets' pages are part of the shipped files (derive --check)."""
+    from gearsym.derive.build import build_files, shipped_planetary, shipped_targets
+
+    path = resolve_target("lin-parker-1999-4")
+    page = build_files([path]).files["docs/derivation/lin_parker_1999_4.md"]
+    assert "12 joints among 7 bodies close 6 independent loops" in page
+    assert "Rigid-body modes: **1**" in page
+    assert page.count("| mesh |") == 8 and page.count("| planet bearing |") == 8
+    assert "\\sin{\\left(\\alpha_{s} \\right)}" in page  # the planet's term, simplified
+    shipped = build_files(shipped_targets(), index=True).files
+    for p in shipped_planetary():
+        name = p.stem.replace("-", "_")
+        assert f"docs/derivation/{name}.md" in shipped
+        assert f"derivation/{name}.md" in shipped["docs/derivation.md"]
