@@ -130,6 +130,9 @@ def _planetary(path, args) -> int:
         "planet_angles_deg": list(ps.angles_deg),
         "equally_spaced": ps.equally_spaced,
         "rigid_body_modes": st.rigid_body_modes,
+        "mesh_phases": None
+        if st.phases is None
+        else [{"planet": n, "sun": g_s, "ring": g_r} for n, (g_s, g_r) in enumerate(st.phases, 1)],
         "modes": [
             {
                 "index": m.index,

@@ -110,7 +110,7 @@ def planetary_page(st: PlanetaryStructure, command: str, source: str) -> str:
     ]
     for spring, delta in zip(st.springs, st.deflections, strict=True):
         lines.append(f"* `{spring}`: $\\delta = {sp.latex(delta)}$")
-    lines.append("")
+    lines += ["", *_phase_lines(st)]
     return "\n".join(line for line in lines if line is not None) + "\n"
 
 
@@ -135,3 +135,34 @@ def planetary_index(structures: list) -> str:
             f"{st.rigid_body_modes} | [derivation/{name}.md](derivation/{name}.md) |"
         )
     return "\n".join(lines) + "\n"
+
+
+def _phase_lines(st: PlanetaryStructure) -> list[str]:
+    """The mesh phases round the carrier (``derive.equations.planetary``), or why none."""
+    ps = st.planetary
+    out = ["## Mesh phases\n"]
+    if st.phases is None:
+        return out + [
+            "The file gives no tooth counts (`sun_teeth`, `ring_teeth`), so the meshes' "
+            "phases round the carrier are not known; the modes do not need them (each mesh "
+            "at its mean stiffness).\n"
+        ]
+    out += [
+        f"Sun {ps.sun_teeth} teeth, ring {ps.ring_teeth}. Planet n's sun mesh repeats planet "
+        "1's delayed by γ_sn mesh periods, its ring mesh by γ_rn: γ_sn = frac(Z_s ψ_n / 360°),"
+        " γ_rn = frac(−Z_r ψ_n / 360°), the angles counted in the sense the sun turns "
+        "relative to the carrier (`derive/equations/planetary.py`; the phase between a "
+        "planet's own sun and ring meshes depends on the tooth geometry and is not given).\n",
+        "| planet | ψ (deg) | γ_sn | γ_rn |",
+        "|---|---|---|---|",
+    ]
+    for n, (a, (g_s, g_r)) in enumerate(zip(ps.angles_deg, st.phases, strict=True), start=1):
+        out.append(f"| {n} | {a:g} | {g_s:.6g} | {g_r:.6g} |")
+    same = all(g == 0.0 for g, _ in st.phases)
+    out += [
+        "",
+        "The sun meshes are "
+        + ("all in phase." if same else "not all in phase.")
+        + "\n",
+    ]
+    return out

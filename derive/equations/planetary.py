@@ -33,6 +33,21 @@ every translation and carries each planet's centre with the carrier (``zeta_n = 
 ``eta_n = u_c``): ``q = T q_t`` with ``q_t = (u_c, u_r, u_s, u_1, ..., u_N)``, ``M_t = T^T M T``
 (the carrier's entry gains ``N m_p``) and ``R_t = R T``.
 
+**Mesh phases** (with the tooth counts ``Z_s``, ``Z_r``; derived here from the teeth's
+positions).  In the carrier's frame the sun's teeth pass the planets at ``Z_s |Omega_s -
+Omega_c| / 2 pi`` per second, the mesh frequency; the sun's tooth that planet 1 sees now
+reaches planet ``n`` after the sun has turned (relative to the carrier) by ``psi_n``, so the
+stiffness of sun mesh ``n`` is that of mesh 1 delayed by ``gamma_sn = frac(Z_s psi_n / 2
+pi)`` mesh periods, ``k_sn(t) = k_s1(t - gamma_sn T_m)``, with the angles counted in the
+sense the sun turns relative to the carrier.  The ring turns the other way relative to the
+carrier (Willis: ``(Omega_s - Omega_c) / (Omega_r - Omega_c) = -Z_r / Z_s``), so ``gamma_rn =
+frac(-Z_r psi_n / 2 pi)``.  The sun meshes are in phase when ``Z_s psi_n / 2 pi`` is whole
+(equally spaced: ``Z_s / N`` whole).  The phase between a planet's ring and sun meshes
+depends on the tooth geometry (where each contact starts on its line of action), not on
+the counts alone, and is not given.  The question is the one Parker and Lin (2004, "Mesh
+phasing relationships in planetary and epicyclic gears") treat; the derivation here is
+our own.
+
 **Rigid-body modes**: the null space of ``R`` (its dimension found numerically, relative
 tolerance 1e-10 of the largest singular value): a member free to turn with nothing
 holding the set (``torsional_N_per_m = 0`` on all but one member) gives one.
@@ -48,7 +63,7 @@ import sympy as sp
 
 from ..input.planetary import CENTRAL, PlanetarySet
 
-__all__ = ["PlanetaryStructure", "derive_planetary"]
+__all__ = ["PlanetaryStructure", "derive_planetary", "mesh_phases"]
 
 _SHORT = {"carrier": "c", "ring": "r", "sun": "s"}
 
@@ -69,6 +84,7 @@ class PlanetaryStructure:
     incidence: np.ndarray  # R (springs x q)
     stiffness: tuple[float, ...]
     rigid_body_modes: int
+    phases: tuple[tuple[float, float], ...] | None = None  # (gamma_sn, gamma_rn) per planet
 
     def as_structure(self) -> dict:
         """The ``STRUCTURE`` mapping of a generated module (``solver.analysis.modes``)."""
@@ -167,6 +183,21 @@ def _lateral(ps: PlanetarySet):
     return q, members, motions, mass, springs, kinds, deflections, R, stiffness
 
 
+def mesh_phases(ps: PlanetarySet) -> tuple[tuple[float, float], ...] | None:
+    """``(gamma_sn, gamma_rn)`` of each planet in mesh periods, in [0, 1) (module
+    docstring); None without tooth counts."""
+    if ps.sun_teeth is None:
+        return None
+
+    def frac(x: float) -> float:
+        g = x % 1.0
+        return 0.0 if min(g, 1.0 - g) <= 1e-9 else g
+
+    return tuple(
+        (frac(ps.sun_teeth * a / 360.0), frac(-ps.ring_teeth * a / 360.0)) for a in ps.angles_deg
+    )
+
+
 def derive_planetary(ps: PlanetarySet) -> PlanetaryStructure:
     """The model of ``ps`` (module docstring)."""
     q, members, motions, mass, springs, kinds, deflections, R, k = _lateral(ps)
@@ -204,4 +235,5 @@ def derive_planetary(ps: PlanetarySet) -> PlanetaryStructure:
         incidence=R,
         stiffness=tuple(float(v) for v in k),
         rigid_body_modes=len(names) - rank,
+        phases=mesh_phases(ps),
     )

@@ -16,6 +16,8 @@ the carrier are equally spaced unless given.
     [planetary]
     degrees_of_freedom = "lateral-torsional"      # or "torsional"
     planets = 3                                   # or planet_angles_deg = [0, 120, 240]
+    sun_teeth = 31                                # optional, both: the mesh phases
+    ring_teeth = 89
     sun_planet = { stiffness_N_per_m = 5e8, pressure_angle_deg = 24.6 }
     ring_planet = { stiffness_N_per_m = 5e8, pressure_angle_deg = 24.6 }
     [planetary.sun]
@@ -69,6 +71,8 @@ class PlanetarySet:
     k_rp: float  # ring-planet
     alpha_s_deg: float  # sun-planet pressure angle
     alpha_r_deg: float  # ring-planet
+    sun_teeth: int | None = None  # tooth counts, for the mesh phases (optional)
+    ring_teeth: int | None = None
 
     @property
     def planets(self) -> int:
@@ -144,6 +148,24 @@ def load_planetary(path: Path | str) -> PlanetarySet:
         if min(gaps) <= 1e-9:
             raise p.error("planet_angles_deg", f"two planets at the same angle: {list(angles)}")
         equal = max(gaps) - min(gaps) <= 1e-9
+    if p.has("sun_teeth") != p.has("ring_teeth"):
+        raise p.error("sun_teeth", "give both sun_teeth and ring_teeth, or neither")
+    z_s = p.integer("sun_teeth", None, low=3) if p.has("sun_teeth") else None
+    z_r = p.integer("ring_teeth", None, low=3) if p.has("ring_teeth") else None
+    if z_s is not None:
+        if z_r <= z_s:
+            raise p.error("ring_teeth", f"must exceed sun_teeth ({z_s}), got {z_r}")
+        # Each planet must fit both the sun's and the ring's teeth where it sits: (Z_s +
+        # Z_r) psi_n / 360 deg a whole number (equally spaced: (Z_s + Z_r) / N)
+        for a in angles:
+            turns = (z_s + z_r) * a / 360.0
+            if abs(turns - round(turns)) > 1e-9:
+                raise p.error(
+                    "planet_angles_deg" if p.has("planet_angles_deg") else "planets",
+                    f"a planet at {a:g} deg cannot mesh with both the sun ({z_s} teeth) and "
+                    f"the ring ({z_r}): (sun_teeth + ring_teeth) x angle / 360 = {turns:g} "
+                    "must be a whole number; change the angles or the tooth counts",
+                )
     k_sp, alpha_s = _mesh(p.table("sun_planet"))
     k_rp, alpha_r = _mesh(p.table("ring_planet"))
     members = {m: _member(p.table(m), m, False) for m in CENTRAL}
@@ -153,5 +175,17 @@ def load_planetary(path: Path | str) -> PlanetarySet:
     if any(not math.isfinite(a) for a in angles):
         raise InputError(source, "planetary.planet_angles_deg", "angles must be finite")
     return PlanetarySet(
-        name, description, source, dofs, angles, equal, members, k_sp, k_rp, alpha_s, alpha_r
+        name,
+        description,
+        source,
+        dofs,
+        angles,
+        equal,
+        members,
+        k_sp,
+        k_rp,
+        alpha_s,
+        alpha_r,
+        z_s,
+        z_r,
     )

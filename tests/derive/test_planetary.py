@@ -295,3 +295,49 @@ def test_audit_page():
         name = p.stem.replace("-", "_")
         assert f"docs/derivation/{name}.md" in shipped
         assert f"derivation/{name}.md" in shipped["docs/derivation.md"]
+
+
+def first_passage(teeth: int, rate: float, where: float, period: float) -> float:
+    """The first time in [0, period) at which a tooth of a gear with ``teeth`` teeth,
+    tooth 0 at angle 0 at t = 0 and turning at ``rate`` (rad/s, carrier frame), is at the
+    angle ``where``: found by trying every tooth (brute force, no phase formula)."""
+    times = []
+    for j in range(teeth):
+        t = (where - 2 * np.pi * j / teeth) / rate
+        times.append(t % period)
+    return min(times)
+
+
+@pytest.mark.parametrize(("n", "z_s", "z_r"), [(3, 31, 89), (4, 30, 90), (5, 23, 77), (4, 21, 79)])
+def test_mesh_phases_against_tooth_passages(n, z_s, z_r):
+    """Each mesh's delay behind planet 1's, in mesh periods, against the first passage of
+    a tooth over each planet found by brute force: the sun turning at 1 rad/s relative to
+    the carrier, the ring the other way at Z_s / Z_r (Willis)."""
+    ps = replace(example(n), sun_teeth=z_s, ring_teeth=z_r)
+    phases = derive_planetary(ps).phases
+    period = 2 * np.pi / z_s  # the mesh period at 1 rad/s of the sun
+    for (g_s, g_r), psi in zip(phases, np.radians(ps.angles_deg), strict=True):
+        t_s = first_passage(z_s, 1.0, psi, period) - first_passage(z_s, 1.0, 0.0, period)
+        t_r = first_passage(z_r, -z_s / z_r, psi, period) - first_passage(
+            z_r, -z_s / z_r, 0.0, period
+        )
+        for gamma, t in ((g_s, t_s), (g_r, t_r)):
+            lag = (t / period) % 1.0
+            assert min(abs(gamma - lag), 1 - abs(gamma - lag)) < 1e-9, (gamma, lag)
+    in_phase = all(g == 0.0 for g, _ in phases)
+    assert in_phase == (z_s % n == 0)  # the sun meshes in phase iff N divides Z_s
+
+
+def test_planets_that_cannot_be_assembled_are_refused(tmp_path):
+    """Equally spaced planets need (Z_s + Z_r) / N whole: 31 + 90 over 4 is not."""
+    text = resolve_target("lin-parker-1999-4").read_text(encoding="utf-8")
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace("planets = 4", "planets = 4\nsun_teeth = 31\nring_teeth = 90"))
+    done = run("modes", str(bad))
+    assert done.returncode == 2
+    assert "cannot mesh with both the sun (31 teeth) and the ring (90)" in done.stderr
+    good = tmp_path / "good.toml"
+    good.write_text(text.replace("planets = 4", "planets = 4\nsun_teeth = 30\nring_teeth = 90"))
+    done = run("modes", str(good), "--json")
+    assert done.returncode == 0, done.stderr
+    assert '"mesh_phases"' in done.stdout
