@@ -161,8 +161,6 @@ def _phase_lines(st: PlanetaryStructure) -> list[str]:
     same = all(g == 0.0 for g, _ in st.phases)
     out += [
         "",
-        "The sun meshes are "
-        + ("all in phase." if same else "not all in phase.")
-        + "\n",
+        "The sun meshes are " + ("all in phase." if same else "not all in phase.") + "\n",
     ]
     return out
