@@ -26,8 +26,11 @@ from gearsym.solver.plots_maps import (
 __all__ = [
     "CAPTIONS",
     "backlash_figure",
+    "branch_png",
+    "call",
     "figure_list",
     "floquet_figure",
+    "map_png",
     "response_figure",
     "stiffness_figure",
     "sweep_state_figure",
@@ -332,3 +335,33 @@ def figure_list(folder, captions=CAPTIONS) -> str:
     if rest:
         lines.append("- " + ", ".join(f"`{f}`" for f in rest) + ": (no caption)")
     return "\n".join(lines) if lines else "(no figures were written)"
+
+
+def call(job: tuple):
+    """Worker: ``fn(*args)`` of a ``(fn, args)`` pair (a figure of the results)."""
+    fn, args = job
+    return fn(*args)
+
+
+def map_png(f1, lam, max_u, min_v, motion_v, path: Path) -> Path:
+    """The (f1, lambda) map of the light scene: Max(u), Min(v) and the motion of v."""
+    from gearsym.solver import plots
+
+    fig = plots.map_figure(
+        f1,
+        lam,
+        max_u,
+        min_v,
+        motion_v,
+        title="light-load scene with f1 varied",
+        names=("f1", "lambda", "u", "v"),
+    )
+    return plots.save_figure(fig, path)
+
+
+def branch_png(branches, sweeps, title: str, system, stem: Path) -> Path:
+    """The continued periodic branches of one load case over its sweeps."""
+    from gearsym.solver import plots
+
+    fig = plots.branch_figure(branches, ("u", "v"), sweeps=sweeps, title=title, system=system)
+    return plots.save_figure(fig, stem.parent / f"continuation_{stem.name}.png")

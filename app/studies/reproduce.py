@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 from gearsym.solver._json import dumps
+from gearsym.solver.executor import map_tasks
 from gearsym.solver.export import save_all
 from gearsym.solver.integrate import fastest_method
 from gearsym.solver.sweep import SweepJob, sweep_many
@@ -189,9 +190,15 @@ def _reproduce(out, quick, executor, workers, fresh, res, stages, writer) -> Rep
     for sw, f1 in zip(got["dead maps"], res.map_f1, strict=True):
         writer.submit(save_all, sw, out / "data" / f"sweep_{DEAD_ZONE}_map_f1_{f1}.json")
     files["dead zone"]["model_hash"] = dead["light"].model_hash
-    from gearsym.solver import plots
-
-    from .figures import backlash_figure, floquet_figure, stiffness_figure, sweep_state_figure
+    from .figures import (
+        backlash_figure,
+        branch_png,
+        call,
+        floquet_figure,
+        map_png,
+        stiffness_figure,
+        sweep_state_figure,
+    )
 
     # figures of what the batch does not change, drawn by its workers (in this process
     # they kept both workers idle)
@@ -242,7 +249,6 @@ def _reproduce(out, quick, executor, workers, fresh, res, stages, writer) -> Rep
     # switching with the figures' text layout at every interval slowed them by half
     # (a repeated run, whose batch above is loaded in a second, met the writer here)
     writer.wait()
-    bar = stages.stage(STAGES[3], 6)  # the f1 map, 2 x 2 of the branches, the responses
     from .mechanisms import mechanisms_section
 
     points, dead_points = pick(done, "polynomial", "sweep"), pick(done, "dead zone", "sweep")
@@ -251,41 +257,40 @@ def _reproduce(out, quick, executor, workers, fresh, res, stages, writer) -> Rep
         "dead zone": (dead_points, pick(done, "dead zone", "rest")),
     }
     points.update(pick(done, "polynomial", "chaotic"))
-    max_u = [sw.maxima("u") for sw in maps]
-    min_v = [sw.minima("v") for sw in maps]
-    motion_v = [sw.motion("v") for sw in maps]
-    fig = plots.map_figure(
-        np.array(res.map_f1),
-        map_lam,
-        max_u,
-        min_v,
-        motion_v,
-        title="light-load scene with f1 varied",
-        names=("f1", "lambda", "u", "v"),
-    )
-    plots.save_figure(fig, out / "map_f1_lambda.png")
-    bar.step()
+    # The figures of the batch's results are drawn by the workers, side by side (drawn
+    # here, one after another, they left both workers idle for about 5 s of a first run)
+    jobs = [
+        (
+            map_png,
+            (
+                np.array(res.map_f1),
+                map_lam,
+                [sw.maxima("u") for sw in maps],
+                [sw.minima("v") for sw in maps],
+                [sw.motion("v") for sw in maps],
+                out / "map_f1_lambda.png",
+            ),
+        )
+    ]
     branches = {case: done[("branches", case)] for case, _, _ in CASES}
     for case, _, f1 in CASES:
-        fig = plots.branch_figure(
-            branches[case],
-            ("u", "v"),
-            sweeps=by_case[case],
-            title=f"{case} load, f1 = {f1}: periodic branches over the sweeps",
-            system=systems[case],
-        )
-        plots.save_figure(fig, out / f"continuation_{case}.png")
-        floquet_figure(
-            branches[case],
-            out / f"floquet_{case}.png",
-            f"{case} load, f1 = {f1}",
-            f"{systems[case].name}, scene values (no overrides); branches continued both ways "
-            "from the periodic points of the forward sweep",
+        title = f"{case} load, f1 = {f1}: periodic branches over the sweeps"
+        jobs.append((branch_png, (branches[case], by_case[case], title, systems[case], out / case)))
+        jobs.append(
+            (
+                floquet_figure,
+                (
+                    branches[case],
+                    out / f"floquet_{case}.png",
+                    f"{case} load, f1 = {f1}",
+                    f"{systems[case].name}, scene values (no overrides); branches continued "
+                    "both ways from the periodic points of the forward sweep",
+                ),
+            )
         )
         (out / "data" / f"continuation_{case}.json").write_text(
             dumps([b.describe() for b in branches[case]]), encoding="utf-8"
         )
-        bar.step(n=2)
     from .response import response_section, run_response
 
     responses = {k[1:]: r for k, r in done.items() if k[0] == "response"}
@@ -297,8 +302,10 @@ def _reproduce(out, quick, executor, workers, fresh, res, stages, writer) -> Rep
         quick=quick,
         done=responses,
         save=lambda result, path: writer.submit(save_all, result, path),
+        figures=jobs,
     )
-    bar.step()
+    bar = stages.stage(STAGES[3], len(jobs))
+    map_tasks(call, jobs, executor=executor, workers=workers, on_result=lambda _: bar.step())
     from .report_sensitivity import sensitivity_section
     from .sensitivity import SCENES, physical_scales, run_sensitivity
 

@@ -100,11 +100,13 @@ def run_response(
     quick: bool,
     done: dict | None = None,
     save=None,
+    figures: list | None = None,
 ) -> list:
     """The frequency responses (figures and data under ``out``), one per (case, lambda);
     ``done``: ``(case, lambda) -> FrequencyResponse`` already computed (the rest are
     computed here); ``save(response, path)`` writes a response's files (default
-    ``export.save_all`` here and now)."""
+    ``export.save_all`` here and now); ``figures``: a list the ``(function, args)`` of each
+    figure is appended to, for the caller to draw (default: drawn here)."""
     from gearsym.solver.export import save_all
     from gearsym.solver.sweep.frequency import frequency_response
 
@@ -128,7 +130,7 @@ def run_response(
             att = _attractor(points.get((case, lam)), sols, coords)
             rows.append(ResponseCase(case, f1, lam, resp, sols, att))
             per_lambda[lam] = resp
-        response_figure(
+        figure = (
             per_lambda,
             out / f"response_{case}.png",
             f"{case} load, f1 = {f1}: period-1 response over ω̄ (harmonic balance, H = {harmonics})",
@@ -137,6 +139,10 @@ def run_response(
             "rest state); stability by Hill's method; the study's ω̄ = 0.5 marked",
             OMEGA,
         )
+        if figures is None:
+            response_figure(*figure)
+        else:
+            figures.append((response_figure, figure))
     return rows
 
 

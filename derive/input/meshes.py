@@ -202,6 +202,12 @@ def _iso_stiffness(t: Table, pair: PairGeometry, gears: tuple[Gear, Gear]) -> Me
     )
 
 
+# The potential-energy results of this process, by everything they are computed from: a
+# process that loads several variants of one scene (a map over open values, reproduce's
+# sensitivity stage) parsed the same pairs again, 70 ms each.
+_PEM_DONE: dict = {}
+
+
 def _pem_stiffness(t: Table, pair: PairGeometry, gears: tuple[Gear, Gear]) -> MeshStiffness:
     """Sliced potential-energy stiffness (``derive/mesh/pem.py``); the Fourier coefficients are
     rounded to 9 significant digits so that generated files do not depend on the last bits
@@ -219,24 +225,36 @@ def _pem_stiffness(t: Table, pair: PairGeometry, gears: tuple[Gear, Gear]) -> Me
                 f"gear '{gear.id}' is undercut; the potential-energy tooth model assumes a full "
                 "involute -- raise its profile_shift or give the stiffness as harmonics",
             )
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        try:
-            res = pem_stiffness(
-                pair,
-                [(g.material.youngs_modulus, g.material.poisson_ratio) for g in gears],
-                [g.bore_radius for g in gears],
-                slices=slices,
-                harmonics=harmonics,
-                samples=samples,
-                names=tuple(g.id for g in gears),
-            )
-        except ValueError as err:
-            raise t.error(
-                "source", f"the potential-energy method cannot be applied: {err}"
-            ) from None
-    for w in caught:
-        warnings.warn(f"{t.where('source')}: {w.message}", stacklevel=3)
+    key = (
+        pair,
+        tuple((g.material.youngs_modulus, g.material.poisson_ratio) for g in gears),
+        tuple(g.bore_radius for g in gears),
+        slices,
+        harmonics,
+        samples,
+        tuple(g.id for g in gears),
+    )
+    if key not in _PEM_DONE:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                res = pem_stiffness(
+                    pair,
+                    key[1],
+                    key[2],
+                    slices=slices,
+                    harmonics=harmonics,
+                    samples=samples,
+                    names=key[6],
+                )
+            except ValueError as err:
+                raise t.error(
+                    "source", f"the potential-energy method cannot be applied: {err}"
+                ) from None
+        _PEM_DONE[key] = (res, tuple(str(w.message) for w in caught))
+    res, said = _PEM_DONE[key]
+    for message in said:
+        warnings.warn(f"{t.where('source')}: {message}", stacklevel=3)
 
     def r9(x: float) -> float:
         return float(f"{x:.9g}")
