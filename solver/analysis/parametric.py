@@ -1,0 +1,226 @@
+"""Parametric instability from the meshes' stiffness variation, with their phases (issue 26).
+
+The linear model of a gear set (a ``STRUCTURE`` mapping: ``M``, ``R``, the springs' mean
+stiffnesses; ``solver.analysis.modes``) with each mesh's stiffness varying about its mean,
+
+    ``M q'' + (K_0 + sum_j k_j v_j(t) r_j r_j^T) q = 0``,
+
+``r_j`` the mesh's row of ``R``, ``k_j`` its mean stiffness and ``v_j`` its relative variation,
+one waveform for every mesh of a kind, delayed by the mesh's phase ``gamma_j`` (in mesh
+periods ``T = 2 pi / Omega``, ``Omega`` the mesh frequency in rad/s):
+
+    ``v_j(t) = sum_l a_l cos(l Omega (t - gamma_j T)) + b_l sin(l Omega (t - gamma_j T))``.
+
+**First order.**  With the flexible modes ``Phi`` normalised on ``M`` (``Phi^T K_0 Phi =
+diag(omega^2)``; a rigid-body mode is in the null space of every ``r_j`` and takes no part),
+``v_j = sum_l c_jl e^{i l Omega t} + c.c.`` with ``c_jl = (a_l - i b_l) / 2 e^{-2 pi i l
+gamma_j}``, and the modal excitation of harmonic ``l`` is
+
+    ``G_l = sum_j k_j c_jl (Phi^T r_j)(Phi^T r_j)^T``  (complex symmetric).
+
+By the method of multiple scales (our derivation; the form of the boundaries Lin and Parker,
+2002, "Planetary gear parametric instability caused by mesh stiffness variation", give),
+the **primary** instability of the modes at one natural frequency ``omega`` (one mode, or the
+two of a translational pair) near ``l Omega = 2 omega`` is the band
+
+    ``|l Omega - 2 omega| < s / omega``,
+
+``s`` the largest singular value of the block of ``G_l`` on those modes (``|G_l,ii|`` for a
+simple mode): write ``G_l``'s block by Takagi's factorisation ``U S U^T`` and the slow
+amplitudes decouple into Mathieu equations, each unstable for ``|sigma| < s_k / omega``.  A
+single degree of freedom gives Mathieu's ``delta = 1/4 +- epsilon / 2``.  Where the phases
+make ``s`` vanish the instability is **suppressed** to first order: for equally spaced planets
+a rotational mode's ``r_j . phi`` is the same at every planet, so ``G_l`` carries
+``sum_n e^{-2 pi i l gamma_sn}``, which is zero unless ``l Z_s / N`` is whole.
+
+**Floquet.**  :func:`multipliers` integrates the same equations over one mesh period in the
+flexible modal coordinates (``scipy``'s DOP853 on the monodromy matrix) and returns its
+eigenvalues; undamped, a stable set has them all on the unit circle.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.integrate
+import scipy.linalg
+
+__all__ = [
+    "Instability",
+    "Meshes",
+    "floquet_band",
+    "modal_basis",
+    "multipliers",
+    "primary_instabilities",
+    "unstable",
+]
+
+
+@dataclass(frozen=True)
+class Meshes:
+    """The varying springs: ``rows`` (their indices in ``R``), each one's phase in mesh
+    periods, and its waveform's ``a_l`` and ``b_l`` (``waveform[j] = ((a_1, b_1), ...)``,
+    relative to the mean stiffness)."""
+
+    rows: tuple[int, ...]
+    phases: tuple[float, ...]
+    waveform: tuple[tuple[tuple[float, float], ...], ...]
+
+    def __post_init__(self):
+        if not len(self.rows) == len(self.phases) == len(self.waveform):
+            raise ValueError("Meshes: rows, phases and waveform need one entry per mesh")
+
+
+@dataclass(frozen=True)
+class Instability:
+    """The first-order band of one primary instability: ``modes`` (indices into the
+    flexible modes), the harmonic ``l``, the natural frequency ``omega`` (rad/s), ``s``
+    (rad^2/s^2) and the band of the mesh frequency ``Omega`` in rad/s, ``lower`` to
+    ``upper`` (equal where suppressed)."""
+
+    modes: tuple[int, ...]
+    l: int  # noqa: E741 (the harmonic, as the papers write it)
+    omega: float
+    s: float
+    lower: float
+    upper: float
+
+    @property
+    def centre(self) -> float:
+        return 2.0 * self.omega / self.l
+
+    @property
+    def suppressed(self) -> bool:
+        return self.upper == self.lower
+
+
+def modal_basis(structure: dict, rigid_tolerance: float = 1e-10):
+    """``(omega, Phi, K_0, R, k)``: the flexible modes' frequencies (rad/s, ascending), their
+    shapes normalised on ``M``, and the mean stiffness matrix, ``R`` and ``k``."""
+    mass = np.asarray(structure["mass"], dtype=float)
+    R = np.asarray(structure["incidence"], dtype=float)
+    k = np.asarray(structure["stiffness"], dtype=float)
+    K0 = R.T @ (k[:, None] * R)
+    w2, vec = scipy.linalg.eigh(K0, np.diag(mass))
+    flexible = w2 > rigid_tolerance * np.max(np.abs(w2))
+    return np.sqrt(w2[flexible]), vec[:, flexible], K0, R, k
+
+
+def _excitation(structure: dict, meshes: Meshes, l: int) -> np.ndarray:  # noqa: E741
+    """``G_l`` on the flexible modes (module text)."""
+    _, Phi, _, R, k = modal_basis(structure)
+    G = np.zeros((Phi.shape[1], Phi.shape[1]), dtype=complex)
+    for row, gamma, wave in zip(meshes.rows, meshes.phases, meshes.waveform, strict=True):
+        if l > len(wave):
+            continue
+        a, b = wave[l - 1]
+        c = 0.5 * (a - 1j * b) * np.exp(-2j * math.pi * l * gamma)
+        p = Phi.T @ R[row]
+        G += k[row] * c * np.outer(p, p)
+    return G
+
+
+def primary_instabilities(
+    structure: dict, meshes: Meshes, harmonics: int, group_tolerance: float = 1e-7
+) -> list[Instability]:
+    """The first-order band of every primary instability ``l Omega = 2 omega``, ``l = 1 ..
+    harmonics``, modes within ``group_tolerance`` (relative) of one frequency taken
+    together (module text), in the order of ``l`` and then of ``omega``."""
+    omega, *_ = modal_basis(structure)
+    groups: list[list[int]] = []
+    for i, w in enumerate(omega):
+        if groups and abs(w - omega[groups[-1][0]]) <= group_tolerance * omega[-1]:
+            groups[-1].append(i)
+        else:
+            groups.append([i])
+    out = []
+    for h in range(1, harmonics + 1):
+        G = _excitation(structure, meshes, h)
+        for g in groups:
+            w = float(np.mean(omega[g]))
+            block = G[np.ix_(g, g)]
+            s = float(np.linalg.svd(block, compute_uv=False).max())
+            if s <= 1e-12 * np.abs(G).max(initial=0.0):
+                s = 0.0
+            out.append(Instability(tuple(g), h, w, s, (2 * w - s / w) / h, (2 * w + s / w) / h))
+    return out
+
+
+def multipliers(
+    structure: dict, meshes: Meshes, Omega: float, *, rtol: float = 1e-11
+) -> np.ndarray:
+    """The Floquet multipliers of the set at the mesh frequency ``Omega`` (rad/s): the
+    eigenvalues of the monodromy matrix over one mesh period, in the flexible modal
+    coordinates ``(eta, d eta / d(Omega t))``, by DOP853 at ``rtol``."""
+    omega, Phi, _, R, k = modal_basis(structure)
+    n = omega.size
+    P = np.array([Phi.T @ R[row] for row in meshes.rows])  # (meshes, n)
+    weights = np.array([k[row] for row in meshes.rows])
+
+    # in the mesh's angle s = Omega t (one period is 2 pi), so that eta and its
+    # derivative are of one size
+    def v(s: float) -> np.ndarray:
+        out = np.zeros(len(meshes.rows))
+        for j, (gamma, wave) in enumerate(zip(meshes.phases, meshes.waveform, strict=True)):
+            for h, (a, b) in enumerate(wave, start=1):
+                phase = h * (s - 2.0 * math.pi * gamma)
+                out[j] += a * math.cos(phase) + b * math.sin(phase)
+        return out
+
+    def rhs(s: float, y: np.ndarray) -> np.ndarray:
+        X = y.reshape(2 * n, 2 * n)
+        stiff = (np.diag(omega**2) + P.T @ ((weights * v(s))[:, None] * P)) / Omega**2
+        return np.vstack([X[n:], -stiff @ X[:n]]).ravel()
+
+    sol = scipy.integrate.solve_ivp(
+        rhs,
+        (0.0, 2.0 * math.pi),
+        np.eye(2 * n).ravel(),
+        method="DOP853",
+        rtol=rtol,
+        atol=rtol * 1e-2,
+    )
+    if not sol.success:
+        raise RuntimeError(f"the monodromy matrix could not be integrated: {sol.message}")
+    return np.linalg.eigvals(sol.y[:, -1].reshape(2 * n, 2 * n))
+
+
+def unstable(mu: np.ndarray, threshold: float = 1e-7) -> bool:
+    """Whether a multiplier lies outside the unit circle by more than ``threshold`` (the
+    undamped set's multipliers sit on it, to the integration's error, where stable)."""
+    return bool(np.abs(mu).max() > 1.0 + threshold)
+
+
+def floquet_band(
+    structure: dict, meshes: Meshes, ins: Instability, *, span: float = 3.0, tol: float = 1e-9
+) -> tuple[float, float]:
+    """The edges of the instability band ``ins`` by the Floquet multipliers: bisection from
+    its centre (which must be unstable) to the first stable point found stepping outwards
+    by quarter first-order half-widths (at most ``span`` of them), to ``tol`` relative.  Raises ``ValueError`` where either end fails."""
+    centre, half = ins.centre, 0.5 * (ins.upper - ins.lower)
+    if half <= 0.0 or not unstable(multipliers(structure, meshes, centre)):
+        raise ValueError(f"harmonic {ins.l}, modes {ins.modes}: stable at the band's centre")
+    edges = []
+    for sign in (-1.0, 1.0):
+        # out from the centre in quarter half-widths to the first stable point (a
+        # neighbouring band, a combination resonance, may begin past a stable gap)
+        inside = centre
+        for step in np.arange(1.25, span + 1e-9, 0.25):
+            outside = centre + sign * step * half
+            if not unstable(multipliers(structure, meshes, outside)):
+                break
+            inside = outside
+        else:
+            raise ValueError(
+                f"harmonic {ins.l}, modes {ins.modes}: still unstable {span} half-widths out"
+            )
+        while abs(outside - inside) > tol * centre:
+            mid = 0.5 * (inside + outside)
+            if unstable(multipliers(structure, meshes, mid)):
+                inside = mid
+            else:
+                outside = mid
+        edges.append(0.5 * (inside + outside))
+    return edges[0], edges[1]

@@ -1,0 +1,135 @@
+"""Parametric instability from mesh stiffness variation and mesh phasing (issue 26).
+
+References: Mathieu's first instability tongue to second order (Nayfeh and Mook, 1979,
+*Nonlinear Oscillations*, section 5.2: ``delta = 1/4 +- q/2 - q^2/8 + O(q^3)`` for
+``x'' + (delta + q cos s) x = 0``); the selection rules of mesh phasing for equally spaced
+planets (Lin and Parker, 2002, "Planetary gear parametric instability caused by mesh
+stiffness variation"; Parker, 2000, "A physical explanation for the effectiveness of planet
+phasing to suppress planetary gear vibration"); and the first-order band of
+``primary_instabilities`` against the Floquet multipliers of the same equations, an
+independent (numerical) method.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+import scipy.optimize
+from gearsym.derive.equations.planetary import derive_planetary
+from gearsym.derive.input.planetary import load_planetary
+from gearsym.derive.input.scene import resolve_target
+from gearsym.solver.analysis.modes import planetary_modes
+from gearsym.solver.analysis.parametric import (
+    Meshes,
+    floquet_band,
+    multipliers,
+    primary_instabilities,
+)
+
+ONE_SPRING = {"mass": (1.0,), "incidence": ((1.0,),), "stiffness": (1.0,)}
+
+
+def test_one_spring_is_mathieu():
+    """x'' + (1 + eps cos Omega t) x = 0 is Mathieu's equation in s = Omega t with
+    delta = 1 / Omega^2, q = eps / Omega^2: the band's edges by the multipliers agree with
+    the second-order closed form to its third-order term (q^3 / 32 in delta, below 1e-6
+    of Omega here), and the first-order band of ``primary_instabilities`` with it to
+    O(q^2)."""
+    eps = 0.1
+    meshes = Meshes((0,), (0.0,), (((eps, 0.0),),))
+    (ins,) = primary_instabilities(ONE_SPRING, meshes, 1)
+    assert ins.s == pytest.approx(eps / 2, rel=1e-12)
+    lo, hi = floquet_band(ONE_SPRING, meshes, ins)
+
+    def edge(sign):
+        def gap(Omega):
+            delta, q = 1 / Omega**2, eps / Omega**2
+            return delta - (0.25 + sign * q / 2 - q**2 / 8)
+
+        return scipy.optimize.brentq(gap, 1.5, 2.5, xtol=1e-14)
+
+    # the lower edge in Omega is the upper edge in delta = 1 / Omega^2
+    assert abs(lo - edge(+1)) <= 2e-6 * lo
+    assert abs(hi - edge(-1)) <= 2e-6 * hi
+    assert abs(ins.lower - lo) <= 2 * (eps / 4) ** 2 * lo
+    assert abs(ins.upper - hi) <= 2 * (eps / 4) ** 2 * hi
+
+
+def _set(scene: str, sun_teeth: int, ring_teeth: int, eps: float, sin: float = 0.0):
+    """The structure of a shipped set with the tooth counts given, its mesh springs varying
+    by ``eps`` (and ``sin``) in each of four harmonics, each delayed by its mesh phase;
+    the labels of its flexible modes."""
+    ps = load_planetary(resolve_target(scene))
+    ps = replace(ps, sun_teeth=sun_teeth, ring_teeth=ring_teeth)
+    st = derive_planetary(ps)
+    S = st.as_structure()
+    rows = [i for i, kind in enumerate(S["kinds"]) if kind == "mesh"]
+    phases = []
+    for i in rows:
+        name = S["coordinates"][i]  # sp<n> or rp<n>
+        phases.append(st.phases[int(name[2:]) - 1][0 if name[0] == "s" else 1])
+    meshes = Meshes(tuple(rows), tuple(phases), tuple(((eps, sin),) * 4 for _ in rows))
+    labels = [m.label for m in planetary_modes(S, scene).modes if m.label != "rigid-body"]
+    return S, meshes, labels, ps.planets
+
+
+# a mode's planets move in the cyclic order k (rotational 0, translational +-1, a planet
+# mode of four planets 2): harmonic l of the mesh stiffness drives its primary instability
+# only where l Z_s is 0 or +-2k modulo N
+ORDER = {"rotational": (0,), "translational": (1, -1), "planet": (2,)}
+
+
+@pytest.mark.parametrize(
+    "scene, sun, ring",
+    [("lin-parker-1999-3", 31, 89), ("lin-parker-1999-4", 29, 91), ("lin-parker-1999-4", 30, 90)],
+)
+def test_phasing_suppresses_what_the_selection_rules_say(scene, sun, ring):
+    """First order: the band of every primary instability (harmonics 1 to 4) is empty
+    exactly where the selection rule says, and no wider than 1e-12 of the largest there."""
+    S, meshes, labels, N = _set(scene, sun, ring, 0.05, 0.02)
+    found = primary_instabilities(S, meshes, 4)
+    largest = max(i.s for i in found)
+    for ins in found:
+        label = labels[ins.modes[0]]
+        assert len(ins.modes) == (2 if label == "translational" else 1), ins
+        driven = any((ins.l * sun - s * 2 * k) % N == 0 for k in ORDER[label] for s in (1, -1))
+        driven = driven or (ins.l * sun) % N == 0
+        assert (ins.s > 1e-12 * largest) == driven, (label, ins.l, ins.s)
+
+
+def test_floquet_agrees_with_the_first_order_band():
+    """Lin and Parker's three-planet set with Z_s = 31: the edges of two bands found by the
+    Floquet multipliers (a translational pair at l = 1 and a rotational mode at l = 3)
+    differ from the first-order closed form by O(eps^2): below a fifth of the half-width
+    at eps = 0.05, and about half that at eps = 0.025.  A band the phasing suppresses
+    (the same rotational mode at l = 1) is stable at its centre to the integration's
+    error, where the band it keeps (l = 3) grows by more than 1 % a period."""
+    ratios = {}
+    for eps in (0.05, 0.025):
+        S, meshes, labels, _ = _set("lin-parker-1999-3", 31, 89, eps)
+        found = primary_instabilities(S, meshes, 3)
+        upper = [i for i in found if i.modes[0] >= len(labels) - 6]  # the mesh modes
+        pair = next(i for i in upper if i.l == 1 and labels[i.modes[0]] == "translational")
+        rot = next(i for i in upper if i.l == 3 and labels[i.modes[0]] == "rotational")
+        for ins in (pair, rot):
+            half = 0.5 * (ins.upper - ins.lower)
+            lo, hi = floquet_band(S, meshes, ins)
+            err = max(abs(lo - ins.lower), abs(hi - ins.upper)) / half
+            assert err <= 0.2, (eps, ins, lo, hi)
+            ratios.setdefault(ins.modes, []).append(err)
+    for modes, (big, small) in ratios.items():
+        assert 0.35 <= small / big <= 0.65, (modes, big, small)
+    S, meshes, labels, _ = _set("lin-parker-1999-3", 31, 89, 0.05)
+    found = primary_instabilities(S, meshes, 3)
+    kept = next(i for i in found if i.l == 3 and i.modes == rot.modes)
+    cut = next(i for i in found if i.l == 1 and i.modes == rot.modes)
+    assert cut.suppressed and not kept.suppressed
+    assert np.abs(multipliers(S, meshes, cut.centre)).max() - 1 < 1e-9
+    assert np.abs(multipliers(S, meshes, kept.centre)).max() - 1 > 1e-2
+    # the growth at the centre is the first-order rate s / (2 omega) over a mesh period
+    rate = kept.s / (2 * kept.omega) * 2 * math.pi / kept.centre
+    grown = math.log(np.abs(multipliers(S, meshes, kept.centre)).max())
+    assert grown == pytest.approx(rate, rel=0.1)
