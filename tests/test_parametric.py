@@ -12,13 +12,21 @@ independent (numerical) method.
 
 from __future__ import annotations
 
+import json
 import math
+import subprocess
+import sys
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
 import scipy.optimize
-from gearsym.derive.equations.planetary import derive_planetary
+from gearsym.derive.equations.planetary import (
+    derive_planetary,
+    planetary_meshes,
+    rectangular_wave,
+)
 from gearsym.derive.input.planetary import load_planetary
 from gearsym.derive.input.scene import resolve_target
 from gearsym.solver.analysis.modes import planetary_modes
@@ -133,3 +141,106 @@ def test_floquet_agrees_with_the_first_order_band():
     rate = kept.s / (2 * kept.omega) * 2 * math.pi / kept.centre
     grown = math.log(np.abs(multipliers(S, meshes, kept.centre)).max())
     assert grown == pytest.approx(rate, rel=0.1)
+
+
+# -- the command: gearsym modes SET --parametric -------------------------------------------
+
+VARIATION = """
+[planetary.variation]
+sun_planet = { contact_ratio = 1.6, amplitude = 0.1 }
+ring_planet = { contact_ratio = 1.8, amplitude = 0.1 }
+ring_sun_phase = 0.25
+harmonics = 3
+"""
+
+
+def _file(tmp_path, extra: str = VARIATION, teeth: str = "sun_teeth = 31\nring_teeth = 89\n"):
+    text = Path(resolve_target("lin-parker-1999-3")).read_text(encoding="utf-8")
+    text = text.replace("planets = 3\n", "planets = 3\n" + teeth, 1)
+    path = tmp_path / "set.toml"
+    path.write_text(text + extra, encoding="utf-8")
+    return path
+
+
+def run(*args):
+    return subprocess.run(
+        [sys.executable, "-m", "gearsym", *args], capture_output=True, text=True, timeout=300
+    )
+
+
+def test_rectangular_wave_is_its_fourier_series():
+    """The waveform of a mesh with one more pair in contact during the first c - floor(c)
+    of each mesh period: its harmonics against an FFT of the sampled wave (an independent
+    method), to the FFT's sampling error."""
+    for c, amp in ((1.6, 0.2), (1.25, 0.5), (2.4, 0.1)):
+        wave = rectangular_wave(c, amp, 5)
+        n = 1 << 16
+        t = (np.arange(n) + 0.5) / n
+        v = amp * ((t < c - math.floor(c)) - (c - math.floor(c)))
+        F = np.fft.rfft(v) / n
+        for h, (a, b) in enumerate(wave, start=1):
+            assert a == pytest.approx(2 * F[h].real, abs=1e-4 * amp)
+            assert b == pytest.approx(-2 * F[h].imag, abs=1e-4 * amp)
+
+
+def test_cli_parametric(tmp_path):
+    """`gearsym modes SET --parametric`: every primary band, the ones the phasing
+    suppresses marked (rotational modes of Z_s = 31, N = 3: all but l = 3), the bands
+    those of ``primary_instabilities`` on the file's waveform and phases, in Hz."""
+    path = _file(tmp_path)
+    done = run("modes", str(path), "--parametric", "--json")
+    assert done.returncode == 0, done.stderr
+    bands = json.loads(done.stdout)["parametric"]["bands"]
+    assert {b["type"] for b in bands} == {"rotational", "translational"}
+    for b in bands:
+        if b["type"] == "rotational":
+            assert b["suppressed"] == (b["harmonic"] != 3), b
+        else:
+            assert not b["suppressed"], b
+    ps = load_planetary(path)
+    st = derive_planetary(ps)
+    rows, phases, waves = planetary_meshes(st)
+    found = primary_instabilities(st.as_structure(), Meshes(rows, phases, waves), 3)
+    assert len(found) == len(bands)
+    for ins, b in zip(found, bands, strict=True):
+        assert b["lower_hz"] == pytest.approx(ins.lower / (2 * math.pi), rel=1e-12)
+        assert b["upper_hz"] == pytest.approx(ins.upper / (2 * math.pi), rel=1e-12)
+    # the ring meshes lag their planet's sun mesh by the stated quarter period
+    assert phases[1] == pytest.approx((st.phases[0][1] + 0.25) % 1.0)
+    done = run("modes", str(path), "--parametric")
+    assert done.returncode == 0, done.stderr
+    assert "suppressed by the phasing" in done.stdout
+    assert "first order" in done.stdout
+
+
+@pytest.mark.parametrize(
+    "extra, teeth, where",
+    [
+        (VARIATION, "", "sun_teeth"),
+        (VARIATION.replace("1.6", "0.9"), None, "contact_ratio"),
+        (
+            VARIATION.replace("amplitude = 0.1 }\nring", "amplitude = 3.0 }\nring"),
+            None,
+            "amplitude",
+        ),
+        (VARIATION.replace("harmonics = 3", "harmonic = 3"), None, "harmonic"),
+        ("", None, "[planetary.variation]"),
+    ],
+)
+def test_cli_parametric_refusals(tmp_path, extra, teeth, where):
+    """A variation without tooth counts, a contact ratio below 1, a stiffness that would
+    fall to zero, an unknown key, and --parametric on a set without a variation: one line
+    naming the input, exit 2."""
+    path = _file(tmp_path, extra) if teeth is None else _file(tmp_path, extra, teeth)
+    done = run("modes", str(path), "--parametric")
+    assert done.returncode == 2, (done.stdout, done.stderr)
+    assert len(done.stderr.strip().splitlines()) == 1, done.stderr
+    assert where in done.stderr
+    assert "Traceback" not in done.stderr
+
+
+def test_cli_parametric_refused_on_a_tree():
+    done = run("modes", "reference-light", "--parametric")
+    assert done.returncode == 2
+    assert len(done.stderr.strip().splitlines()) == 1
+    assert "planetary" in done.stderr

@@ -29,6 +29,19 @@ def register(sub) -> None:
     )
     p.add_argument("--plot", metavar="FILE", help="write the resonance diagram (PNG, PDF, SVG)")
     p.add_argument("--out", metavar="DIR", help="also write modes.json, .csv, .mat (--format)")
+    p.add_argument(
+        "--parametric",
+        action="store_true",
+        help="a planetary set: the primary parametric instabilities its meshes' stiffness "
+        "variation ([planetary.variation]) drives, first order, each band of the mesh "
+        "frequency or marked suppressed by the phasing (default: off)",
+    )
+    p.add_argument(
+        "--floquet",
+        action="store_true",
+        help="with --parametric: each band's edges also by the Floquet multipliers (a second "
+        "or two a band; default: off)",
+    )
     format_option(p, "modes")
     p.set_defaults(func=_cmd_modes)
 
@@ -54,6 +67,11 @@ def _cmd_modes(args) -> int:
     path = resolve_target(args.target)
     if is_planetary(path):
         return _planetary(path, args)
+    if args.parametric or args.floquet:
+        raise Fail(
+            "--parametric: the parametric-instability table is for planetary sets (a "
+            "[planetary] file); run without it"
+        )
     if args.plot:
         figure_file(args.plot, "--plot")
     module = module_for(args.target)
@@ -120,6 +138,14 @@ def _planetary(path, args) -> int:
                 "no mesh frequency to draw or meet; run without it"
             )
     ps = load_planetary(path)
+    if (args.parametric or args.floquet) and ps.variation is None:
+        raise Fail(
+            f"--parametric: {path} has no [planetary.variation] table (the meshes' contact "
+            "ratios and stiffness amplitude, and sun_teeth, ring_teeth for their phases); "
+            "add it (docs/user-guide.md, Planetary sets)"
+        )
+    if args.floquet and not args.parametric:
+        raise Fail("--floquet: only with --parametric; add --parametric")
     st = derive_planetary(ps)
     result = planetary_modes(st.as_structure(), ps.name)
     data = {
@@ -146,6 +172,10 @@ def _planetary(path, args) -> int:
             for m in result.modes
         ],
     }
+    if args.parametric:
+        from ._parametric import parametric_table
+
+        data["parametric"] = parametric_table(st, result, floquet=args.floquet)
     if args.out:
         from gearsym.solver.export import Document
 
@@ -178,4 +208,8 @@ def _planetary(path, args) -> int:
     for m in result.modes:
         counts[m.label] = counts.get(m.label, 0) + 1
     print("  " + ", ".join(f"{n} {label}" for label, n in counts.items()))
+    if args.parametric:
+        from ._parametric import print_parametric
+
+        print_parametric(data["parametric"])
     return 0

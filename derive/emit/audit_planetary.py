@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..equations.planetary import PlanetaryStructure
+from ..equations.planetary import PlanetaryStructure, rectangular_wave
 from ..escape import markdown
 
 __all__ = ["planetary_index", "planetary_name", "planetary_page"]
@@ -54,10 +54,14 @@ def planetary_page(st: PlanetaryStructure, command: str, source: str) -> str:
         "rotating frame), no damping. It gives the natural frequencies and modes "
         "(`gearsym modes`), each typed rotational, translational or planet with its "
         "multiplicity.\n",
-        "**Not modelled yet** (issue 26): the meshes' stiffness variation and their phasing "
-        "round the carrier, backlash and tooth separation, damping, the rotating frame's "
-        "gyroscopic and centripetal terms, and therefore simulation, sweeps, maps, periodic "
-        "orbits and frequency responses of a planetary set: those commands refuse it.\n",
+        "The meshes' stiffness variation, each mesh delayed by its phase round the carrier, "
+        "enters the linear analysis of parametric instability (`gearsym modes "
+        "--parametric`, with a `[planetary.variation]` table and the tooth counts; "
+        "`docs/analysis.md`).\n",
+        "**Not modelled yet** (issue 26): backlash and tooth separation, damping, the "
+        "rotating frame's gyroscopic and centripetal terms, and therefore simulation, "
+        "sweeps, maps, periodic orbits and frequency responses of a planetary set: those "
+        "commands refuse it.\n",
         "## Kinematic graph\n",
         f"Bodies ({bodies}): carrier `c`, ring `r`, sun `s` and {n} planets, {spacing}, at "
         f"ψ = {angles} round the carrier. Each planet meshes with the sun (external) and "
@@ -122,8 +126,10 @@ def planetary_index(structures: list) -> str:
         "\n## Planetary sets\n",
         "A planetary set closes gear loops (each planet meshes with the sun and the ring), so "
         "it is written as a `[planetary]` table and derived in each body's own coordinates "
-        "(`derive/equations/planetary.py`). So far its linear model and modes are derived "
-        "(`gearsym modes`); the other commands take trees of meshes only (issue 26).\n",
+        "(`derive/equations/planetary.py`). So far its linear model is derived: its modes "
+        "and the parametric instabilities of its meshes' stiffness variation (`gearsym "
+        "modes`, `--parametric`); the nonlinear commands take trees of meshes only (issue "
+        "26).\n",
         "| set | planets | model | rigid-body modes | page |",
         "|---|---|---|---|---|",
     ]
@@ -163,4 +169,23 @@ def _phase_lines(st: PlanetaryStructure) -> list[str]:
         "",
         "The sun meshes are " + ("all in phase." if same else "not all in phase.") + "\n",
     ]
+    v = ps.variation
+    if v is None:
+        return out
+    out += [
+        "## Stiffness variation\n",
+        "Each mesh's stiffness about its mean, `k(t) / k_m - 1 = sum_l a_l cos(l phi) + b_l "
+        "sin(l phi)` in the mesh angle `phi` from the start of its extra pair's contact "
+        "(a rectangular wave: one more tooth pair in contact during the fraction `c - "
+        "floor(c)` of each mesh period, the stiffness then higher by the amplitude times the "
+        f"mean; `derive/equations/planetary.py`); each ring mesh {v.ring_sun_phase:g} mesh "
+        "periods after its planet's sun mesh (stated in the file: it follows from the "
+        "teeth's geometry, not from the counts).\n",
+        "| mesh | contact ratio | amplitude | l | a_l | b_l |",
+        "|---|---|---|---|---|---|",
+    ]
+    for kind, (c, amp) in (("sun-planet", v.sun), ("ring-planet", v.ring)):
+        for h, (a, b) in enumerate(rectangular_wave(c, amp, v.harmonics), start=1):
+            out.append(f"| {kind} | {c:g} | {amp:g} | {h} | {a:.6g} | {b:.6g} |")
+    out.append("")
     return out

@@ -63,7 +63,13 @@ import sympy as sp
 
 from ..input.planetary import CENTRAL, PlanetarySet
 
-__all__ = ["PlanetaryStructure", "derive_planetary", "mesh_phases"]
+__all__ = [
+    "PlanetaryStructure",
+    "derive_planetary",
+    "mesh_phases",
+    "planetary_meshes",
+    "rectangular_wave",
+]
 
 _SHORT = {"carrier": "c", "ring": "r", "sun": "s"}
 
@@ -237,3 +243,42 @@ def derive_planetary(ps: PlanetarySet) -> PlanetaryStructure:
         rigid_body_modes=len(names) - rank,
         phases=mesh_phases(ps),
     )
+
+
+def rectangular_wave(contact_ratio: float, amplitude: float, harmonics: int) -> tuple:
+    """``((a_1, b_1), ...)``: the harmonics of ``k(t) / k_m - 1`` for a mesh with one more
+    tooth pair in contact during the first fraction ``d = c - floor(c)`` of each mesh
+    period, its stiffness then higher by ``amplitude`` times the mean (the rectangular
+    waves of Lin and Parker, 2002): ``a_l = A sin(2 pi l d) / (pi l)``, ``b_l = A (1 -
+    cos(2 pi l d)) / (pi l)``, in ``cos`` and ``sin`` of ``l`` times the mesh angle."""
+    d = contact_ratio - math.floor(contact_ratio)
+    return tuple(
+        (
+            amplitude * math.sin(2 * math.pi * h * d) / (math.pi * h),
+            amplitude * (1.0 - math.cos(2 * math.pi * h * d)) / (math.pi * h),
+        )
+        for h in range(1, harmonics + 1)
+    )
+
+
+def planetary_meshes(st: PlanetaryStructure) -> tuple[tuple, tuple, tuple]:
+    """``(rows, phases, waveforms)`` of the set's meshes for the parametric analysis
+    (``solver.analysis.parametric.Meshes``): each mesh's row of ``R``, its phase in mesh
+    periods (a ring mesh's further by ``ring_sun_phase``) and its rectangular wave.
+    Needs the file's ``[planetary.variation]`` and tooth counts."""
+    v = st.planetary.variation
+    if v is None or st.phases is None:
+        raise ValueError("the set's file has no [planetary.variation] with tooth counts")
+    waves = {
+        "s": rectangular_wave(*v.sun, v.harmonics),
+        "r": rectangular_wave(*v.ring, v.harmonics),
+    }
+    rows, phases, waveforms = [], [], []
+    for i, (name, kind) in enumerate(zip(st.springs, st.kinds, strict=True)):
+        if kind != "mesh":
+            continue
+        sun_phase, ring_phase = st.phases[int(name[2:]) - 1]
+        rows.append(i)
+        phases.append(sun_phase if name[0] == "s" else (ring_phase + v.ring_sun_phase) % 1.0)
+        waveforms.append(waves[name[0]])
+    return tuple(rows), tuple(phases), tuple(waveforms)

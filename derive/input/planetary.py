@@ -40,7 +40,7 @@ from pathlib import Path
 
 from .reader import InputError, Table, load_toml
 
-__all__ = ["DOFS", "Member", "PlanetarySet", "is_planetary", "load_planetary"]
+__all__ = ["DOFS", "Member", "PlanetarySet", "Variation", "is_planetary", "load_planetary"]
 
 DOFS = ("torsional", "lateral-torsional")
 CENTRAL = ("carrier", "ring", "sun")  # Lin and Parker's order of the central members
@@ -59,6 +59,23 @@ class Member:
 
 
 @dataclass(frozen=True)
+class Variation:
+    """The meshes' stiffness variation about their mean, for the parametric instability
+    (``gearsym modes --parametric``): each kind of mesh (sun-planet, ring-planet) a
+    rectangular wave, one more tooth pair in contact during the fraction ``c - floor(c)``
+    of each mesh period (``c`` the contact ratio), its stiffness then higher by
+    ``amplitude`` times the mean; every mesh of a kind delayed by its phase, the ring
+    meshes further by ``ring_sun_phase`` (mesh periods from a planet's sun mesh to its ring
+    mesh: it follows from the teeth's geometry, not from the counts, and is given here);
+    ``harmonics`` of each wave kept."""
+
+    sun: tuple[float, float]  # (contact ratio, amplitude)
+    ring: tuple[float, float]
+    ring_sun_phase: float
+    harmonics: int
+
+
+@dataclass(frozen=True)
 class PlanetarySet:
     name: str
     description: str
@@ -73,6 +90,7 @@ class PlanetarySet:
     alpha_r_deg: float  # ring-planet
     sun_teeth: int | None = None  # tooth counts, for the mesh phases (optional)
     ring_teeth: int | None = None
+    variation: Variation | None = None  # [planetary.variation] (optional)
 
     @property
     def planets(self) -> int:
@@ -115,6 +133,33 @@ def _mesh(t: Table) -> tuple[float, float]:
     alpha = t.number("pressure_angle_deg", low=0.0, high=60.0, low_open=True)
     t.finish()
     return k, alpha
+
+
+def _variation(t: Table, teeth: bool) -> Variation:
+    if not teeth:
+        raise t.error(
+            "sun_planet",
+            "the stiffness variation needs sun_teeth and ring_teeth in [planetary] (each "
+            "mesh's phase follows from them); add both",
+        )
+    waves = []
+    for kind in ("sun_planet", "ring_planet"):
+        w = t.table(kind)
+        c = w.number("contact_ratio", low=1.0, high=10.0)
+        amp = w.number("amplitude", low=0.0)
+        w.finish()
+        share = c - math.floor(c)
+        if amp * share >= 1.0:
+            raise w.error(
+                "amplitude",
+                f"{amp:g} at contact ratio {c:g} takes the stiffness to zero or below between "
+                f"the extra pair's contacts (amplitude x {share:.3g} must stay below 1)",
+            )
+        waves.append((c, amp))
+    phase = t.number("ring_sun_phase", 0.0, low=0.0, high=1.0, high_open=True)
+    harmonics = t.integer("harmonics", 3, low=1, high=32)
+    t.finish()
+    return Variation(waves[0], waves[1], phase, harmonics)
 
 
 def load_planetary(path: Path | str) -> PlanetarySet:
@@ -170,6 +215,8 @@ def load_planetary(path: Path | str) -> PlanetarySet:
     k_rp, alpha_r = _mesh(p.table("ring_planet"))
     members = {m: _member(p.table(m), m, False) for m in CENTRAL}
     members["planet"] = _member(p.table("planet"), "planet", True)
+    variation = p.table("variation", None)
+    variation = None if variation is None else _variation(variation, z_s is not None)
     p.finish()
     top.finish()
     if any(not math.isfinite(a) for a in angles):
@@ -188,4 +235,5 @@ def load_planetary(path: Path | str) -> PlanetarySet:
         alpha_r,
         z_s,
         z_r,
+        variation,
     )
