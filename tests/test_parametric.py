@@ -32,6 +32,7 @@ from gearsym.derive.input.scene import resolve_target
 from gearsym.solver.analysis.modes import planetary_modes
 from gearsym.solver.analysis.parametric import (
     Meshes,
+    combination_instabilities,
     floquet_band,
     multipliers,
     primary_instabilities,
@@ -143,6 +144,64 @@ def test_floquet_agrees_with_the_first_order_band():
     assert grown == pytest.approx(rate, rel=0.1)
 
 
+@pytest.mark.parametrize(
+    "scene, sun, ring",
+    [("lin-parker-1999-3", 31, 89), ("lin-parker-1999-4", 29, 91), ("lin-parker-1999-4", 30, 90)],
+)
+def test_combinations_follow_the_selection_rules(scene, sun, ring):
+    """First order, sum type: modes of cyclic orders k1 and k2 are driven by harmonic l
+    only where l Z_s + s1 k1 + s2 k2 is 0 modulo N for some signs s1, s2 (the product of
+    their shapes round the carrier against the meshes' phases; with k1 = k2 the primary
+    rule above): every band outside the rule is empty."""
+    S, meshes, labels, N = _set(scene, sun, ring, 0.05, 0.02)
+    found = combination_instabilities(S, meshes, 4)
+    largest = max(i.s for i in found)
+    assert all(i.omega_partner > i.omega for i in found)
+    kept = 0
+    for ins in found:
+        k1, k2 = ORDER[labels[ins.modes[0]]], ORDER[labels[ins.partner[0]]]
+        driven = any(
+            (ins.l * sun + s1 * a + s2 * b) % N == 0
+            for a in k1
+            for b in k2
+            for s1 in (1, -1)
+            for s2 in (1, -1)
+        )
+        if not driven:
+            assert ins.s <= 1e-12 * largest, (ins, labels[ins.modes[0]])
+        kept += driven and ins.s > 1e-12 * largest
+    # the rule is necessary, not sufficient: with one waveform on every mesh the
+    # variation is proportional to the mean stiffness there, and two planet modes, or a
+    # planet mode and another, can be orthogonal under it whatever the phases
+    assert kept > 0  # and the test is not empty
+
+
+def test_floquet_agrees_with_the_first_order_combination_band():
+    """The sum-type band of the upper translational pair and rotational mode of Lin and
+    Parker's three-planet set (l = 1, the widest of that pair): Floquet edges against
+    |l Omega - omega_1 - omega_2| < s / sqrt(omega_1 omega_2), an error below a tenth of
+    the half-width at eps = 0.05 that halves with eps."""
+    errors = []
+    for eps in (0.05, 0.025):
+        S, meshes, labels, _ = _set("lin-parker-1999-3", 31, 89, eps)
+        found = combination_instabilities(S, meshes, 1)
+        ins = max(
+            (
+                i
+                for i in found
+                if labels[i.modes[0]] == "translational"
+                and labels[i.partner[0]] == "rotational"
+                and i.modes[0] >= len(labels) - 6
+            ),
+            key=lambda i: (i.upper - i.lower) / i.centre,
+        )
+        lo, hi = floquet_band(S, meshes, ins)
+        half = 0.5 * (ins.upper - ins.lower)
+        errors.append(max(abs(lo - ins.lower), abs(hi - ins.upper)) / half)
+    assert errors[0] <= 0.1, errors
+    assert 0.35 <= errors[1] / errors[0] <= 0.65, errors
+
+
 # -- the command: gearsym modes SET --parametric -------------------------------------------
 
 VARIATION = """
@@ -205,12 +264,18 @@ def test_cli_parametric(tmp_path):
     for ins, b in zip(found, bands, strict=True):
         assert b["lower_hz"] == pytest.approx(ins.lower / (2 * math.pi), rel=1e-12)
         assert b["upper_hz"] == pytest.approx(ins.upper / (2 * math.pi), rel=1e-12)
+    combos = json.loads(done.stdout)["parametric"]["combinations"]
+    expected = combination_instabilities(st.as_structure(), Meshes(rows, phases, waves), 3)
+    assert [(c["harmonic"], c["lower_hz"]) for c in combos] == [
+        (i.l, pytest.approx(i.lower / (2 * math.pi), rel=1e-12)) for i in expected
+    ]
     # the ring meshes lag their planet's sun mesh by the stated quarter period
     assert phases[1] == pytest.approx((st.phases[0][1] + 0.25) % 1.0)
     done = run("modes", str(path), "--parametric")
     assert done.returncode == 0, done.stderr
     assert "suppressed by the phasing" in done.stdout
     assert "first order" in done.stdout
+    assert "combination instabilities" in done.stdout
 
 
 @pytest.mark.parametrize(

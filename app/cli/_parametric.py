@@ -8,6 +8,8 @@ import sys
 
 __all__ = ["parametric_table", "print_parametric"]
 
+SHOWN = 10  # combination bands printed (the widest, relative to their centre)
+
 
 def parametric_table(st, modes, *, floquet: bool = False) -> dict:
     """The bands of every primary instability (``l Omega = 2 omega``, ``l`` up to the
@@ -15,7 +17,12 @@ def parametric_table(st, modes, *, floquet: bool = False) -> dict:
     their natural frequency, the band of the mesh frequency in Hz (first order) and, with
     ``floquet``, its edges by the Floquet multipliers."""
     from gearsym.derive.equations.planetary import planetary_meshes
-    from gearsym.solver.analysis.parametric import Meshes, floquet_band, primary_instabilities
+    from gearsym.solver.analysis.parametric import (
+        Meshes,
+        combination_instabilities,
+        floquet_band,
+        primary_instabilities,
+    )
 
     v = st.planetary.variation
     structure = st.as_structure()
@@ -45,14 +52,30 @@ def parametric_table(st, modes, *, floquet: bool = False) -> dict:
                 band["floquet_hz"] = None
                 band["floquet_note"] = str(err)
         bands.append(band)
+    combinations = [
+        {
+            "harmonic": ins.l,
+            "modes": [i + 1 for i in ins.modes],
+            "partner": [i + 1 for i in ins.partner],
+            "types": [labels[ins.modes[0]], labels[ins.partner[0]]],
+            "natural_hz": [ins.omega / (2 * math.pi), ins.omega_partner / (2 * math.pi)],
+            "centre_hz": ins.centre / (2 * math.pi),
+            "lower_hz": ins.lower / (2 * math.pi),
+            "upper_hz": ins.upper / (2 * math.pi),
+            "suppressed": ins.suppressed,
+        }
+        for ins in combination_instabilities(structure, meshes, v.harmonics)
+    ]
     return {
-        "method": "first order (multiple scales), primary instabilities l Omega = 2 omega",
+        "method": "first order (multiple scales): primary instabilities l Omega = 2 omega "
+        "and combination instabilities l Omega = omega_1 + omega_2",
         "sun_planet": {"contact_ratio": v.sun[0], "amplitude": v.sun[1]},
         "ring_planet": {"contact_ratio": v.ring[0], "amplitude": v.ring[1]},
         "ring_sun_phase": v.ring_sun_phase,
         "harmonics": v.harmonics,
         "sun_teeth": st.planetary.sun_teeth,
         "bands": bands,
+        "combinations": combinations,
     }
 
 
@@ -84,3 +107,22 @@ def print_parametric(table: dict) -> None:
                 else f"; Floquet: undetermined ({b['floquet_note']})"
             )
         print(line)
+    kept = [c for c in table["combinations"] if not c["suppressed"]]
+    if not kept:
+        return
+    widest = sorted(kept, key=lambda c: -(c["upper_hz"] - c["lower_hz"]) / c["centre_hz"])
+    print(
+        f"combination instabilities (l x mesh frequency = natural 1 + natural 2): {len(kept)} "
+        f"of {len(table['combinations'])} not suppressed by the phasing; the "
+        f"{min(len(kept), SHOWN)} widest (every one in --json and --out):"
+    )
+    print(f"  {'l':>2}  {'types':<27}  {'natural Hz':>19}  mesh frequency band (Hz)")
+    for c in widest[:SHOWN]:
+        types = " + ".join(c["types"])
+        pair = " + ".join(f"{f:.1f}" for f in c["natural_hz"])
+        width = c["upper_hz"] - c["lower_hz"]
+        places = max(1, 1 - math.floor(math.log10(width)))
+        print(
+            f"  {c['harmonic']:2d}  {types:<27}  {pair:>19}  "
+            f"{c['lower_hz']:.{places}f} to {c['upper_hz']:.{places}f}"
+        )

@@ -50,6 +50,7 @@ import scipy.linalg
 __all__ = [
     "Instability",
     "Meshes",
+    "combination_instabilities",
     "floquet_band",
     "modal_basis",
     "multipliers",
@@ -75,10 +76,11 @@ class Meshes:
 
 @dataclass(frozen=True)
 class Instability:
-    """The first-order band of one primary instability: ``modes`` (indices into the
-    flexible modes), the harmonic ``l``, the natural frequency ``omega`` (rad/s), ``s``
+    """The first-order band of one instability: ``modes`` (indices into the flexible
+    modes), the harmonic ``l``, their natural frequency ``omega`` (rad/s), ``s``
     (rad^2/s^2) and the band of the mesh frequency ``Omega`` in rad/s, ``lower`` to
-    ``upper`` (equal where suppressed)."""
+    ``upper`` (equal where suppressed).  A combination instability has a second group of
+    modes, ``partner``, at ``omega_partner``."""
 
     modes: tuple[int, ...]
     l: int  # noqa: E741 (the harmonic, as the papers write it)
@@ -86,10 +88,17 @@ class Instability:
     s: float
     lower: float
     upper: float
+    partner: tuple[int, ...] = ()
+    omega_partner: float | None = None
 
     @property
     def centre(self) -> float:
-        return 2.0 * self.omega / self.l
+        other = self.omega if self.omega_partner is None else self.omega_partner
+        return (self.omega + other) / self.l
+
+    @property
+    def kind(self) -> str:
+        return "combination" if self.partner else "primary"
 
     @property
     def suppressed(self) -> bool:
@@ -122,6 +131,24 @@ def _excitation(structure: dict, meshes: Meshes, l: int) -> np.ndarray:  # noqa:
     return G
 
 
+def _groups(omega: np.ndarray, tolerance: float) -> list[list[int]]:
+    """Indices of the modes at one frequency (within ``tolerance`` of the largest)."""
+    groups: list[list[int]] = []
+    for i, w in enumerate(omega):
+        if groups and abs(w - omega[groups[-1][0]]) <= tolerance * omega[-1]:
+            groups[-1].append(i)
+        else:
+            groups.append([i])
+    return groups
+
+
+def _largest(block: np.ndarray, G: np.ndarray) -> float:
+    """The largest singular value of ``block``, 0 below 1e-12 of ``G``'s largest entry
+    (what the phases cancel is zero to rounding)."""
+    s = float(np.linalg.svd(block, compute_uv=False).max())
+    return 0.0 if s <= 1e-12 * np.abs(G).max(initial=0.0) else s
+
+
 def primary_instabilities(
     structure: dict, meshes: Meshes, harmonics: int, group_tolerance: float = 1e-7
 ) -> list[Instability]:
@@ -129,22 +156,43 @@ def primary_instabilities(
     harmonics``, modes within ``group_tolerance`` (relative) of one frequency taken
     together (module text), in the order of ``l`` and then of ``omega``."""
     omega, *_ = modal_basis(structure)
-    groups: list[list[int]] = []
-    for i, w in enumerate(omega):
-        if groups and abs(w - omega[groups[-1][0]]) <= group_tolerance * omega[-1]:
-            groups[-1].append(i)
-        else:
-            groups.append([i])
     out = []
     for h in range(1, harmonics + 1):
         G = _excitation(structure, meshes, h)
-        for g in groups:
+        for g in _groups(omega, group_tolerance):
             w = float(np.mean(omega[g]))
-            block = G[np.ix_(g, g)]
-            s = float(np.linalg.svd(block, compute_uv=False).max())
-            if s <= 1e-12 * np.abs(G).max(initial=0.0):
-                s = 0.0
+            s = _largest(G[np.ix_(g, g)], G)
             out.append(Instability(tuple(g), h, w, s, (2 * w - s / w) / h, (2 * w + s / w) / h))
+    return out
+
+
+def combination_instabilities(
+    structure: dict, meshes: Meshes, harmonics: int, group_tolerance: float = 1e-7
+) -> list[Instability]:
+    """The first-order band of every combination instability of the sum type, ``l Omega
+    = omega_1 + omega_2`` for two groups of modes at different frequencies:
+
+        ``|l Omega - omega_1 - omega_2| < s / sqrt(omega_1 omega_2)``,
+
+    ``s`` the largest singular value of ``G_l``'s block coupling the two groups (the
+    singular value decomposition of the block decouples the slow amplitudes into pairs,
+    each unstable there; a group with itself is the primary band).  The difference type
+    ``omega_2 - omega_1`` is not unstable in this undamped, symmetric model.  In the order
+    of ``l``, then of the first group, then of the second."""
+    omega, *_ = modal_basis(structure)
+    groups = _groups(omega, group_tolerance)
+    out = []
+    for h in range(1, harmonics + 1):
+        G = _excitation(structure, meshes, h)
+        for a, ga in enumerate(groups):
+            for gb in groups[a + 1 :]:
+                w1, w2 = float(np.mean(omega[ga])), float(np.mean(omega[gb]))
+                s = _largest(G[np.ix_(ga, gb)], G)
+                half = s / math.sqrt(w1 * w2) / h
+                centre = (w1 + w2) / h
+                out.append(
+                    Instability(tuple(ga), h, w1, s, centre - half, centre + half, tuple(gb), w2)
+                )
     return out
 
 
@@ -198,7 +246,8 @@ def floquet_band(
 ) -> tuple[float, float]:
     """The edges of the instability band ``ins`` by the Floquet multipliers: bisection from
     its centre (which must be unstable) to the first stable point found stepping outwards
-    by quarter first-order half-widths (at most ``span`` of them), to ``tol`` relative.  Raises ``ValueError`` where either end fails."""
+    by quarter first-order half-widths (at most ``span`` of them), to ``tol`` relative.
+    Raises ``ValueError`` where either end fails."""
     centre, half = ins.centre, 0.5 * (ins.upper - ins.lower)
     if half <= 0.0 or not unstable(multipliers(structure, meshes, centre)):
         raise ValueError(f"harmonic {ins.l}, modes {ins.modes}: stable at the band's centre")
