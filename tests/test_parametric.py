@@ -144,6 +144,35 @@ def test_floquet_agrees_with_the_first_order_band():
     assert grown == pytest.approx(rate, rel=0.1)
 
 
+def test_unequal_spacing_suppresses_nothing():
+    """The suppression rests on equal spacing: with Lin and Parker's second planet at
+    117 deg instead of 120 (still assembled: 120 x 117 / 360 = 39 whole), the modes are
+    coupled and no primary band of the six mesh modes is empty at l = 1; the multipliers
+    at each band's centre grow, where with equal spacing the rotational ones stay on the
+    unit circle."""
+    ps = load_planetary(resolve_target("lin-parker-1999-3"))
+    for angles, equal in (((0.0, 120.0, 240.0), True), ((0.0, 117.0, 240.0), False)):
+        moved = replace(ps, sun_teeth=31, ring_teeth=89, angles_deg=angles, equally_spaced=equal)
+        st = derive_planetary(moved)
+        S = st.as_structure()
+        rows = [i for i, kind in enumerate(S["kinds"]) if kind == "mesh"]
+        phases = [
+            st.phases[int(S["coordinates"][i][2:]) - 1][0 if S["coordinates"][i][0] == "s" else 1]
+            for i in rows
+        ]
+        meshes = Meshes(tuple(rows), tuple(phases), tuple(((0.05, 0.0),) for _ in rows))
+        labels = [m.label for m in planetary_modes(S, "x").modes if m.label != "rigid-body"]
+        for ins in primary_instabilities(S, meshes, 1):
+            if ins.modes[0] < len(labels) - 6:
+                continue
+            grown = np.abs(multipliers(S, meshes, ins.centre)).max() - 1
+            if equal and labels[ins.modes[0]] == "rotational":
+                assert ins.suppressed and grown < 1e-9, ins
+            else:
+                assert labels[ins.modes[0]] == ("translational" if equal else "coupled")
+                assert not ins.suppressed and grown > 1e-2, (ins, grown)
+
+
 @pytest.mark.parametrize(
     "scene, sun, ring",
     [("lin-parker-1999-3", 31, 89), ("lin-parker-1999-4", 29, 91), ("lin-parker-1999-4", 30, 90)],
