@@ -14,7 +14,8 @@ The public API (see ``docs/api.md``)::
 
 Every command of the CLI has its function here: ``simulate``/``analyse`` (simulate),
 ``sweep``, ``regime_map`` (map), ``shoot``, ``continue_orbit`` (continue),
-``frequency_response`` (with ``harmonic_balance`` and ``continue_hb``), ``modes``,
+``frequency_response`` (with ``harmonic_balance`` and ``continue_hb``), ``modes`` (of a
+planetary set ``planetary.modes`` and ``planetary.parametric_instabilities``),
 ``fit_dead_zone`` (backlash), ``derive_model`` (derive), ``reproduce``; ``gearsym.plot``
 draws their results.
 
@@ -39,6 +40,7 @@ _EXPORTS = {
     "continue_hb": "gearsym.solver.periodic.hb_continuation",
     "frequency_response": "gearsym.solver.sweep.frequency",
     "modes": "gearsym.solver.analysis.modes",
+    "planetary": ("gearsym.planetary", None),  # the module: planetary sets
     "Modes": "gearsym.solver.analysis.modes",
     "FrequencyResponse": "gearsym.solver.sweep.frequency_result",
     "regime_map": "gearsym.solver.sweep.atlas",
@@ -122,6 +124,7 @@ __all__ = [
     "load_target",
     "modes",
     "orbit_in_units",
+    "planetary",
     "plot",
     "regime_map",
     "reproduce",

@@ -338,3 +338,26 @@ def test_cli_parametric_refused_on_a_tree():
     assert done.returncode == 2
     assert len(done.stderr.strip().splitlines()) == 1
     assert "planetary" in done.stderr
+
+
+def test_the_api_gives_what_the_command_prints():
+    """``gearsym.planetary.parametric_instabilities`` and ``gearsym.planetary.modes``
+    (``planetary`` in ``gearsym.__all__``): the same bands as ``gearsym modes --parametric
+    --json`` of the shipped lin-parker-1999-3-phased, and the modes with Lin and Parker's
+    multiplicities."""
+    import gearsym
+
+    assert "planetary" in gearsym.__all__
+    table = gearsym.planetary.parametric_instabilities("lin-parker-1999-3-phased")
+    done = run("modes", "lin-parker-1999-3-phased", "--parametric", "--json")
+    assert done.returncode == 0, done.stderr
+    printed = json.loads(done.stdout)["parametric"]
+    assert printed["bands"] == table["bands"]
+    assert printed["combinations"] == table["combinations"]
+    modal = gearsym.planetary.modes("lin-parker-1999-4")
+    planet = [m for m in modal.modes if m.label == "planet"]
+    assert planet and all(m.multiplicity == 1 for m in planet)  # N - 3 = 1
+    with pytest.raises(ValueError, match="variation"):
+        gearsym.planetary.parametric_instabilities("lin-parker-1999-3")
+    with pytest.raises(ValueError, match="not a planetary set"):
+        gearsym.planetary.modes("reference-light")

@@ -12,71 +12,14 @@ SHOWN = 10  # combination bands printed (the widest, relative to their centre)
 
 
 def parametric_table(st, modes, *, floquet: bool = False) -> dict:
-    """The bands of every primary instability (``l Omega = 2 omega``, ``l`` up to the
-    file's harmonics) as a JSON-ready mapping: each band's harmonic, the type of its modes,
-    their natural frequency, the band of the mesh frequency in Hz (first order) and, with
-    ``floquet``, its edges by the Floquet multipliers."""
-    from gearsym.derive.equations.planetary import planetary_meshes
-    from gearsym.solver.analysis.parametric import (
-        Meshes,
-        combination_instabilities,
-        floquet_band,
-        primary_instabilities,
-    )
+    """The bands of :func:`gearsym.planetary.parametric_instabilities` (``modes`` is not
+    needed again: kept for the caller's order of work); a line on stderr first when the
+    Floquet check runs (a second or two a band)."""
+    from gearsym.planetary import parametric_instabilities
 
-    v = st.planetary.variation
-    structure = st.as_structure()
-    meshes = Meshes(*planetary_meshes(st))
-    labels = [m.label for m in modes.modes if m.label != "rigid-body"]
-    found = primary_instabilities(structure, meshes, v.harmonics)
-    bands = []
     if floquet:
-        todo = sum(not ins.suppressed for ins in found)
-        print(f"confirming {todo} bands by the Floquet multipliers", file=sys.stderr)
-    for ins in found:
-        band = {
-            "harmonic": ins.l,
-            "modes": [i + 1 for i in ins.modes],
-            "type": labels[ins.modes[0]],
-            "natural_hz": ins.omega / (2 * math.pi),
-            "centre_hz": ins.centre / (2 * math.pi),
-            "lower_hz": ins.lower / (2 * math.pi),
-            "upper_hz": ins.upper / (2 * math.pi),
-            "suppressed": ins.suppressed,
-        }
-        if floquet and not ins.suppressed:
-            try:
-                lo, hi = floquet_band(structure, meshes, ins)
-                band["floquet_hz"] = [lo / (2 * math.pi), hi / (2 * math.pi)]
-            except ValueError as err:
-                band["floquet_hz"] = None
-                band["floquet_note"] = str(err)
-        bands.append(band)
-    combinations = [
-        {
-            "harmonic": ins.l,
-            "modes": [i + 1 for i in ins.modes],
-            "partner": [i + 1 for i in ins.partner],
-            "types": [labels[ins.modes[0]], labels[ins.partner[0]]],
-            "natural_hz": [ins.omega / (2 * math.pi), ins.omega_partner / (2 * math.pi)],
-            "centre_hz": ins.centre / (2 * math.pi),
-            "lower_hz": ins.lower / (2 * math.pi),
-            "upper_hz": ins.upper / (2 * math.pi),
-            "suppressed": ins.suppressed,
-        }
-        for ins in combination_instabilities(structure, meshes, v.harmonics)
-    ]
-    return {
-        "method": "first order (multiple scales): primary instabilities l Omega = 2 omega "
-        "and combination instabilities l Omega = omega_1 + omega_2",
-        "sun_planet": {"contact_ratio": v.sun[0], "amplitude": v.sun[1]},
-        "ring_planet": {"contact_ratio": v.ring[0], "amplitude": v.ring[1]},
-        "ring_sun_phase": v.ring_sun_phase,
-        "harmonics": v.harmonics,
-        "sun_teeth": st.planetary.sun_teeth,
-        "bands": bands,
-        "combinations": combinations,
-    }
+        print("confirming each band by the Floquet multipliers", file=sys.stderr)
+    return parametric_instabilities(st, floquet=floquet)
 
 
 def print_parametric(table: dict) -> None:
