@@ -53,6 +53,7 @@ __all__ = [
     "combination_instabilities",
     "floquet_band",
     "modal_basis",
+    "monodromy",
     "multipliers",
     "primary_instabilities",
     "unstable",
@@ -200,8 +201,15 @@ def multipliers(
     structure: dict, meshes: Meshes, Omega: float, *, rtol: float = 1e-11
 ) -> np.ndarray:
     """The Floquet multipliers of the set at the mesh frequency ``Omega`` (rad/s): the
-    eigenvalues of the monodromy matrix over one mesh period, in the flexible modal
-    coordinates ``(eta, d eta / d(Omega t))``, by DOP853 at ``rtol``."""
+    eigenvalues of :func:`monodromy`."""
+    return np.linalg.eigvals(monodromy(structure, meshes, Omega, rtol=rtol))
+
+
+def monodromy(structure: dict, meshes: Meshes, Omega: float, *, rtol: float = 1e-11) -> np.ndarray:
+    """The monodromy matrix over one mesh period at the mesh frequency ``Omega`` (rad/s),
+    ``(2n, 2n)`` in the flexible modal coordinates ``(eta, d eta / d(Omega t))``, by DOP853
+    at ``rtol``; the energy ``(|eta'|^2 Omega^2 + sum omega_i^2 eta_i^2) / 2`` of the
+    undamped set with constant stiffness is its invariant."""
     omega, Phi, _, R, k = modal_basis(structure)
     n = omega.size
     P = np.array([Phi.T @ R[row] for row in meshes.rows])  # (meshes, n)
@@ -232,7 +240,7 @@ def multipliers(
     )
     if not sol.success:
         raise RuntimeError(f"the monodromy matrix could not be integrated: {sol.message}")
-    return np.linalg.eigvals(sol.y[:, -1].reshape(2 * n, 2 * n))
+    return sol.y[:, -1].reshape(2 * n, 2 * n)
 
 
 def unstable(mu: np.ndarray, threshold: float = 1e-7) -> bool:
