@@ -25,6 +25,7 @@ __all__ = [
     "map",
     "modes",
     "multipliers",
+    "parametric",
     "point",
     "save",
 ]
@@ -143,3 +144,16 @@ def campbell(result, speeds_rpm=None, harmonics: int = 3):
 
 
 modes = campbell  # the figure of gearsym.modes' result
+
+
+def parametric(table):
+    """The parametric-instability diagram of a planetary set: the first-order wedges of
+    its primary and combination instabilities over the mesh frequency (Hz) and the share
+    of the stated stiffness variation, the bands its phasing suppresses marked.
+
+    ``table``: the mapping of ``gearsym.planetary.parametric_instabilities``.  Returns a
+    Figure.
+    """
+    from gearsym.solver.plots_modes import parametric_figure
+
+    return parametric_figure(table)

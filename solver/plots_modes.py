@@ -1,13 +1,14 @@
-"""The resonance (Campbell) diagram of a model's modes against its mesh frequency."""
+"""The resonance (Campbell) diagram of a model's modes against its mesh frequency, and the
+parametric-instability diagram of a planetary set."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from .analysis.modes import Modes
-from .plots_style import plt
+from .plots_style import legend_below, plt
 
-__all__ = ["campbell_figure"]
+__all__ = ["campbell_figure", "parametric_figure"]
 
 _STYLE = {
     "torsional": ("tab:blue", "-"),
@@ -67,5 +68,77 @@ def campbell_figure(
         bbox_to_anchor=(1.01, 1.0),
         fontsize=8,
         frameon=False,
+    )
+    return fig
+
+
+_TYPES = {
+    "rotational": "tab:blue",
+    "translational": "tab:green",
+    "planet": "tab:orange",
+    "coupled": "tab:red",
+}
+
+
+def parametric_figure(table: dict):
+    """The first-order instability wedges of a planetary set in the plane of the mesh
+    frequency (Hz, log) and the stiffness variation's amplitude (as a share of the one its
+    file states, 0 to 1): each band grows linearly from its centre at zero amplitude to
+    its edges at the stated amplitude.  Primary bands coloured by the type of their modes,
+    combination bands grey, and a ring on the axis at the centre of each band the phasing
+    suppresses.  ``table``: the mapping of ``gearsym.planetary.parametric_instabilities``;
+    returns the ``Figure`` (nothing saved)."""
+    fig, ax = plt.subplots(figsize=(9, 5))
+    kept = [b for b in table["combinations"] if not b["suppressed"]]
+    for b in kept:
+        ax.fill(
+            [b["centre_hz"], b["lower_hz"], b["upper_hz"]],
+            [0.0, 1.0, 1.0],
+            color="0.6",
+            alpha=0.5,
+            lw=0.5,
+            label="combination (sum of two natural frequencies)",
+        )
+    for b in table["bands"]:
+        colour = _TYPES.get(b["type"], "black")
+        if b["suppressed"]:
+            ax.plot(
+                b["centre_hz"],
+                0.0,
+                "o",
+                mfc="none",
+                mec=colour,
+                ms=6,
+                clip_on=False,
+                label=f"{b['type']}, primary: suppressed by the phasing",
+            )
+            continue
+        ax.fill(
+            [b["centre_hz"], b["lower_hz"], b["upper_hz"]],
+            [0.0, 1.0, 1.0],
+            color=colour,
+            alpha=0.8,
+            lw=0.8,
+            label=f"{b['type']}, primary",
+        )
+    ax.set_xscale("log")
+    ax.set_ylim(0.0, 1.05)
+    ax.set_xlabel("mesh frequency (Hz)")
+    ax.set_ylabel("stiffness variation / the stated one")
+    s, r = table["sun_planet"], table["ring_planet"]
+    ax.set_title(
+        f"{table['model']}: parametric instability, first order "
+        f"(harmonics 1 to {table['harmonics']})"
+    )
+    legend_below(
+        fig,
+        [ax],
+        f"Stated variation: sun-planet contact ratio {s['contact_ratio']:g}, amplitude "
+        f"{s['amplitude']:g}; ring-planet {r['contact_ratio']:g}, {r['amplitude']:g}; ring "
+        f"meshes {table['ring_sun_phase']:g} mesh periods after their sun meshes; Z_s = "
+        f"{table['sun_teeth']}, Z_r = {table['ring_teeth']}. A wedge is unstable inside (the "
+        "first-order band widens linearly with the amplitude); a ring on the axis marks a "
+        "primary instability the planets' phasing cancels. gearsym modes --parametric "
+        "--floquet checks the primary bands by Floquet multipliers.",
     )
     return fig

@@ -392,3 +392,15 @@ def test_energy_and_liouville():
     assert np.abs(mu).max() > 1.0 + 1e-6  # unstable there, and yet
     for m in mu:
         assert np.abs(mu - 1.0 / m).min() <= 1e-7 * np.abs(mu).max()
+
+
+def test_cli_parametric_diagram(tmp_path):
+    """`--parametric --plot FILE` writes the diagram (also with --json); --plot alone on a
+    planetary set, which has no resonance diagram, is refused in one line."""
+    png = tmp_path / "parametric.png"
+    done = run("modes", "lin-parker-1999-3-phased", "--parametric", "--json", "--plot", str(png))
+    assert done.returncode == 0, done.stderr
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    done = run("modes", "lin-parker-1999-3-phased", "--plot", str(png))
+    assert done.returncode == 2
+    assert len(done.stderr.strip().splitlines()) == 1 and "--parametric" in done.stderr

@@ -27,7 +27,12 @@ def register(sub) -> None:
         metavar="LO:HI",
         help="speed range of the first mesh's driver, rpm (default: 0 to twice the scene's)",
     )
-    p.add_argument("--plot", metavar="FILE", help="write the resonance diagram (PNG, PDF, SVG)")
+    p.add_argument(
+        "--plot",
+        metavar="FILE",
+        help="write the resonance diagram (PNG, PDF, SVG); of a planetary set with "
+        "--parametric, its parametric-instability diagram",
+    )
     p.add_argument("--out", metavar="DIR", help="also write modes.json, .csv, .mat (--format)")
     p.add_argument(
         "--parametric",
@@ -131,12 +136,18 @@ def _planetary(path, args) -> int:
     from gearsym.derive.input.planetary import load_planetary
     from gearsym.solver.analysis.modes import planetary_modes
 
-    for flag, value in (("--plot", args.plot), ("--speeds", args.speeds)):
-        if value:
-            raise Fail(
-                f"{flag}: a planetary set's file gives no speed or tooth counts, so there is "
-                "no mesh frequency to draw or meet; run without it"
-            )
+    if args.speeds:
+        raise Fail(
+            "--speeds: a planetary set's file gives no speed, so there is no mesh frequency "
+            "to meet; run without it"
+        )
+    if args.plot and not args.parametric:
+        raise Fail(
+            "--plot: a planetary set has no resonance diagram (its file gives no speed); "
+            "add --parametric for its parametric-instability diagram"
+        )
+    if args.plot:
+        figure_file(args.plot, "--plot")
     ps = load_planetary(path)
     if (args.parametric or args.floquet) and ps.variation is None:
         raise Fail(
@@ -176,6 +187,11 @@ def _planetary(path, args) -> int:
         from ._parametric import parametric_table
 
         data["parametric"] = parametric_table(st, result, floquet=args.floquet)
+    if args.plot:
+        from gearsym.solver.plots_modes import parametric_figure
+        from gearsym.solver.plots_style import save_figure
+
+        save_figure(parametric_figure(data["parametric"]), args.plot)
     if args.out:
         from gearsym.solver.export import Document
 
@@ -212,4 +228,6 @@ def _planetary(path, args) -> int:
         from ._parametric import print_parametric
 
         print_parametric(data["parametric"])
+    if args.plot:
+        print(f"  parametric-instability diagram: {args.plot}")
     return 0
