@@ -26,6 +26,11 @@ the carrier are equally spaced unless given.
     bearing_N_per_m = 1e8                         # translational (x and y)
     torsional_N_per_m = 0                         # on u = r theta; 0: free to turn
     ...
+    [planetary.variation]                         # optional: gearsym modes --parametric
+    sun_planet = { contact_ratio = 1.6, amplitude = 0.2 }   # needs sun_teeth, ring_teeth
+    ring_planet = { contact_ratio = 1.8, amplitude = 0.2 }
+    ring_sun_phase = 0.0                          # mesh periods, sun mesh to ring mesh
+    harmonics = 3
 
 The ``torsional`` model keeps each member's rotation only: translations are held and
 each planet's centre moves with the carrier (its bearing rigid), as in the purely
