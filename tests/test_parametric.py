@@ -69,6 +69,17 @@ def test_one_spring_is_mathieu():
     assert abs(ins.upper - hi) <= 2 * (eps / 4) ** 2 * hi
 
 
+def _meshes(st, wave: tuple) -> Meshes:
+    """Every mesh of ``st`` with the waveform ``wave``, delayed by its own phase (a ring
+    mesh by its planet's ring phase: no ring-sun offset)."""
+    rows = [i for i, kind in enumerate(st.kinds) if kind == "mesh"]
+    phases = []
+    for i in rows:
+        name = st.springs[i]  # sp<n> or rp<n>
+        phases.append(st.phases[int(name[2:]) - 1][0 if name[0] == "s" else 1])
+    return Meshes(tuple(rows), tuple(phases), tuple(wave for _ in rows))
+
+
 def _set(scene: str, sun_teeth: int, ring_teeth: int, eps: float, sin: float = 0.0):
     """The structure of a shipped set with the tooth counts given, its mesh springs varying
     by ``eps`` (and ``sin``) in each of four harmonics, each delayed by its mesh phase;
@@ -77,12 +88,7 @@ def _set(scene: str, sun_teeth: int, ring_teeth: int, eps: float, sin: float = 0
     ps = replace(ps, sun_teeth=sun_teeth, ring_teeth=ring_teeth)
     st = derive_planetary(ps)
     S = st.as_structure()
-    rows = [i for i, kind in enumerate(S["kinds"]) if kind == "mesh"]
-    phases = []
-    for i in rows:
-        name = S["coordinates"][i]  # sp<n> or rp<n>
-        phases.append(st.phases[int(name[2:]) - 1][0 if name[0] == "s" else 1])
-    meshes = Meshes(tuple(rows), tuple(phases), tuple(((eps, sin),) * 4 for _ in rows))
+    meshes = _meshes(st, ((eps, sin),) * 4)
     labels = [m.label for m in planetary_modes(S, scene).modes if m.label != "rigid-body"]
     return S, meshes, labels, ps.planets
 
@@ -157,12 +163,7 @@ def test_unequal_spacing_suppresses_nothing():
         moved = replace(ps, sun_teeth=31, ring_teeth=89, angles_deg=angles, equally_spaced=equal)
         st = derive_planetary(moved)
         S = st.as_structure()
-        rows = [i for i, kind in enumerate(S["kinds"]) if kind == "mesh"]
-        phases = [
-            st.phases[int(S["coordinates"][i][2:]) - 1][0 if S["coordinates"][i][0] == "s" else 1]
-            for i in rows
-        ]
-        meshes = Meshes(tuple(rows), tuple(phases), tuple(((0.05, 0.0),) for _ in rows))
+        meshes = _meshes(st, ((0.05, 0.0),))
         labels = [m.label for m in planetary_modes(S, "x").modes if m.label != "rigid-body"]
         for ins in primary_instabilities(S, meshes, 1):
             if ins.modes[0] < len(labels) - 6:

@@ -1,29 +1,29 @@
-"""``gearsym modes SET --parametric``: the primary parametric instabilities of a planetary
-set from its meshes' stiffness variation and phases (``solver.analysis.parametric``)."""
+"""``gearsym modes SET --parametric``: the table of a planetary set's parametric
+instabilities (``gearsym.planetary.parametric_instabilities``) for the terminal."""
 
 from __future__ import annotations
 
 import math
-import sys
 
-__all__ = ["parametric_table", "print_parametric"]
+__all__ = ["print_parametric"]
 
 SHOWN = 10  # combination bands printed (the widest, relative to their centre)
 
 
-def parametric_table(st, modes, *, floquet: bool = False) -> dict:
-    """The bands of :func:`gearsym.planetary.parametric_instabilities` (``modes`` is not
-    needed again: kept for the caller's order of work); a line on stderr first when the
-    Floquet check runs (a second or two a band)."""
-    from gearsym.planetary import parametric_instabilities
-
-    if floquet:
-        print("confirming each band by the Floquet multipliers", file=sys.stderr)
-    return parametric_instabilities(st, floquet=floquet)
+def _band(lo: float, hi: float, edges=None) -> str:
+    """``lo to hi`` with enough decimals to show the band's width (some are a hundredth
+    of a hertz), the same decimals for ``edges`` (the Floquet edges) if given."""
+    width = hi - lo
+    places = max(1, 1 - math.floor(math.log10(width))) if width > 0 else 1
+    text = f"{lo:.{places}f} to {hi:.{places}f}"
+    return (
+        text if edges is None else f"{text}; Floquet {edges[0]:.{places}f} to {edges[1]:.{places}f}"
+    )
 
 
 def print_parametric(table: dict) -> None:
-    """The table of :func:`parametric_table`, for the terminal."""
+    """The mapping of :func:`gearsym.planetary.parametric_instabilities`, for the
+    terminal: every primary band, then the widest combination bands."""
     s, r = table["sun_planet"], table["ring_planet"]
     print(
         "parametric instabilities, first order (primary, l x mesh frequency = 2 x natural): "
@@ -38,17 +38,11 @@ def print_parametric(table: dict) -> None:
         if b["suppressed"]:
             print(head + "suppressed by the phasing")
             continue
-        # enough decimals to show the band's width (some are a hundredth of a hertz)
-        width = b["upper_hz"] - b["lower_hz"]
-        places = max(1, 1 - math.floor(math.log10(width))) if width > 0 else 1
-        line = head + f"{b['lower_hz']:.{places}f} to {b['upper_hz']:.{places}f}"
-        if "floquet_hz" in b:
-            f = b["floquet_hz"]
-            line += (
-                f"; Floquet {f[0]:.{places}f} to {f[1]:.{places}f}"
-                if f
-                else f"; Floquet: undetermined ({b['floquet_note']})"
-            )
+        if "floquet_hz" in b and b["floquet_hz"] is None:
+            line = head + _band(b["lower_hz"], b["upper_hz"])
+            line += f"; Floquet: undetermined ({b['floquet_note']})"
+        else:
+            line = head + _band(b["lower_hz"], b["upper_hz"], b.get("floquet_hz"))
         print(line)
     kept = [c for c in table["combinations"] if not c["suppressed"]]
     if not kept:
@@ -63,9 +57,5 @@ def print_parametric(table: dict) -> None:
     for c in widest[:SHOWN]:
         types = " + ".join(c["types"])
         pair = " + ".join(f"{f:.1f}" for f in c["natural_hz"])
-        width = c["upper_hz"] - c["lower_hz"]
-        places = max(1, 1 - math.floor(math.log10(width)))
-        print(
-            f"  {c['harmonic']:2d}  {types:<27}  {pair:>19}  "
-            f"{c['lower_hz']:.{places}f} to {c['upper_hz']:.{places}f}"
-        )
+        band = _band(c["lower_hz"], c["upper_hz"])
+        print(f"  {c['harmonic']:2d}  {types:<27}  {pair:>19}  {band}")

@@ -4,6 +4,7 @@ model, with the resonance (Campbell) diagram against the mesh frequency."""
 from __future__ import annotations
 
 import math
+import sys
 
 from ._common import Fail, figure_file, out_folder
 from ._output import format_option, write_result
@@ -184,9 +185,11 @@ def _planetary(path, args) -> int:
         ],
     }
     if args.parametric:
-        from ._parametric import parametric_table
+        from gearsym.planetary import parametric_instabilities
 
-        data["parametric"] = parametric_table(st, result, floquet=args.floquet)
+        if args.floquet:
+            print("confirming each band by the Floquet multipliers", file=sys.stderr)
+        data["parametric"] = parametric_instabilities(st, floquet=args.floquet)
     if args.plot:
         from gearsym.solver.plots_modes import parametric_figure
         from gearsym.solver.plots_style import save_figure

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-__all__ = ["DOMINANT", "Mode", "Modes", "modes", "planetary_modes"]
+__all__ = ["DOMINANT", "Mode", "Modes", "eigenproblem", "modes", "planetary_modes"]
 
 DOMINANT = 0.8  # kinetic-energy share of one group that names a mode
 _GROUPS = {
@@ -132,6 +132,17 @@ class Modes:
         return columns, [[m.index, m.frequency_hz, self.over_mesh(m), m.label] for m in self.modes]
 
 
+def eigenproblem(structure: dict):
+    """``(w2, vec, mass, R, k)``: the squared natural frequencies (ascending) and the mode
+    shapes normalised on ``M`` of ``K v = w^2 M v``, ``K = R^T diag(k) R``, from a
+    ``STRUCTURE`` mapping, with its ``M`` diagonal, ``R`` and ``k`` as arrays."""
+    mass = np.asarray(structure["mass"], dtype=float)
+    R = np.asarray(structure["incidence"], dtype=float)
+    k = np.asarray(structure["stiffness"], dtype=float)
+    w2, vec = scipy.linalg.eigh(R.T @ (k[:, None] * R), np.diag(mass))
+    return w2, vec, mass, R, k
+
+
 def modes(model, omega: float | None = None) -> Modes:
     """The modes of the linear, time-averaged model of ``model`` (a :class:`System` or a
     generated module; module docstring).  ``omega`` (the system's, else the scene's) sets
@@ -141,11 +152,7 @@ def modes(model, omega: float | None = None) -> Modes:
     if omega is None and hasattr(model, "parameter"):
         omega = model.parameter(forcing)
     s = module.STRUCTURE
-    mass = np.asarray(s["mass"], dtype=float)
-    R = np.asarray(s["incidence"], dtype=float)
-    k = np.asarray(s["stiffness"], dtype=float)
-    K = R.T @ (k[:, None] * R)
-    w2, vec = scipy.linalg.eigh(K, np.diag(mass))
+    w2, vec, mass, R, k = eigenproblem(s)
     # The rigid-body mode is zero up to round-off of the largest eigenvalue.
     rigid = np.abs(w2) <= 1e-10 * np.max(np.abs(w2))
     groups = [_GROUPS[name.split("_")[0]] for name in s["physical"]]
@@ -209,11 +216,7 @@ def planetary_modes(structure: dict, name: str) -> Modes:
     modes at its frequency (translational modes come in pairs, planet modes N - 3 at a time,
     N - 1 in the torsional model).  No mesh frequency is known (the set's file gives no
     speed): ``mesh_frequency_hz`` is NaN."""
-    mass = np.asarray(structure["mass"], dtype=float)
-    R = np.asarray(structure["incidence"], dtype=float)
-    k = np.asarray(structure["stiffness"], dtype=float)
-    K = R.T @ (k[:, None] * R)
-    w2, vec = scipy.linalg.eigh(K, np.diag(mass))
+    w2, vec, mass, R, k = eigenproblem(structure)
     rigid = np.abs(w2) <= 1e-10 * np.max(np.abs(w2))
     f = np.where(rigid, 0.0, np.sqrt(np.abs(w2)) / (2 * math.pi))
     central = np.array([m in ("carrier", "ring", "sun") for m in structure["members"]])

@@ -45,7 +45,8 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.integrate
-import scipy.linalg
+
+from .modes import eigenproblem
 
 __all__ = [
     "Instability",
@@ -107,20 +108,16 @@ class Instability:
 
 
 def modal_basis(structure: dict, rigid_tolerance: float = 1e-10):
-    """``(omega, Phi, K_0, R, k)``: the flexible modes' frequencies (rad/s, ascending), their
-    shapes normalised on ``M``, and the mean stiffness matrix, ``R`` and ``k``."""
-    mass = np.asarray(structure["mass"], dtype=float)
-    R = np.asarray(structure["incidence"], dtype=float)
-    k = np.asarray(structure["stiffness"], dtype=float)
-    K0 = R.T @ (k[:, None] * R)
-    w2, vec = scipy.linalg.eigh(K0, np.diag(mass))
+    """``(omega, Phi, R, k)``: the flexible modes' frequencies (rad/s, ascending) and
+    shapes normalised on ``M`` (``modes.eigenproblem``), ``R`` and ``k``."""
+    w2, vec, _, R, k = eigenproblem(structure)
     flexible = w2 > rigid_tolerance * np.max(np.abs(w2))
-    return np.sqrt(w2[flexible]), vec[:, flexible], K0, R, k
+    return np.sqrt(w2[flexible]), vec[:, flexible], R, k
 
 
-def _excitation(structure: dict, meshes: Meshes, l: int) -> np.ndarray:  # noqa: E741
-    """``G_l`` on the flexible modes (module text)."""
-    _, Phi, _, R, k = modal_basis(structure)
+def _excitation(basis: tuple, meshes: Meshes, l: int) -> np.ndarray:  # noqa: E741
+    """``G_l`` on the flexible modes of ``basis`` (:func:`modal_basis`; module text)."""
+    _, Phi, R, k = basis
     G = np.zeros((Phi.shape[1], Phi.shape[1]), dtype=complex)
     for row, gamma, wave in zip(meshes.rows, meshes.phases, meshes.waveform, strict=True):
         if l > len(wave):
@@ -156,10 +153,11 @@ def primary_instabilities(
     """The first-order band of every primary instability ``l Omega = 2 omega``, ``l = 1 ..
     harmonics``, modes within ``group_tolerance`` (relative) of one frequency taken
     together (module text), in the order of ``l`` and then of ``omega``."""
-    omega, *_ = modal_basis(structure)
+    basis = modal_basis(structure)
+    omega = basis[0]
     out = []
     for h in range(1, harmonics + 1):
-        G = _excitation(structure, meshes, h)
+        G = _excitation(basis, meshes, h)
         for g in _groups(omega, group_tolerance):
             w = float(np.mean(omega[g]))
             s = _largest(G[np.ix_(g, g)], G)
@@ -180,11 +178,12 @@ def combination_instabilities(
     each unstable there; a group with itself is the primary band).  The difference type
     ``omega_2 - omega_1`` is not unstable in this undamped, symmetric model.  In the order
     of ``l``, then of the first group, then of the second."""
-    omega, *_ = modal_basis(structure)
+    basis = modal_basis(structure)
+    omega = basis[0]
     groups = _groups(omega, group_tolerance)
     out = []
     for h in range(1, harmonics + 1):
-        G = _excitation(structure, meshes, h)
+        G = _excitation(basis, meshes, h)
         for a, ga in enumerate(groups):
             for gb in groups[a + 1 :]:
                 w1, w2 = float(np.mean(omega[ga])), float(np.mean(omega[gb]))
@@ -210,7 +209,7 @@ def monodromy(structure: dict, meshes: Meshes, Omega: float, *, rtol: float = 1e
     ``(2n, 2n)`` in the flexible modal coordinates ``(eta, d eta / d(Omega t))``, by DOP853
     at ``rtol``; the energy ``(|eta'|^2 Omega^2 + sum omega_i^2 eta_i^2) / 2`` of the
     undamped set with constant stiffness is its invariant."""
-    omega, Phi, _, R, k = modal_basis(structure)
+    omega, Phi, R, k = modal_basis(structure)
     n = omega.size
     P = np.array([Phi.T @ R[row] for row in meshes.rows])  # (meshes, n)
     weights = np.array([k[row] for row in meshes.rows])
