@@ -43,15 +43,19 @@ def parametric_instabilities(target, *, floquet: bool = False) -> dict:
     """Every primary and combination instability of a planetary set's meshes' stiffness
     variation (its ``[planetary.variation]``), to first order, as a JSON-ready mapping:
     each band's harmonic, the types of its modes, their natural frequencies and the band
-    of the mesh frequency in Hz, or ``suppressed`` by the phasing; with ``floquet``, each
-    primary band's edges also by the Floquet multipliers (``solver.analysis.parametric``).
+    of the mesh frequency in Hz, or ``suppressed`` by the phasing (to first order); with
+    ``floquet``, each primary band's edges also by the Floquet multipliers, and for a
+    suppressed one whether they stay on the unit circle at its centre
+    (``solver.analysis.parametric``).
     Raises ``ValueError`` for a set without a variation."""
     from gearsym.derive.equations.planetary import planetary_meshes
     from gearsym.solver.analysis.parametric import (
         Meshes,
         combination_instabilities,
         floquet_band,
+        multipliers,
         primary_instabilities,
+        unstable,
     )
 
     st = target if hasattr(target, "as_structure") else load(target)
@@ -80,7 +84,12 @@ def parametric_instabilities(target, *, floquet: bool = False) -> dict:
             "upper_hz": hz(ins.upper),
             "suppressed": ins.suppressed,
         }
-        if floquet and not ins.suppressed:
+        if floquet and ins.suppressed:
+            # the first order cancels it; a higher order may leave a narrow band there
+            band["floquet_stable_at_centre"] = not unstable(
+                multipliers(structure, meshes, ins.centre)
+            )
+        elif floquet:
             try:
                 band["floquet_hz"] = [hz(e) for e in floquet_band(structure, meshes, ins)]
             except ValueError as err:

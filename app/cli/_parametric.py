@@ -36,7 +36,14 @@ def print_parametric(table: dict) -> None:
     for b in table["bands"]:
         head = f"  {b['harmonic']:2d}  {b['type']:<13}  {b['natural_hz']:10.1f}  "
         if b["suppressed"]:
-            print(head + "suppressed by the phasing")
+            line = head + "suppressed by the phasing (first order)"
+            if "floquet_stable_at_centre" in b:
+                line += (
+                    "; Floquet: stable at its centre"
+                    if b["floquet_stable_at_centre"]
+                    else "; Floquet: unstable at its centre (a higher-order band)"
+                )
+            print(line)
             continue
         if "floquet_hz" in b and b["floquet_hz"] is None:
             line = head + _band(b["lower_hz"], b["upper_hz"])
