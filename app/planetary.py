@@ -47,7 +47,7 @@ def parametric_instabilities(target, *, floquet: bool = False) -> dict:
     ``floquet``, each primary band's edges also by the Floquet multipliers, and for a
     suppressed one whether they stay on the unit circle at its centre
     (``solver.analysis.parametric``).
-    Raises ``ValueError`` for a set without a variation."""
+    Raises ``ValueError`` for a set without a variation or with a carrier speed."""
     from gearsym.derive.equations.planetary import planetary_meshes
     from gearsym.solver.analysis.parametric import (
         Meshes,
@@ -59,6 +59,11 @@ def parametric_instabilities(target, *, floquet: bool = False) -> dict:
     )
 
     st = target if hasattr(target, "as_structure") else load(target)
+    if st.planetary.carrier_speed_rpm:
+        raise ValueError(
+            f"{st.planetary.name}: the parametric analysis is of the fixed-carrier model "
+            "(no gyroscopic terms); the set turns its carrier (carrier_speed_rpm)"
+        )
     v = st.planetary.variation
     if v is None or st.phases is None:
         raise ValueError(

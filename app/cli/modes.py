@@ -158,12 +158,22 @@ def _planetary(path, args) -> int:
         )
     if args.floquet and not args.parametric:
         raise Fail("--floquet: only with --parametric; add --parametric")
-    st = derive_planetary(ps)
-    result = planetary_modes(st.as_structure(), ps.name)
+    if args.parametric and ps.carrier_speed_rpm:
+        raise Fail(
+            f"--parametric: {path} turns the carrier (carrier_speed_rpm = "
+            f"{ps.carrier_speed_rpm:g}); the parametric analysis is of the fixed-carrier "
+            "model, without gyroscopic terms: remove carrier_speed_rpm for it"
+        )
+    try:
+        st = derive_planetary(ps)
+        result = planetary_modes(st.as_structure(), ps.name)
+    except ValueError as err:  # a carrier speed the set cannot run at
+        raise Fail(f"{path}: {err}; lower carrier_speed_rpm") from None
     data = {
         "model": ps.name,
         "source": str(path),
         "degrees_of_freedom": ps.dofs,
+        "carrier_speed_rpm": ps.carrier_speed_rpm,
         "planets": ps.planets,
         "planet_angles_deg": list(ps.angles_deg),
         "equally_spaced": ps.equally_spaced,
@@ -209,8 +219,14 @@ def _planetary(path, args) -> int:
     spacing = "equally spaced" if ps.equally_spaced else "unequally spaced"
     print(
         f"{ps.name}: {len(result.modes)} modes of the {ps.dofs} planetary model, "
-        f"{ps.planets} {spacing} planets, carrier speed 0 (no gyroscopic terms); "
-        f"{st.rigid_body_modes} rigid-body"
+        f"{ps.planets} {spacing} planets, "
+        + (
+            f"carrier at {ps.carrier_speed_rpm:g} rpm (gyroscopic and centripetal terms; "
+            "frequencies seen from the carrier, shapes as magnitudes)"
+            if ps.carrier_speed_rpm
+            else "carrier speed 0 (no gyroscopic terms)"
+        )
+        + f"; {st.rigid_body_modes} rigid-body"
     )
     print(f"  {'#':>2}  {'Hz':>10}  {'type':<13}  {'x':>2}  kinetic energy")
     seen = set()

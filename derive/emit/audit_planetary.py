@@ -50,16 +50,26 @@ def planetary_page(st: PlanetaryStructure, command: str, source: str) -> str:
         f"The linear, time-averaged **{ps.dofs}** model of a planetary set in the coordinates "
         "of Lin and Parker (1999, *Analytical characterization of the unique properties of "
         "planetary gear free vibration*): each mesh at its mean stiffness with its backlash "
-        "closed, the carrier's speed zero (no gyroscopic or centripetal terms of the "
-        "rotating frame), no damping. It gives the natural frequencies and modes "
+        "closed, "
+        + (
+            f"the carrier turning at {ps.carrier_speed_rpm:g} rpm (`carrier_speed_rpm`): the "
+            "translations are measured in its rotating frame, which adds the gyroscopic "
+            "matrix `G` and the centripetal stiffness `-Ω_c² K_Ω` of Lin and Parker's "
+            "equations of motion, with the planets' bearings' centripetal load on `u_c` "
+            "(the derivation's module text: it keeps the rigid-body rotation at 0 Hz)"
+            if ps.carrier_speed_rpm
+            else "the carrier's speed zero (no gyroscopic or centripetal terms of the "
+            "rotating frame; `carrier_speed_rpm` adds them)"
+        )
+        + ", no damping. It gives the natural frequencies and modes "
         "(`gearsym modes`), each typed rotational, translational or planet with its "
         "multiplicity.\n",
         "The meshes' stiffness variation, each mesh delayed by its phase round the carrier, "
         "enters the linear analysis of parametric instability (`gearsym modes "
         "--parametric`, with a `[planetary.variation]` table and the tooth counts; "
         "`docs/analysis.md`).\n",
-        "**Not modelled yet** (issue 26): backlash and tooth separation, damping, the "
-        "rotating frame's gyroscopic and centripetal terms, and therefore simulation, "
+        "**Not modelled yet** (issue 26): backlash and tooth separation, damping, "
+        "the rotating frame's terms in the parametric analysis, and therefore simulation, "
         "sweeps, maps, periodic orbits and frequency responses of a planetary set: those "
         "commands refuse it.\n",
         "## Kinematic graph\n",

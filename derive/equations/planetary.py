@@ -6,9 +6,32 @@ base radius; the carrier's the radius of the planets' centres); planet ``n`` at 
 ``psi_n`` round the carrier moves radially by ``zeta_n`` and tangentially by ``eta_n`` in the
 carrier's frame and turns by ``u_n``.  All rotations are counted in one sense (the
 torsional derivation's "one frame": an external mesh's deflection adds its gears' ``u``, an
-internal one subtracts the ring's partner).  The carrier's speed is taken as zero in the
-modes: the gyroscopic and centripetal terms of the rotating frame are left out, as in Lin
-and Parker's free-vibration analysis.
+internal one subtracts the ring's partner).
+
+**The rotating frame** (``carrier_speed_rpm`` not zero, lateral-torsional model): the
+translations are measured in axes turning with the carrier at the constant speed
+``Omega_c`` (positive in the sense the rotations are counted), so a body of mass ``m`` at
+``(x, y)`` in them feels ``m (x'' - 2 Omega_c y' - Omega_c^2 x)`` and ``m (y'' + 2 Omega_c x' -
+Omega_c^2 y)``: Lin and Parker's ``M q'' + Omega_c G q' + (K - Omega_c^2 K_Omega) q``, with
+``G`` holding ``-2 m`` at (x, y) and ``2 m`` at (y, x) of every body's pair of translations
+(a planet's ``zeta``, ``eta``) and ``K_Omega`` holding ``m`` on each translation.  ``G`` is
+skew, so the gyroscopic forces do no work.  Speed zero (the default) leaves both out, as
+Lin and Parker's free-vibration analysis does.
+
+One term is added to their ``K_Omega``, on the carrier's rotation ``u_c``.  A planet's
+``eta`` is its tangential displacement in the frame (not relative to the carrier's
+vibration), so turning the whole set moves every planet by ``eta`` about ``u_c``, and
+``K_Omega`` alone prices that at ``-N m_p Omega_c^2 u_c^2 / 2``: the free set's rigid-body
+rotation would diverge at any speed, which a rotation of the whole set cannot do.  What is
+missing is the centripetal load that each planet's bearing carries in the steady state,
+``F = k_p d = m_p Omega_c^2 (r_c + d)`` (``d`` its static stretch), working through the
+pin's second-order motion ``r_c (1 - cos theta)``: ``+F u_c^2 / (2 r_c)`` a planet, with
+``F / r_c = k_p m_p Omega_c^2 / (k_p - m_p Omega_c^2)`` (no ``r_c`` needed).  So
+``K_Omega[u_c, u_c] = -N k_p m_p / (k_p - m_p Omega_c^2)``; the rest of the model keeps the
+unstretched geometry.  With it the rigid-body rotation is an exact null vector at every
+speed (tested: 0 Hz).  A carrier speed at or above ``sqrt(k_p / m_p)`` (the bearings can
+no longer hold the planets) is refused.  Not checked against a published table at speed
+(none was at hand).
 
 **Springs** (each a row of ``R``, ``delta = R q``, and a stiffness ``k``):
 
@@ -91,6 +114,9 @@ class PlanetaryStructure:
     stiffness: tuple[float, ...]
     rigid_body_modes: int
     phases: tuple[tuple[float, float], ...] | None = None  # (gamma_sn, gamma_rn) per planet
+    carrier_speed_rad_s: float = 0.0  # Omega_c; not zero: G and K_Omega below
+    gyroscopic: np.ndarray | None = None  # G (q x q), the coefficient of Omega_c q'
+    centripetal: np.ndarray | None = None  # K_Omega (q x q), of -Omega_c^2 q
 
     def as_structure(self) -> dict:
         """The ``STRUCTURE`` mapping of a generated module (``solver.analysis.modes``)."""
@@ -103,7 +129,39 @@ class PlanetaryStructure:
             "stiffness": self.stiffness,
             "members": self.members,
             "motions": self.motions,
+            **(
+                {
+                    "carrier_speed_rad_s": self.carrier_speed_rad_s,
+                    "gyroscopic": tuple(tuple(map(float, r)) for r in self.gyroscopic),
+                    "centripetal": tuple(tuple(map(float, r)) for r in self.centripetal),
+                }
+                if self.carrier_speed_rad_s
+                else {}
+            ),
         }
+
+
+def _rotating_frame(
+    names: list[str], mass: list[float], speed: float, bearing: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(G, K_Omega)`` over the coordinates ``names`` at the carrier speed ``speed``
+    (rad/s) with the planets' bearing stiffness ``bearing`` (module docstring): every
+    body's pair of translations, ``x_j, y_j`` or ``zeta_n, eta_n``, and the planets'
+    bearing load on ``u_c``."""
+    G = np.zeros((len(names), len(names)))
+    K = np.zeros_like(G)
+    pairs = [(f"x_{s}", f"y_{s}") for s in _SHORT.values()]
+    pairs += [(n, "eta_" + n[len("zeta_") :]) for n in names if n.startswith("zeta_")]
+    for a, b in pairs:
+        i, j = names.index(a), names.index(b)
+        G[i, j], G[j, i] = -2.0 * mass[i], 2.0 * mass[j]
+        K[i, i], K[j, j] = mass[i], mass[j]
+    # the planets' bearings' centripetal load through the pins' second-order motion
+    planets = [mass[names.index(n)] for n in names if n.startswith("zeta_")]
+    K[names.index("u_c"), names.index("u_c")] -= sum(
+        bearing * m / (bearing - m * speed**2) for m in planets
+    )
+    return G, K
 
 
 def _lateral(ps: PlanetarySet):
@@ -227,6 +285,17 @@ def derive_planetary(ps: PlanetarySet) -> PlanetaryStructure:
         motions = ["rotation"] * len(keep)
         mass = list(np.diag(M))
         names = keep
+    speed = ps.carrier_speed_rpm * 2.0 * math.pi / 60.0
+    if speed and ps.dofs == "torsional":
+        raise ValueError("a carrier speed needs the lateral-torsional model (translations)")
+    bearing = ps.members["planet"].bearing
+    if speed and bearing <= ps.members["planet"].mass * speed**2:
+        raise ValueError(
+            f"at a carrier speed of {ps.carrier_speed_rpm:g} rpm the planets' bearings "
+            f"({bearing:g} N/m) cannot hold the planets against the centripetal "
+            f"stiffness m_p Omega_c^2 = {ps.members['planet'].mass * speed**2:.4g} N/m"
+        )
+    G, K_omega = _rotating_frame(names, mass, speed, bearing) if speed else (None, None)
     sv = np.linalg.svd(R, compute_uv=False) if R.size else np.zeros(0)
     rank = int(np.sum(sv > 1e-10 * (sv.max() if sv.size else 1.0)))
     return PlanetaryStructure(
@@ -242,6 +311,9 @@ def derive_planetary(ps: PlanetarySet) -> PlanetaryStructure:
         stiffness=tuple(float(v) for v in k),
         rigid_body_modes=len(names) - rank,
         phases=mesh_phases(ps),
+        carrier_speed_rad_s=speed,
+        gyroscopic=G,
+        centripetal=K_omega,
     )
 
 

@@ -16,6 +16,7 @@ the carrier are equally spaced unless given.
     [planetary]
     degrees_of_freedom = "lateral-torsional"      # or "torsional"
     planets = 3                                   # or planet_angles_deg = [0, 120, 240]
+    carrier_speed_rpm = 0                         # optional: the rotating frame's terms
     sun_teeth = 31                                # optional, both: the mesh phases
     ring_teeth = 89
     sun_planet = { stiffness_N_per_m = 5e8, pressure_angle_deg = 24.6 }
@@ -35,6 +36,13 @@ the carrier are equally spaced unless given.
 The ``torsional`` model keeps each member's rotation only: translations are held and
 each planet's centre moves with the carrier (its bearing rigid), as in the purely
 torsional model Lin and Parker compare with.
+
+``carrier_speed_rpm`` (default 0) turns the carrier at that constant speed: the translations
+are then measured in the carrier's rotating frame, which adds the gyroscopic and
+centripetal terms of Lin and Parker's equations of motion (their eq. 1); the modes are
+then those of ``M q'' + Omega_c G q' + (K - Omega_c^2 K_Omega) q = 0``, their frequencies
+seen from the carrier.  The torsional model has no translations for these terms to act
+on and refuses a carrier speed.
 """
 
 from __future__ import annotations
@@ -96,6 +104,7 @@ class PlanetarySet:
     sun_teeth: int | None = None  # tooth counts, for the mesh phases (optional)
     ring_teeth: int | None = None
     variation: Variation | None = None  # [planetary.variation] (optional)
+    carrier_speed_rpm: float = 0.0  # the rotating frame's terms when not zero
 
     @property
     def planets(self) -> int:
@@ -216,6 +225,14 @@ def load_planetary(path: Path | str) -> PlanetarySet:
                     f"the ring ({z_r}): (sun_teeth + ring_teeth) x angle / 360 = {turns:g} "
                     "must be a whole number; change the angles or the tooth counts",
                 )
+    speed = p.number("carrier_speed_rpm", 0.0)
+    if speed != 0.0 and dofs == "torsional":
+        raise p.error(
+            "carrier_speed_rpm",
+            "the torsional model has no translations, on which the rotating frame's "
+            'gyroscopic and centripetal terms act; use degrees_of_freedom = "lateral-'
+            'torsional", or leave the carrier speed out',
+        )
     k_sp, alpha_s = _mesh(p.table("sun_planet"))
     k_rp, alpha_r = _mesh(p.table("ring_planet"))
     members = {m: _member(p.table(m), m, False) for m in CENTRAL}
@@ -241,4 +258,5 @@ def load_planetary(path: Path | str) -> PlanetarySet:
         z_s,
         z_r,
         variation,
+        speed,
     )

@@ -24,7 +24,15 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-__all__ = ["DOMINANT", "Mode", "Modes", "eigenproblem", "modes", "planetary_modes"]
+__all__ = [
+    "DOMINANT",
+    "Mode",
+    "Modes",
+    "UnstableAtSpeed",
+    "eigenproblem",
+    "modes",
+    "planetary_modes",
+]
 
 DOMINANT = 0.8  # kinetic-energy share of one group that names a mode
 _GROUPS = {
@@ -215,18 +223,29 @@ def planetary_modes(structure: dict, name: str) -> Modes:
     ``coupled`` where none holds (unequally spaced planets); and each with the number of
     modes at its frequency (translational modes come in pairs, planet modes N - 3 at a time,
     N - 1 in the torsional model).  No mesh frequency is known (the set's file gives no
-    speed): ``mesh_frequency_hz`` is NaN."""
-    w2, vec, mass, R, k = eigenproblem(structure)
-    rigid = np.abs(w2) <= 1e-10 * np.max(np.abs(w2))
-    f = np.where(rigid, 0.0, np.sqrt(np.abs(w2)) / (2 * math.pi))
+    speed): ``mesh_frequency_hz`` is NaN.
+
+    With a carrier speed (``carrier_speed_rad_s`` in ``structure``) the modes are those of
+    ``M q'' + Omega_c G q' + (K - Omega_c^2 K_Omega) q = 0`` (:func:`_rotating`), their
+    frequencies seen from the carrier and their shapes complex: ``shape`` then holds each
+    coordinate's magnitude (the largest 1), the energies the magnitudes squared."""
+    mass = np.asarray(structure["mass"], dtype=float)
+    R = np.asarray(structure["incidence"], dtype=float)
+    k = np.asarray(structure["stiffness"], dtype=float)
+    if structure.get("carrier_speed_rad_s"):
+        f, vec, rigid = _rotating(structure, mass, R, k)
+    else:
+        w2, vec, mass, R, k = eigenproblem(structure)
+        rigid = np.abs(w2) <= 1e-10 * np.max(np.abs(w2))
+        f = np.where(rigid, 0.0, np.sqrt(np.abs(w2)) / (2 * math.pi))
     central = np.array([m in ("carrier", "ring", "sun") for m in structure["members"]])
     turning = np.array([m == "rotation" for m in structure["motions"]])
     tol = PLANETARY_TOLERANCE
     counts = [int(np.sum(np.abs(f - fi) <= tol * f.max())) for fi in f]
     out = []
-    for i in range(len(w2)):
+    for i in range(len(f)):
         v = vec[:, i]
-        kinetic = mass * v**2
+        kinetic = mass * np.abs(v) ** 2
         total = kinetic.sum()
         shares = {
             "central rotation": float(kinetic[central & turning].sum() / total),
@@ -243,13 +262,13 @@ def planetary_modes(structure: dict, name: str) -> Modes:
             label = "translational"
         else:
             label = "coupled"
-        strain = k * (R @ v) ** 2
+        strain = k * np.abs(R @ v) ** 2
         strain_total = strain.sum()
         strain_shares = {
             c: 0.0 if rigid[i] else float(e / strain_total)
             for c, e in zip(structure["coordinates"], strain, strict=True)
         }
-        scale = v[np.argmax(np.abs(v))]
+        shape = np.abs(v) / np.abs(v).max() if np.iscomplexobj(v) else v / v[np.argmax(np.abs(v))]
         out.append(
             Mode(
                 index=i,
@@ -257,8 +276,60 @@ def planetary_modes(structure: dict, name: str) -> Modes:
                 label=label,
                 kinetic_shares=shares,
                 strain_shares=strain_shares,
-                shape={n: float(a / scale) for n, a in zip(structure["physical"], v, strict=True)},
+                shape={n: float(a) for n, a in zip(structure["physical"], shape, strict=True)},
                 multiplicity=counts[i],
             )
         )
     return Modes(name, tuple(out), float("nan"), 0, "")
+
+
+class UnstableAtSpeed(ValueError):
+    """The set has no modes at this carrier speed: a solution grows (the centripetal
+    softening has made the stiffness indefinite, or the gyroscopic coupling flutters)."""
+
+
+def _rotating(structure: dict, mass, R, k):
+    """``(f, shapes, rigid)`` of ``M q'' + W G q' + (K - W^2 K_W) q = 0`` (``W`` the carrier
+    speed): the rigid-body modes (the null space of the stiffness, real) first, then the
+    ``n - r`` eigenvalues ``i 2 pi f`` of the first-order form with ``f > 0``, ascending,
+    with the displacement part of their eigenvectors.  Raises :class:`UnstableAtSpeed` when
+    an eigenvalue leaves the imaginary axis (relative 1e-9) or the stiffness is
+    indefinite."""
+    W = float(structure["carrier_speed_rad_s"])
+    G = np.asarray(structure["gyroscopic"], dtype=float)
+    K = R.T @ (k[:, None] * R) - W**2 * np.asarray(structure["centripetal"], dtype=float)
+    n = mass.size
+    w2, static = scipy.linalg.eigh(K, np.diag(mass))
+    scale = np.max(np.abs(w2))
+    rigid = np.abs(w2) <= 1e-10 * scale
+    speed = f"{W * 60 / (2 * math.pi):g} rpm"
+    if np.any(w2 < -1e-10 * scale):
+        raise UnstableAtSpeed(
+            f"at a carrier speed of {speed} the centripetal terms make the stiffness "
+            "indefinite (divergence): the set has no vibration modes there"
+        )
+    A = np.zeros((2 * n, 2 * n))
+    A[:n, n:] = np.eye(n)
+    A[n:, :n] = -K / mass[:, None]
+    A[n:, n:] = -W * G / mass[:, None]
+    lam, V = scipy.linalg.eig(A)
+    size = np.max(np.abs(lam))
+    # the 2 r eigenvalues nearest 0 are the rigid-body modes' (a Jordan block, scattered
+    # by rounding to about sqrt(eps) of the largest): the rest must sit on the axis
+    elastic = np.argsort(np.abs(lam))[2 * int(rigid.sum()) :]
+    if np.max(np.abs(lam.real[elastic])) > 1e-9 * size:
+        raise UnstableAtSpeed(
+            f"at a carrier speed of {speed} an eigenvalue has a real part "
+            f"{np.max(lam.real[elastic]):.3g} 1/s (flutter): the set has no vibration modes "
+            "there"
+        )
+    up = elastic[lam.imag[elastic] > 0]
+    up = up[np.argsort(lam.imag[up])]
+    if up.size != n - int(rigid.sum()):
+        raise UnstableAtSpeed(
+            f"at a carrier speed of {speed} the first-order form has {up.size} "
+            f"oscillating eigenvalues where {n - int(rigid.sum())} were expected"
+        )
+    f = np.concatenate([np.zeros(int(rigid.sum())), lam.imag[up] / (2 * math.pi)])
+    shapes = np.concatenate([static[:, rigid].astype(complex), V[:n, up]], axis=1)
+    return f, shapes, np.arange(n) < int(rigid.sum())

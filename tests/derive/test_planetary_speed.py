@@ -1,0 +1,214 @@
+"""A planetary set with its carrier turning (issue 26, Build 3): the gyroscopic and
+centripetal terms of the rotating frame, against named references.
+
+* Closed form: a mass on an isotropic spring seen from axes turning at Omega has the
+  frequencies sqrt(k / m) -/+ Omega (m (w + Omega)^2 = k for z = x + i y ~ exp(i w t)).
+* An independent assembly written here: M and K of Lin and Parker's lateral-torsional
+  model by hand (``test_planetary.by_hand``), their gyroscopic matrix G and centripetal
+  K_Omega of their equations of motion by hand, and the planets' bearings' load on u_c from
+  a numerical Hessian of one planet's exact energy in the rotating frame (centripetal
+  potential and its bearing as a vector spring between its centre and the pin, the pin on
+  a circle of radius r_c, in static equilibrium): the eigenvalues of the first-order form,
+  no gearsym code.
+* First principles: turning the whole set is neutral at any carrier speed (its rigid-body
+  mode stays at 0 Hz); G is skew, so the gyroscopic forces do no work (the undamped
+  model's energy in the frame is conserved) and the stiffness is symmetric.
+* Cooley and Parker (2012, "Vibration properties of high-speed planetary gears with
+  gyroscopic effects", J. Vib. Acoust. 134) show the rotational, translational and planet
+  mode types surviving the gyroscopic terms for equally spaced planets, the degenerate
+  translational pairs splitting: checked on the types here, not on their numbers.
+"""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from gearsym.derive.equations.planetary import derive_planetary
+from gearsym.solver.analysis.modes import planetary_modes
+
+from .test_planetary import by_hand, example
+
+RPM = 2 * math.pi / 60
+
+
+def test_mass_on_an_isotropic_spring_in_turning_axes():
+    m, k, rpm = 2.0, 8.0e6, 6000.0
+    W = rpm * RPM
+    structure = {
+        "physical": ("zeta_1", "eta_1"),
+        "mass": (m, m),
+        "coordinates": ("x", "y"),
+        "kinds": ("bearing", "bearing"),
+        "incidence": ((1.0, 0.0), (0.0, 1.0)),
+        "stiffness": (k, k),
+        "members": ("planet1", "planet1"),
+        "motions": ("translation", "translation"),
+        "carrier_speed_rad_s": W,
+        "gyroscopic": ((0.0, -2 * m), (2 * m, 0.0)),
+        "centripetal": ((m, 0.0), (0.0, m)),
+    }
+    f = [mode.frequency_hz for mode in planetary_modes(structure, "one mass").modes]
+    wn = math.sqrt(k / m)
+    assert f == pytest.approx([(wn - W) / (2 * math.pi), (wn + W) / (2 * math.pi)], rel=1e-12)
+
+
+def by_hand_at_speed(ps, rpm: float, r_c: float = 0.1):
+    """(M, G, K - W^2 K_Omega) by hand; the planets' load on u_c from a central-difference
+    Hessian of one planet's exact energy (coordinates zeta, eta, u_c; the pin at radius
+    ``r_c``, which the result must not depend on)."""
+    W = rpm * RPM
+    M, K = by_hand(ps)
+    n = len(ps.angles_deg)
+    masses = np.diag(M)
+    G = np.zeros_like(K)
+    Kw = np.zeros_like(K)
+    for body in range(3 + n):
+        x, y = 3 * body, 3 * body + 1
+        G[x, y], G[y, x] = -2 * masses[x], 2 * masses[y]
+        Kw[x, x], Kw[y, y] = masses[x], masses[y]
+    mp, kp = ps.members["planet"].mass, ps.members["planet"].bearing
+    d = mp * W**2 * r_c / (kp - mp * W**2)  # static stretch: kp d = mp W^2 (r_c + d)
+
+    def energy(q):
+        zeta, eta, u_c = q
+        p = np.array([r_c + d + zeta, eta])
+        pin = r_c * np.array([math.cos(u_c / r_c), math.sin(u_c / r_c)])
+        return 0.5 * kp * np.sum((p - pin) ** 2) - 0.5 * mp * W**2 * np.sum(p**2)
+
+    h = 1e-7
+    H = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            e_i, e_j = np.eye(3)[i] * h, np.eye(3)[j] * h
+            H[i, j] = (
+                energy(e_i + e_j) - energy(e_i - e_j) - energy(-e_i + e_j) + energy(-e_i - e_j)
+            ) / (4 * h * h)
+    # the Hessian's u_c entry less the bearing's linear k_p: the load's share, per planet
+    load = H[2, 2] - kp
+    Keff = K - W**2 * Kw
+    Keff[2, 2] += n * load
+    return M, G * W, Keff, H
+
+
+def first_order_frequencies(M, C, K) -> np.ndarray:
+    n = M.shape[0]
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+    lam = np.linalg.eigvals(A)
+    return np.sort(lam.imag[lam.imag > 1e-3]) / (2 * math.pi)
+
+
+@pytest.mark.parametrize(("n", "rpm"), [(3, 3000.0), (4, 12000.0), (5, 20000.0)])
+def test_frequencies_at_speed_equal_the_hand_assembly(n, rpm):
+    ps = replace(example(n), carrier_speed_rpm=rpm)
+    ours = [m.frequency_hz for m in planetary_modes(derive_planetary(ps).as_structure(), "x").modes]
+    M, C, K, H = by_hand_at_speed(ps, rpm)
+    hand = first_order_frequencies(M, C, K)
+    assert ours[0] == 0.0  # the rigid-body rotation
+    assert np.array(ours[1:]) == pytest.approx(hand, rel=1e-6)
+    # the exact planet Hessian has the model's other entries: bearing k_p on zeta and on
+    # eta - u_c, and the centripetal -m_p W^2 on zeta and eta
+    kp, mp, W = ps.members["planet"].bearing, ps.members["planet"].mass, rpm * RPM
+    expected = np.array([[kp - mp * W**2, 0, 0], [0, kp - mp * W**2, -kp], [0, -kp, None]])
+    for i, j in [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2)]:
+        assert H[i, j] == pytest.approx(expected[i, j], rel=1e-5, abs=1e-3 * kp)
+
+
+@pytest.mark.parametrize("rpm", [1000.0, 10000.0, 30000.0])
+def test_turning_the_whole_set_stays_neutral(rpm):
+    st = derive_planetary(replace(example(4), carrier_speed_rpm=rpm))
+    modal = planetary_modes(st.as_structure(), "x")
+    assert [m.label for m in modal.modes].count("rigid-body") == 1
+    assert modal.modes[0].frequency_hz == 0.0
+    assert modal.modes[1].frequency_hz > 100.0
+
+
+def test_gyroscopic_forces_do_no_work_and_the_stiffness_is_symmetric():
+    st = derive_planetary(replace(example(3), carrier_speed_rpm=5000.0))
+    G, Kw = st.gyroscopic, st.centripetal
+    assert np.array_equal(G, -G.T)
+    assert np.array_equal(Kw, Kw.T)
+    v = np.random.default_rng(0).normal(size=G.shape[0])
+    assert abs(v @ G @ v) <= 1e-12 * np.abs(G).max() * (v @ v)
+
+
+def test_mode_types_survive_the_gyroscopic_terms():
+    """Cooley and Parker (2012): rotational modes keep the central members from
+    translating, planet modes keep them still; the translational pairs split."""
+    for n in (3, 5):
+        fixed = planetary_modes(derive_planetary(example(n)).as_structure(), "x").modes
+        turning = planetary_modes(
+            derive_planetary(replace(example(n), carrier_speed_rpm=3000.0)).as_structure(), "x"
+        ).modes
+        labels = [m.label for m in turning]
+        assert labels.count("coupled") == 0
+        assert labels.count("rotational") == [m.label for m in fixed].count("rotational")
+        trans = [m for m in turning if m.label == "translational"]
+        assert len(trans) == 12 and all(m.multiplicity == 1 for m in trans)
+        planet = [m for m in turning if m.label == "planet"]
+        assert all(m.multiplicity == n - 3 for m in planet)
+        assert len(planet) == 3 * (n - 3)
+        # the lowest pair split about its fixed-carrier frequency by about the speed
+        f0 = min(m.frequency_hz for m in fixed if m.label == "translational")
+        lo, hi = trans[0].frequency_hz, trans[1].frequency_hz
+        assert lo < f0 < hi and 0.5 * 50.0 < (hi - lo) / 2 < 1.5 * 50.0
+
+
+def test_slow_carrier_approaches_the_fixed_carrier():
+    fixed = planetary_modes(derive_planetary(example(3)).as_structure(), "x").modes
+    slow = planetary_modes(
+        derive_planetary(replace(example(3), carrier_speed_rpm=1e-3)).as_structure(), "x"
+    ).modes
+    for a, b in zip(fixed, slow, strict=True):
+        assert abs(a.frequency_hz - b.frequency_hz) < 1e-4  # the split: 1.7e-5 Hz
+
+
+def run(*args):
+    return subprocess.run(
+        [sys.executable, "-m", "gearsym", *args], capture_output=True, text=True, timeout=300
+    )
+
+
+def test_cli_and_refusals(tmp_path):
+    src = (
+        __import__("gearsym.derive.input.scene", fromlist=["resolve_target"])
+        .resolve_target("lin-parker-1999-3")
+        .read_text(encoding="utf-8")
+    )
+    turning = tmp_path / "turning.toml"
+    turning.write_text(
+        src.replace(
+            'degrees_of_freedom = "lateral-torsional"',
+            'degrees_of_freedom = "lateral-torsional"\ncarrier_speed_rpm = 3000',
+        ),
+        encoding="utf-8",
+    )
+    done = run("modes", str(turning))
+    assert done.returncode == 0, done.stderr
+    assert "carrier at 3000 rpm" in done.stdout and "696.5" in done.stdout
+    torsional = tmp_path / "torsional.toml"
+    torsional.write_text(
+        src.replace(
+            'degrees_of_freedom = "lateral-torsional"',
+            'degrees_of_freedom = "torsional"\ncarrier_speed_rpm = 3000',
+        ),
+        encoding="utf-8",
+    )
+    done = run("modes", str(torsional))
+    assert done.returncode == 2 and "carrier_speed_rpm" in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
+    fast = tmp_path / "fast.toml"
+    fast.write_text(
+        src.replace(
+            'degrees_of_freedom = "lateral-torsional"',
+            'degrees_of_freedom = "lateral-torsional"\ncarrier_speed_rpm = 200000',
+        ),
+        encoding="utf-8",
+    )
+    done = run("modes", str(fast))
+    assert done.returncode == 2 and "lower carrier_speed_rpm" in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
