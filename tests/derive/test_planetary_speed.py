@@ -174,11 +174,9 @@ def run(*args):
 
 
 def test_cli_and_refusals(tmp_path):
-    src = (
-        __import__("gearsym.derive.input.scene", fromlist=["resolve_target"])
-        .resolve_target("lin-parker-1999-3")
-        .read_text(encoding="utf-8")
-    )
+    from gearsym.derive.input.scene import resolve_target
+
+    src = resolve_target("lin-parker-1999-3").read_text(encoding="utf-8")
     turning = tmp_path / "turning.toml"
     turning.write_text(
         src.replace(
@@ -212,3 +210,19 @@ def test_cli_and_refusals(tmp_path):
     done = run("modes", str(fast))
     assert done.returncode == 2 and "lower carrier_speed_rpm" in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
+
+
+def test_parametric_analysis_refuses_a_turning_carrier(tmp_path):
+    """The parametric analysis is of the fixed-carrier model: with a speed it refuses,
+    in the API and in one line of the CLI, rather than drop the gyroscopic terms."""
+    import gearsym.planetary
+    from gearsym.derive.input.scene import resolve_target
+
+    src = resolve_target("lin-parker-1999-3-phased").read_text(encoding="utf-8")
+    path = tmp_path / "phased-turning.toml"
+    path.write_text(src.replace("[planetary]\n", "[planetary]\ncarrier_speed_rpm = 3000\n", 1))
+    with pytest.raises(ValueError, match="fixed-carrier"):
+        gearsym.planetary.parametric_instabilities(str(path))
+    done = run("modes", str(path), "--parametric")
+    assert done.returncode == 2 and "remove carrier_speed_rpm" in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1
