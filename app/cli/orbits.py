@@ -59,7 +59,7 @@ def register(sub) -> None:
         "--monodromy",
         choices=("ad", "variational", "fd"),
         default=None,
-        help="monodromy route (default: variational, with located crossings for a dead zone)",
+        help="monodromy route (default: ad; variational with located crossings for a dead zone)",
     )
     sh.add_argument(
         "--compare-monodromy",

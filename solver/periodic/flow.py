@@ -127,13 +127,10 @@ class FlowMap:
     ):
         """(end state, d end / d start, int trace J) over ``duration`` from ``x0``.
 
-        ``method`` defaults to ``"variational"``: with the crossings located for a
-        piecewise model, on CVODES otherwise, where it agrees with ``"ad"`` to about
-        1e-11 (``monodromy_agreement``) at a quarter of the time on the reference model
-        (6 ms against 24 ms a period) and less than half on the 22-state bearing model
-        (51 ms against 117 ms)."""
+        ``method`` defaults to ``"variational"`` when crossings are located (piecewise
+        models), else ``"ad"``."""
         if method is None:
-            method = "variational"
+            method = "variational" if self.locate else "ad"
         if method not in MONODROMY_METHODS:
             raise ValueError(
                 f"unknown monodromy method '{method}'; methods: {', '.join(MONODROMY_METHODS)}"

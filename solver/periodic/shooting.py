@@ -199,7 +199,7 @@ def shoot(
     ``segments`` > 1 uses multiple shooting: the initial segment states come from
     integrating the guess.  Converged when the residual's max-norm is below ``tol``.
     ``monodromy`` picks the route (``ad``, ``variational``, ``fd``); by default the
-    flow's own (the variational equations, crossings located for a piecewise model).  Pass
+    flow's own (located variational equations for a piecewise model, else AD).  Pass
     ``flow`` to reuse one flow map (and its integrators) over many calls.
     """
     if n < 1 or segments < 1:
