@@ -62,7 +62,8 @@ def parametric_instabilities(target, *, floquet: bool = False) -> dict:
     if st.planetary.carrier_speed_rpm:
         raise ValueError(
             f"{st.planetary.name}: the parametric analysis is of the fixed-carrier model "
-            "(no gyroscopic terms); the set turns its carrier (carrier_speed_rpm)"
+            "(no gyroscopic terms), and the set turns its carrier: remove carrier_speed_rpm "
+            "for it"
         )
     v = st.planetary.variation
     if v is None or st.phases is None:

@@ -135,16 +135,17 @@ def _planetary(path, args) -> int:
     (1999) prove them (``planetary_modes``); no speed is known, so no resonance diagram."""
     from gearsym.derive.equations.planetary import derive_planetary
     from gearsym.derive.input.planetary import load_planetary
-    from gearsym.solver.analysis.modes import planetary_modes
+    from gearsym.solver.analysis.modes import UnstableAtSpeed, planetary_modes
 
     if args.speeds:
         raise Fail(
-            "--speeds: a planetary set's file gives no speed, so there is no mesh frequency "
+            "--speeds: a planetary set's file gives no tooth-pass speed, so there is no mesh "
+            "frequency "
             "to meet; run without it"
         )
     if args.plot and not args.parametric:
         raise Fail(
-            "--plot: a planetary set has no resonance diagram (its file gives no speed); "
+            "--plot: a planetary set has no resonance diagram (no mesh frequency); "
             "add --parametric for its parametric-instability diagram"
         )
     if args.plot:
@@ -164,10 +165,10 @@ def _planetary(path, args) -> int:
             f"{ps.carrier_speed_rpm:g}); the parametric analysis is of the fixed-carrier "
             "model, without gyroscopic terms: remove carrier_speed_rpm for it"
         )
+    st = derive_planetary(ps)
     try:
-        st = derive_planetary(ps)
         result = planetary_modes(st.as_structure(), ps.name)
-    except ValueError as err:  # a carrier speed the set cannot run at
+    except UnstableAtSpeed as err:  # a carrier speed the set cannot run at
         raise Fail(f"{path}: {err}; lower carrier_speed_rpm") from None
     data = {
         "model": ps.name,
@@ -222,7 +223,7 @@ def _planetary(path, args) -> int:
         f"{ps.planets} {spacing} planets, "
         + (
             f"carrier at {ps.carrier_speed_rpm:g} rpm (gyroscopic and centripetal terms; "
-            "frequencies seen from the carrier, shapes as magnitudes)"
+            "frequencies seen from the carrier)"
             if ps.carrier_speed_rpm
             else "carrier speed 0 (no gyroscopic terms)"
         )

@@ -68,8 +68,8 @@ def planetary_page(st: PlanetaryStructure, command: str, source: str) -> str:
         "enters the linear analysis of parametric instability (`gearsym modes "
         "--parametric`, with a `[planetary.variation]` table and the tooth counts; "
         "`docs/analysis.md`).\n",
-        "**Not modelled yet** (issue 26): backlash and tooth separation, damping, "
-        "the rotating frame's terms in the parametric analysis, and therefore simulation, "
+        "**Not modelled yet** (issue 26): the rotating frame's terms in the parametric "
+        "analysis; backlash and tooth separation, damping, and therefore simulation, "
         "sweeps, maps, periodic orbits and frequency responses of a planetary set: those "
         "commands refuse it.\n",
         "## Kinematic graph\n",

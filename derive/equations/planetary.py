@@ -29,9 +29,16 @@ pin's second-order motion ``r_c (1 - cos theta)``: ``+F u_c^2 / (2 r_c)`` a plan
 ``F / r_c = k_p m_p Omega_c^2 / (k_p - m_p Omega_c^2)`` (no ``r_c`` needed).  So
 ``K_Omega[u_c, u_c] = -N k_p m_p / (k_p - m_p Omega_c^2)``; the rest of the model keeps the
 unstretched geometry.  With it the rigid-body rotation is an exact null vector at every
-speed (tested: 0 Hz).  A carrier speed at or above ``sqrt(k_p / m_p)`` (the bearings can
-no longer hold the planets) is refused.  Not checked against a published table at speed
-(none was at hand).
+speed (tested: 0 Hz) for balanced planets (the sum of their unit vectors zero: equally
+spaced, or in opposite pairs); the loader refuses a speed with unbalanced ones, whose net
+centripetal force would offset the carrier.  The bearings carry the whole load where the
+meshes take none of it (checked on the static deflection; true of the shipped sets);
+where they would share it (for example every member held and unequal pressure angles)
+the speed is refused, as the geometric stiffness of a mesh's preload is not modelled.  A
+carrier speed at or above ``sqrt(k_p / m_p)`` (the bearings can no longer hold the
+planets) is refused.  The term departs from Lin and Parker's ``K_Omega``, so results at
+speed need not match work that used it alone; not checked against a published table at
+speed (none was at hand).
 
 **Springs** (each a row of ``R``, ``delta = R q``, and a stiffness ``k``):
 
@@ -247,6 +254,33 @@ def _lateral(ps: PlanetarySet):
     return q, members, motions, mass, springs, kinds, deflections, R, stiffness
 
 
+def _bearings_carry_the_load(ps, names, mass, R, k, kinds, speed, K_omega) -> None:
+    """Refuse a set whose meshes would share the planets' steady centripetal load (all its
+    members held and unequal pressure angles): the load term on ``u_c`` assumes the
+    planets' bearings carry all of it, and the geometric stiffness of a mesh's preload is
+    not modelled.  The static deflection under ``m_p Omega_c^2`` on each ``zeta`` (per unit
+    ``r_c``), and the mesh forces against the bearing forces in it."""
+    from ..input.reader import InputError
+
+    K = R.T @ (np.asarray(k)[:, None] * R) - speed**2 * K_omega
+    load = np.array(
+        [m * speed**2 if n.startswith("zeta_") else 0.0 for n, m in zip(names, mass, strict=True)]
+    )
+    q = np.linalg.lstsq(K, load, rcond=None)[0]
+    force = np.abs(np.asarray(k) * (R @ q))
+    mesh = max(f for f, kind in zip(force, kinds, strict=True) if kind == "mesh")
+    carried = max(f for f, kind in zip(force, kinds, strict=True) if kind == "planet bearing")
+    if mesh > 1e-9 * carried:
+        raise InputError(
+            ps.source,
+            "planetary.carrier_speed_rpm",
+            f"the meshes would carry {100 * mesh / (mesh + carried):.3g} % of the planets' "
+            "centripetal load (the sun, ring and carrier all held, unequal pressure angles): "
+            "the geometric stiffness of a mesh's preload is not modelled; free one member's "
+            "rotation or give the two meshes one pressure angle",
+        )
+
+
 def mesh_phases(ps: PlanetarySet) -> tuple[tuple[float, float], ...] | None:
     """``(gamma_sn, gamma_rn)`` of each planet in mesh periods, in [0, 1) (module
     docstring); None without tooth counts."""
@@ -296,6 +330,8 @@ def derive_planetary(ps: PlanetarySet) -> PlanetaryStructure:
             f"stiffness m_p Omega_c^2 = {ps.members['planet'].mass * speed**2:.4g} N/m"
         )
     G, K_omega = _rotating_frame(names, mass, speed, bearing) if speed else (None, None)
+    if speed:
+        _bearings_carry_the_load(ps, names, mass, R, k, kinds, speed, K_omega)
     sv = np.linalg.svd(R, compute_uv=False) if R.size else np.zeros(0)
     rank = int(np.sum(sv > 1e-10 * (sv.max() if sv.size else 1.0)))
     return PlanetaryStructure(

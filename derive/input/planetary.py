@@ -42,7 +42,9 @@ are then measured in the carrier's rotating frame, which adds the gyroscopic and
 centripetal terms of Lin and Parker's equations of motion (their eq. 1); the modes are
 then those of ``M q'' + Omega_c G q' + (K - Omega_c^2 K_Omega) q = 0``, their frequencies
 seen from the carrier.  The torsional model has no translations for these terms to act
-on and refuses a carrier speed.
+on and refuses a carrier speed; so do unbalanced planets (the carrier's static offset
+under their net centripetal force is not modelled) and a speed at or above
+``sqrt(k_p / m_p)``, where the bearings cannot hold the planets.
 """
 
 from __future__ import annotations
@@ -233,10 +235,30 @@ def load_planetary(path: Path | str) -> PlanetarySet:
             'gyroscopic and centripetal terms act; use degrees_of_freedom = "lateral-'
             'torsional", or leave the carrier speed out',
         )
+    balance = abs(
+        sum(complex(math.cos(math.radians(a)), math.sin(math.radians(a))) for a in angles)
+    )
+    if speed != 0.0 and balance > 1e-9 * len(angles):
+        raise p.error(
+            "carrier_speed_rpm",
+            f"the planets at {[round(a, 6) for a in angles]} deg do not balance (the sum of "
+            f"their unit vectors is {balance:.3g} long): a turning carrier would take a net "
+            "centripetal force whose static offset this model leaves out; a carrier speed "
+            "needs balanced planets (equally spaced, or in opposite pairs)",
+        )
     k_sp, alpha_s = _mesh(p.table("sun_planet"))
     k_rp, alpha_r = _mesh(p.table("ring_planet"))
     members = {m: _member(p.table(m), m, False) for m in CENTRAL}
     members["planet"] = _member(p.table("planet"), "planet", True)
+    planet = members["planet"]
+    if speed != 0.0 and planet.bearing <= planet.mass * (speed * math.pi / 30.0) ** 2:
+        limit = math.sqrt(planet.bearing / planet.mass) * 30.0 / math.pi
+        raise p.error(
+            "carrier_speed_rpm",
+            f"{speed:g} rpm: the planets' bearings ({planet.bearing:g} N/m) cannot hold the "
+            f"planets against the centripetal stiffness m_p Omega_c^2; keep it below "
+            f"{limit:.6g} rpm or stiffen [planetary.planet] bearing_N_per_m",
+        )
     variation = p.table("variation", None)
     variation = None if variation is None else _variation(variation, z_s is not None)
     p.finish()

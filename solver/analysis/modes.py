@@ -8,6 +8,7 @@ and its spring at the mean stiffness.  With the backlash closed (the mesh in con
 solve ``K v = w^2 M v`` (``scipy.linalg.eigh``).  The rigid-body rotation is the mode with
 ``w = 0``.  No damping and no gyroscopic terms: the frequencies do not depend on speed, so
 the resonance (Campbell) diagram is flat lines crossed by the mesh-frequency harmonics.
+(A planetary set with a turning carrier is the exception: :func:`planetary_modes`.)
 
 Each mode is labelled by where its kinetic energy sits, ``m_k v_k^2`` grouped into
 rotations, translations across the axes and along them, and tilts: a group holding at
@@ -223,12 +224,13 @@ def planetary_modes(structure: dict, name: str) -> Modes:
     ``coupled`` where none holds (unequally spaced planets); and each with the number of
     modes at its frequency (translational modes come in pairs, planet modes N - 3 at a time,
     N - 1 in the torsional model).  No mesh frequency is known (the set's file gives no
-    speed): ``mesh_frequency_hz`` is NaN.
+    tooth-pass speed): ``mesh_frequency_hz`` is NaN.
 
     With a carrier speed (``carrier_speed_rad_s`` in ``structure``) the modes are those of
     ``M q'' + Omega_c G q' + (K - Omega_c^2 K_Omega) q = 0`` (:func:`_rotating`), their
     frequencies seen from the carrier and their shapes complex: ``shape`` then holds each
-    coordinate's magnitude (the largest 1), the energies the magnitudes squared."""
+    coordinate's magnitude (the largest 1; a rigid-body mode, real, keeps its signs), the
+    energies the magnitudes squared."""
     mass = np.asarray(structure["mass"], dtype=float)
     R = np.asarray(structure["incidence"], dtype=float)
     k = np.asarray(structure["stiffness"], dtype=float)
@@ -268,6 +270,8 @@ def planetary_modes(structure: dict, name: str) -> Modes:
             c: 0.0 if rigid[i] else float(e / strain_total)
             for c, e in zip(structure["coordinates"], strain, strict=True)
         }
+        if np.iscomplexobj(v) and not np.any(v.imag):
+            v = v.real  # a rigid-body mode of the turning set: real
         shape = np.abs(v) / np.abs(v).max() if np.iscomplexobj(v) else v / v[np.argmax(np.abs(v))]
         out.append(
             Mode(
@@ -284,8 +288,12 @@ def planetary_modes(structure: dict, name: str) -> Modes:
 
 
 class UnstableAtSpeed(ValueError):
-    """The set has no modes at this carrier speed: a solution grows (the centripetal
-    softening has made the stiffness indefinite, or the gyroscopic coupling flutters)."""
+    """No modes are given at this carrier speed: the centripetal softening has made the
+    stiffness indefinite (the set then diverges, or is at best held by its gyroscopic
+    terms, which any damping turning with the carrier undoes: Kelvin, Tait and Chetaev's
+    theorem).  With a positive definite stiffness every eigenvalue lies on the imaginary
+    axis (the gyroscopic forces do no work); one found off it is a numerical failure and
+    is refused too."""
 
 
 def _rotating(structure: dict, mass, R, k):
@@ -293,8 +301,9 @@ def _rotating(structure: dict, mass, R, k):
     speed): the rigid-body modes (the null space of the stiffness, real) first, then the
     ``n - r`` eigenvalues ``i 2 pi f`` of the first-order form with ``f > 0``, ascending,
     with the displacement part of their eigenvectors.  Raises :class:`UnstableAtSpeed` when
-    an eigenvalue leaves the imaginary axis (relative 1e-9) or the stiffness is
-    indefinite."""
+    the stiffness is indefinite or an eigenvalue leaves the imaginary axis (relative 1e-9;
+    the rigid-body pairs, a Jordan block each, scatter by about 5e-9 and are set aside
+    first)."""
     W = float(structure["carrier_speed_rad_s"])
     G = np.asarray(structure["gyroscopic"], dtype=float)
     K = R.T @ (k[:, None] * R) - W**2 * np.asarray(structure["centripetal"], dtype=float)
@@ -304,9 +313,17 @@ def _rotating(structure: dict, mass, R, k):
     rigid = np.abs(w2) <= 1e-10 * scale
     speed = f"{W * 60 / (2 * math.pi):g} rpm"
     if np.any(w2 < -1e-10 * scale):
+        count = int(np.sum(w2 < -1e-10 * scale))
+        held = (
+            "it diverges"
+            if count % 2
+            else "it diverges or is at best held by its gyroscopic terms, which any damping "
+            "turning with the carrier undoes"
+        )
         raise UnstableAtSpeed(
             f"at a carrier speed of {speed} the centripetal terms make the stiffness "
-            "indefinite (divergence): the set has no vibration modes there"
+            f"indefinite ({count} negative direction{'s' if count > 1 else ''}): {held}; no "
+            "modes are given there"
         )
     A = np.zeros((2 * n, 2 * n))
     A[:n, n:] = np.eye(n)
@@ -320,8 +337,8 @@ def _rotating(structure: dict, mass, R, k):
     if np.max(np.abs(lam.real[elastic])) > 1e-9 * size:
         raise UnstableAtSpeed(
             f"at a carrier speed of {speed} an eigenvalue has a real part "
-            f"{np.max(lam.real[elastic]):.3g} 1/s (flutter): the set has no vibration modes "
-            "there"
+            f"{np.max(lam.real[elastic]):.3g} 1/s, which a positive definite stiffness "
+            "excludes: the eigenvalues are not to be trusted there"
         )
     up = elastic[lam.imag[elastic] > 0]
     up = up[np.argsort(lam.imag[up])]

@@ -29,6 +29,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from gearsym.derive.equations.planetary import derive_planetary
+from gearsym.derive.input.planetary import load_planetary
 from gearsym.solver.analysis.modes import planetary_modes
 
 from .test_planetary import by_hand, example
@@ -58,9 +59,11 @@ def test_mass_on_an_isotropic_spring_in_turning_axes():
 
 
 def by_hand_at_speed(ps, rpm: float, r_c: float = 0.1):
-    """(M, G, K - W^2 K_Omega) by hand; the planets' load on u_c from a central-difference
-    Hessian of one planet's exact energy (coordinates zeta, eta, u_c; the pin at radius
-    ``r_c``, which the result must not depend on)."""
+    """(M, G, K - W^2 K_Omega) by hand; the planets' load on u_c from the exact Hessian
+    (SymPy) of one planet's exact energy in the frame, coordinates zeta, eta, u_c, in
+    static equilibrium (the pin at radius ``r_c``, which the result must not depend on)."""
+    import sympy as sp
+
     W = rpm * RPM
     M, K = by_hand(ps)
     n = len(ps.angles_deg)
@@ -72,50 +75,50 @@ def by_hand_at_speed(ps, rpm: float, r_c: float = 0.1):
         G[x, y], G[y, x] = -2 * masses[x], 2 * masses[y]
         Kw[x, x], Kw[y, y] = masses[x], masses[y]
     mp, kp = ps.members["planet"].mass, ps.members["planet"].bearing
+    zeta, eta, u_c = sp.symbols("zeta eta u_c", real=True)
     d = mp * W**2 * r_c / (kp - mp * W**2)  # static stretch: kp d = mp W^2 (r_c + d)
-
-    def energy(q):
-        zeta, eta, u_c = q
-        p = np.array([r_c + d + zeta, eta])
-        pin = r_c * np.array([math.cos(u_c / r_c), math.sin(u_c / r_c)])
-        return 0.5 * kp * np.sum((p - pin) ** 2) - 0.5 * mp * W**2 * np.sum(p**2)
-
-    h = 1e-7
-    H = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            e_i, e_j = np.eye(3)[i] * h, np.eye(3)[j] * h
-            H[i, j] = (
-                energy(e_i + e_j) - energy(e_i - e_j) - energy(-e_i + e_j) + energy(-e_i - e_j)
-            ) / (4 * h * h)
+    p = sp.Matrix([r_c + d + zeta, eta])
+    pin = r_c * sp.Matrix([sp.cos(u_c / r_c), sp.sin(u_c / r_c)])
+    energy = kp * (p - pin).dot(p - pin) / 2 - mp * W**2 * p.dot(p) / 2
+    q = (zeta, eta, u_c)
+    H = np.array([[float(sp.diff(energy, a, b).subs({v: 0 for v in q})) for b in q] for a in q])
+    gradient = [float(sp.diff(energy, a).subs({v: 0 for v in q})) for a in q]
+    assert np.allclose(gradient, 0.0, atol=1e-9 * kp * r_c)  # an equilibrium
     # the Hessian's u_c entry less the bearing's linear k_p: the load's share, per planet
-    load = H[2, 2] - kp
     Keff = K - W**2 * Kw
-    Keff[2, 2] += n * load
+    Keff[2, 2] += n * (H[2, 2] - kp)
     return M, G * W, Keff, H
 
 
-def first_order_frequencies(M, C, K) -> np.ndarray:
+def first_order(M, C, K) -> np.ndarray:
     n = M.shape[0]
     A = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
-    lam = np.linalg.eigvals(A)
-    return np.sort(lam.imag[lam.imag > 1e-3]) / (2 * math.pi)
+    return np.linalg.eigvals(A)
 
 
-@pytest.mark.parametrize(("n", "rpm"), [(3, 3000.0), (4, 12000.0), (5, 20000.0)])
-def test_frequencies_at_speed_equal_the_hand_assembly(n, rpm):
+@pytest.mark.parametrize(
+    ("n", "rpm", "r_c"), [(3, 3000.0, 0.1), (4, 12000.0, 0.05), (5, 20000.0, 0.2)]
+)
+def test_frequencies_at_speed_equal_the_hand_assembly(n, rpm, r_c):
     ps = replace(example(n), carrier_speed_rpm=rpm)
     ours = [m.frequency_hz for m in planetary_modes(derive_planetary(ps).as_structure(), "x").modes]
-    M, C, K, H = by_hand_at_speed(ps, rpm)
-    hand = first_order_frequencies(M, C, K)
-    assert ours[0] == 0.0  # the rigid-body rotation
-    assert np.array(ours[1:]) == pytest.approx(hand, rel=1e-6)
+    M, C, K, H = by_hand_at_speed(ps, rpm, r_c)
+    lam = first_order(M, C, K)
+    by_size = lam[np.argsort(np.abs(lam))]
+    # the rigid-body rotation: a double eigenvalue at 0 (scattered by rounding only)
+    assert np.all(np.abs(by_size[:2]) < 1e-6 * np.abs(lam).max())
+    rest = by_size[2:]
+    assert np.all(np.abs(rest.real) < 1e-9 * np.abs(lam).max())  # on the imaginary axis
+    hand = np.sort(rest.imag[rest.imag > 0]) / (2 * math.pi)
+    assert ours[0] == 0.0
+    assert np.array(ours[1:]) == pytest.approx(hand, rel=1e-9)
     # the exact planet Hessian has the model's other entries: bearing k_p on zeta and on
     # eta - u_c, and the centripetal -m_p W^2 on zeta and eta
     kp, mp, W = ps.members["planet"].bearing, ps.members["planet"].mass, rpm * RPM
-    expected = np.array([[kp - mp * W**2, 0, 0], [0, kp - mp * W**2, -kp], [0, -kp, None]])
-    for i, j in [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2)]:
-        assert H[i, j] == pytest.approx(expected[i, j], rel=1e-5, abs=1e-3 * kp)
+    expected = {(0, 0): kp - mp * W**2, (0, 1): 0.0, (0, 2): 0.0, (1, 1): kp - mp * W**2}
+    expected[(1, 2)] = -kp
+    for (i, j), value in expected.items():
+        assert H[i, j] == pytest.approx(value, rel=1e-12, abs=1e-9 * kp)
 
 
 @pytest.mark.parametrize("rpm", [1000.0, 10000.0, 30000.0])
@@ -208,7 +211,7 @@ def test_cli_and_refusals(tmp_path):
         encoding="utf-8",
     )
     done = run("modes", str(fast))
-    assert done.returncode == 2 and "lower carrier_speed_rpm" in done.stderr
+    assert done.returncode == 2 and "keep it below" in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
 
 
@@ -226,3 +229,47 @@ def test_parametric_analysis_refuses_a_turning_carrier(tmp_path):
     done = run("modes", str(path), "--parametric")
     assert done.returncode == 2 and "remove carrier_speed_rpm" in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1
+
+
+def test_speeds_the_set_cannot_run_at_are_refused():
+    """At 50,000 and 80,000 rpm Lin and Parker's three-planet set's stiffness is
+    indefinite (held at best by its gyroscopic terms): refused, saying so."""
+    from gearsym.solver.analysis.modes import UnstableAtSpeed
+
+    for rpm, words in ((50000.0, "indefinite"), (80000.0, "indefinite")):
+        st = derive_planetary(replace(example(3), carrier_speed_rpm=rpm))
+        with pytest.raises(UnstableAtSpeed, match=words):
+            planetary_modes(st.as_structure(), "x")
+
+
+def test_unbalanced_planets_and_shared_loads_are_refused(tmp_path):
+    from gearsym.derive.input.reader import InputError
+    from gearsym.derive.input.scene import resolve_target
+
+    src = resolve_target("lin-parker-1999-3").read_text(encoding="utf-8")
+    unbalanced = tmp_path / "unbalanced.toml"
+    unbalanced.write_text(
+        src.replace("planets = 3", "planet_angles_deg = [0, 100, 230]\ncarrier_speed_rpm = 5000")
+    )
+    done = run("modes", str(unbalanced))
+    assert done.returncode == 2 and "do not balance" in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1
+    # opposite pairs balance: accepted, and the rotation stays neutral
+    pairs = replace(example(4, angles=(0.0, 100.0, 180.0, 280.0)), carrier_speed_rpm=20000.0)
+    modal = planetary_modes(derive_planetary(pairs).as_structure(), "x").modes
+    assert modal[0].label == "rigid-body" and modal[1].frequency_hz > 100.0
+    # every member held, unequal pressure angles: the meshes share the load, refused
+    cp = load_planetary(resolve_target("cooley-parker-2012-4"))
+    held = replace(cp, alpha_r_deg=cp.alpha_r_deg + 4.0, carrier_speed_rpm=3000.0)
+    with pytest.raises(InputError, match="meshes would carry"):
+        derive_planetary(held)
+    derive_planetary(replace(cp, carrier_speed_rpm=3000.0))  # equal angles: accepted
+
+
+def test_the_rigid_body_shape_keeps_its_signs():
+    turning = replace(example(3), carrier_speed_rpm=3000.0)
+    fixed = planetary_modes(derive_planetary(example(3)).as_structure(), "x").modes[0]
+    rigid = planetary_modes(derive_planetary(turning).as_structure(), "x").modes[0]
+    assert rigid.label == "rigid-body"
+    for name, a in fixed.shape.items():
+        assert np.sign(rigid.shape[name]) == np.sign(a) or abs(a) < 1e-9
