@@ -27,6 +27,22 @@ def _between(spring: str, kind: str, n_planets: int) -> str:
     return f"{member} and the housing"
 
 
+def _rotating(st: PlanetaryStructure) -> str | None:
+    """The rotating frame's terms of a set whose carrier turns (else None: no line)."""
+    if not st.carrier_speed_rad_s:
+        return None
+    names = list(st.physical)
+    load = -st.centripetal[names.index("u_c"), names.index("u_c")]
+    return (
+        f"Rotating frame: the carrier turns at Ω_c = {st.carrier_speed_rad_s:.6g} rad/s. `G` "
+        "holds −2m at (x, y) and +2m at (y, x) of every body's pair of translations "
+        "(`x_j, y_j`; a planet's `zeta_n, eta_n`), `K_Ω` holds m on each translation and, "
+        "for the planets' bearings' centripetal load, "
+        f"−N k_p m_p / (k_p − m_p Ω_c²) = −{load:.6g} kg on `u_c`; the modes solve "
+        "`M q'' + Ω_c G q' + (K − Ω_c² K_Ω) q = 0`.\n"
+    )
+
+
 def planetary_page(st: PlanetaryStructure, command: str, source: str) -> str:
     """The page's Markdown (module docstring)."""
     ps = st.planetary
@@ -83,6 +99,7 @@ def planetary_page(st: PlanetaryStructure, command: str, source: str) -> str:
         "the springs' deflections, `R`). The torsional supports: "
         + ", ".join(f"{j} {ps.members[j].torsional:g} N/m" for j in ("carrier", "ring", "sun"))
         + " (0: free to turn).\n",
+        _rotating(st),
         "| spring | kind | between | stiffness (N/m) |",
         "|---|---|---|---|",
     ]

@@ -273,3 +273,18 @@ def test_the_rigid_body_shape_keeps_its_signs():
     assert rigid.label == "rigid-body"
     for name, a in fixed.shape.items():
         assert np.sign(rigid.shape[name]) == np.sign(a) or abs(a) < 1e-9
+
+
+def test_the_shipped_turning_set_and_its_audit_page():
+    from gearsym.derive.emit.audit_planetary import planetary_page
+    from gearsym.derive.input.scene import resolve_target
+
+    ps = load_planetary(resolve_target("lin-parker-1999-3-turning"))
+    assert ps.carrier_speed_rpm == 3000.0
+    st = derive_planetary(ps)
+    page = planetary_page(st, "gearsym derive", ps.source)
+    assert "Rotating frame: the carrier turns at Ω_c = 314.159 rad/s" in page
+    n, kp, mp, W = 3, ps.members["planet"].bearing, ps.members["planet"].mass, 3000 * RPM
+    assert f"= −{n * kp * mp / (kp - mp * W**2):.6g} kg on `u_c`" in page
+    fixed = load_planetary(resolve_target("lin-parker-1999-3"))
+    assert "Rotating frame" not in planetary_page(derive_planetary(fixed), "x", fixed.source)
