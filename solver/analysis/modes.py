@@ -145,11 +145,16 @@ def eigenproblem(structure: dict):
     """``(w2, vec, mass, R, k)``: the squared natural frequencies (ascending) and the mode
     shapes normalised on ``M`` of ``K v = w^2 M v``, ``K = R^T diag(k) R``, from a
     ``STRUCTURE`` mapping, with its ``M`` diagonal, ``R`` and ``k`` as arrays."""
-    mass = np.asarray(structure["mass"], dtype=float)
-    R = np.asarray(structure["incidence"], dtype=float)
-    k = np.asarray(structure["stiffness"], dtype=float)
+    mass, R, k = _arrays(structure)
     w2, vec = scipy.linalg.eigh(R.T @ (k[:, None] * R), np.diag(mass))
     return w2, vec, mass, R, k
+
+
+def _arrays(structure: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``M``'s diagonal, ``R`` and ``k`` of a ``STRUCTURE`` mapping as arrays."""
+    return tuple(
+        np.asarray(structure[key], dtype=float) for key in ("mass", "incidence", "stiffness")
+    )
 
 
 def modes(model, omega: float | None = None) -> Modes:
@@ -231,10 +236,8 @@ def planetary_modes(structure: dict, name: str) -> Modes:
     frequencies seen from the carrier and their shapes complex: ``shape`` then holds each
     coordinate's magnitude (the largest 1; a rigid-body mode, real, keeps its signs), the
     energies the magnitudes squared."""
-    mass = np.asarray(structure["mass"], dtype=float)
-    R = np.asarray(structure["incidence"], dtype=float)
-    k = np.asarray(structure["stiffness"], dtype=float)
     if structure.get("carrier_speed_rad_s"):
+        mass, R, k = _arrays(structure)
         f, vec, rigid = _rotating(structure, mass, R, k)
     else:
         w2, vec, mass, R, k = eigenproblem(structure)

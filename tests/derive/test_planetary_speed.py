@@ -176,59 +176,58 @@ def run(*args):
     )
 
 
-def test_cli_and_refusals(tmp_path):
+def variant(tmp_path, name: str, base: str, old: str, new: str):
+    """A copy of the shipped set ``base`` with ``old`` replaced by ``new``: its path."""
     from gearsym.derive.input.scene import resolve_target
 
-    src = resolve_target("lin-parker-1999-3").read_text(encoding="utf-8")
-    turning = tmp_path / "turning.toml"
-    turning.write_text(
-        src.replace(
-            'degrees_of_freedom = "lateral-torsional"',
-            'degrees_of_freedom = "lateral-torsional"\ncarrier_speed_rpm = 3000',
-        ),
-        encoding="utf-8",
+    path = tmp_path / f"{name}.toml"
+    text = resolve_target(base).read_text(encoding="utf-8")
+    path.write_text(text.replace(old, new, 1), encoding="utf-8")
+    return path
+
+
+def refused(done, words: str) -> None:
+    """Exit 2 with one line on stderr that holds ``words``, no traceback."""
+    assert done.returncode == 2 and words in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
+
+
+DOFS = 'degrees_of_freedom = "lateral-torsional"'
+
+
+def test_cli_and_refusals(tmp_path):
+    turning = variant(
+        tmp_path, "turning", "lin-parker-1999-3", DOFS, DOFS + "\ncarrier_speed_rpm = 3000"
     )
     done = run("modes", str(turning))
     assert done.returncode == 0, done.stderr
     assert "carrier at 3000 rpm" in done.stdout and "696.5" in done.stdout
-    torsional = tmp_path / "torsional.toml"
-    torsional.write_text(
-        src.replace(
-            'degrees_of_freedom = "lateral-torsional"',
-            'degrees_of_freedom = "torsional"\ncarrier_speed_rpm = 3000',
-        ),
-        encoding="utf-8",
+    torsional = 'degrees_of_freedom = "torsional"\ncarrier_speed_rpm = 3000'
+    refused(
+        run("modes", str(variant(tmp_path, "torsional", "lin-parker-1999-3", DOFS, torsional))),
+        "carrier_speed_rpm",
     )
-    done = run("modes", str(torsional))
-    assert done.returncode == 2 and "carrier_speed_rpm" in done.stderr
-    assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
-    fast = tmp_path / "fast.toml"
-    fast.write_text(
-        src.replace(
-            'degrees_of_freedom = "lateral-torsional"',
-            'degrees_of_freedom = "lateral-torsional"\ncarrier_speed_rpm = 200000',
-        ),
-        encoding="utf-8",
+    fast = variant(
+        tmp_path, "fast", "lin-parker-1999-3", DOFS, DOFS + "\ncarrier_speed_rpm = 200000"
     )
-    done = run("modes", str(fast))
-    assert done.returncode == 2 and "keep it below" in done.stderr
-    assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
+    refused(run("modes", str(fast)), "keep it below")
 
 
 def test_parametric_analysis_refuses_a_turning_carrier(tmp_path):
     """The parametric analysis is of the fixed-carrier model: with a speed it refuses,
     in the API and in one line of the CLI, rather than drop the gyroscopic terms."""
     import gearsym.planetary
-    from gearsym.derive.input.scene import resolve_target
 
-    src = resolve_target("lin-parker-1999-3-phased").read_text(encoding="utf-8")
-    path = tmp_path / "phased-turning.toml"
-    path.write_text(src.replace("[planetary]\n", "[planetary]\ncarrier_speed_rpm = 3000\n", 1))
+    path = variant(
+        tmp_path,
+        "phased-turning",
+        "lin-parker-1999-3-phased",
+        "[planetary]\n",
+        "[planetary]\ncarrier_speed_rpm = 3000\n",
+    )
     with pytest.raises(ValueError, match="fixed-carrier"):
         gearsym.planetary.parametric_instabilities(str(path))
-    done = run("modes", str(path), "--parametric")
-    assert done.returncode == 2 and "remove carrier_speed_rpm" in done.stderr
-    assert len(done.stderr.strip().splitlines()) == 1
+    refused(run("modes", str(path), "--parametric"), "remove carrier_speed_rpm")
 
 
 def test_speeds_the_set_cannot_run_at_are_refused():
@@ -236,9 +235,9 @@ def test_speeds_the_set_cannot_run_at_are_refused():
     indefinite (held at best by its gyroscopic terms): refused, saying so."""
     from gearsym.solver.analysis.modes import UnstableAtSpeed
 
-    for rpm, words in ((50000.0, "indefinite"), (80000.0, "indefinite")):
+    for rpm in (50000.0, 80000.0):
         st = derive_planetary(replace(example(3), carrier_speed_rpm=rpm))
-        with pytest.raises(UnstableAtSpeed, match=words):
+        with pytest.raises(UnstableAtSpeed, match="indefinite"):
             planetary_modes(st.as_structure(), "x")
 
 
@@ -246,14 +245,9 @@ def test_unbalanced_planets_and_shared_loads_are_refused(tmp_path):
     from gearsym.derive.input.reader import InputError
     from gearsym.derive.input.scene import resolve_target
 
-    src = resolve_target("lin-parker-1999-3").read_text(encoding="utf-8")
-    unbalanced = tmp_path / "unbalanced.toml"
-    unbalanced.write_text(
-        src.replace("planets = 3", "planet_angles_deg = [0, 100, 230]\ncarrier_speed_rpm = 5000")
-    )
-    done = run("modes", str(unbalanced))
-    assert done.returncode == 2 and "do not balance" in done.stderr
-    assert len(done.stderr.strip().splitlines()) == 1
+    unbalanced = "planet_angles_deg = [0, 100, 230]\ncarrier_speed_rpm = 5000"
+    path = variant(tmp_path, "unbalanced", "lin-parker-1999-3", "planets = 3", unbalanced)
+    refused(run("modes", str(path)), "do not balance")
     # opposite pairs balance: accepted, and the rotation stays neutral
     pairs = replace(example(4, angles=(0.0, 100.0, 180.0, 280.0)), carrier_speed_rpm=20000.0)
     modal = planetary_modes(derive_planetary(pairs).as_structure(), "x").modes
