@@ -8,10 +8,12 @@ states in its caption line.  The palettes are in :mod:`.plots_style` (re-exporte
 
 from __future__ import annotations
 
+import weakref
 from pathlib import Path
 
 import numpy as np
 from matplotlib.patches import Patch, Rectangle
+from matplotlib.transforms import Bbox
 
 from .plots_style import (
     _OUTCOME_COLOUR,
@@ -163,12 +165,22 @@ def _hatch(ax, m: RegimeMap, outcomes: np.ndarray, what: str) -> None:
         )
 
 
+# figure -> its tight box with the caption (inches), measured when it was captioned, for
+# write_map_figures: saving with it skips the layout pass of savefig's "tight" box (a
+# third of the cost of saving a map's figure); a figure changed afterwards is not saved
+# with it (map_figures' caller gets plain figures)
+_BOXES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
 def _captioned(fig, caption: str):
     fig.tight_layout()
     # the caption under everything drawn (axis labels, legends below the axes)
-    box = fig.get_tightbbox(fig.canvas.get_renderer())
+    renderer = fig.canvas.get_renderer()
+    box = fig.get_tightbbox(renderer)
     bottom = box.y0 / fig.get_figheight()
     put_caption(fig, bottom - 0.01, caption)
+    text = fig.texts[-1].get_window_extent(renderer).transformed(fig.dpi_scale_trans.inverted())
+    _BOXES[fig] = Bbox.union([box, text])
     return fig
 
 
@@ -197,7 +209,10 @@ def write_map_figures(
 ) -> list[Path]:
     """:func:`map_figures` written into ``folder`` as ``<prefix>-<kind>.png``; the paths."""
     figures = map_figures(m, ticks=ticks, title=title, kinds=kinds, system=system, units=units)
-    return [save_figure(fig, Path(folder) / f"{prefix}-{k}.png") for k, fig in figures.items()]
+    return [
+        save_figure(fig, Path(folder) / f"{prefix}-{k}.png", box=_BOXES.pop(fig, None))
+        for k, fig in figures.items()
+    ]
 
 
 def map_figures(

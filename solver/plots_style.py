@@ -212,11 +212,14 @@ def not_ok_marks(ax, values, statuses) -> None:
         )
 
 
-def save_figure(fig, path) -> Path:
+def save_figure(fig, path, box=None) -> Path:
     """Write ``fig`` to ``path`` (its folder made if missing; the format from the suffix;
-    :data:`DPI`, the bounding box tight around everything drawn) and close it; the path."""
+    :data:`DPI`, the bounding box tight around everything drawn) and close it; the path.
+    ``box``: that bounding box (inches), already measured on the finished figure, padded
+    as savefig pads its own."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=DPI, bbox_inches="tight")
+    tight = "tight" if box is None else box.padded(plt.rcParams["savefig.pad_inches"])
+    fig.savefig(path, dpi=DPI, bbox_inches=tight)
     plt.close(fig)
     return path

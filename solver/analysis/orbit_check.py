@@ -6,10 +6,22 @@ Newton's method solves
     ``G(x) = phi_{nT}(x; t) - x = 0``,   ``x <- x - (M - I)^{-1} G(x)``,
 
 with the flow ``phi`` and the monodromy ``M = d phi_{nT} / dx`` both from the one engine
-(``integrate()``; all ``2 N + 1`` runs of an iteration in one batch): ``M`` by central
-differences of the flow with steps ``h_i = 1e-5 max(1, |x_i|)`` at ``rtol = 1e-12``, so its
-entries carry an error of about ``h^2 + rtol / h``, about 1e-7 relative (the multipliers'
-stated error ``mu_error``).  Converged when ``|G|`` is below ``tol max(1, |x|)``.
+(``integrate()``, DOP853 at ``rtol = 1e-12``, the ``N`` or ``2 N + 1`` runs of an
+iteration in one batch):
+
+* a smooth force law: ``M`` from the variational equations, one tangent per state started
+  from its unit vector; its entries carry about the integration's error (against central
+  differences of the flow, 1e-7 relative: the differences' own error);
+* a piecewise one (the dead zone): central differences of the flow with steps
+  ``h_i = 1e-5 max(1, |x_i|)``, as before the variational route.  The tangent's vector
+  field jumps at every kink and the flow is only once differentiable there; near a
+  grazing contact neither route settles (on the reference dead-zone model, one period
+  from (0.9, 0.7, 0.1, -0.2), entries move by up to 5 % with the tolerance or the step,
+  the tangent's between two values, 0.43608 and 0.43627 for the first).
+
+The multipliers' stated error ``mu_error`` (1e-6) is that of the differences on a smooth
+flow, ``h^2 + rtol / h`` with a margin; near a kink it can be larger, as said.  Converged
+when ``|G|`` is below ``tol max(1, |x|)``.
 
 The orbit found is then checked as the verdict needs it:
 
@@ -36,7 +48,7 @@ from ..system import System
 
 __all__ = ["OrbitCheck", "check_orbit"]
 
-_H = 1e-5  # relative finite-difference step of the monodromy
+_H = 1e-5  # relative step of the central differences (piecewise force laws)
 _MU_ERROR = 1e-6  # the multipliers' stated error (see the module text), with a margin
 
 
@@ -57,6 +69,7 @@ class OrbitCheck:
     multipliers: np.ndarray | None = None
     distance: float = float("inf")
     why: str = ""
+    method: str = "Newton shooting, variational monodromy, DOP853 at rtol 1e-12"
 
     @property
     def largest(self) -> float:
@@ -88,19 +101,35 @@ class OrbitCheck:
             "largest_multiplier": None if self.multipliers is None else self.largest,
             "multiplier_error": _MU_ERROR,
             "attracting": self.attracting,
-            "method": "Newton shooting, central-difference monodromy, DOP853 at rtol 1e-12",
+            "method": self.method,
             **({"why": self.why} if self.why else {}),
         }
 
 
-def _flows(system: System, X: np.ndarray, n: int, t0: float, spec: RunSpec) -> np.ndarray:
-    """``phi_{mT}`` of every row of ``X`` (J, N) for m = 0..n: shape (J, n + 1, N)."""
+_METHODS = {
+    False: "Newton shooting, variational monodromy, DOP853 at rtol 1e-12",
+    True: "Newton shooting, central-difference monodromy, DOP853 at rtol 1e-12",
+}
+
+
+def _flow(system: System, x: np.ndarray, n: int, t0: float, spec: RunSpec):
+    """``phi_{mT}(x)`` for m = 0..n, shape (n + 1, N), and the monodromy ``d phi_{nT} /
+    dx`` (N, N), by the route the module text gives for the force law."""
+    spec = spec.with_(t0=t0, periods=n, lyapunov_periods=n)
+    if not system.piecewise:
+        res = integrate(system, x, spec)
+        if res.status[0] != "ok":
+            raise FloatingPointError(f"the flow stopped: {res.status[0]}")
+        return res.x[0], res.monodromy[0]
+    h = _H * np.maximum(1.0, np.abs(x))
+    X = np.vstack([x, x + np.diag(h), x - np.diag(h)])
     batch = Batch.of(system.module, np.repeat(system.p[None, :], X.shape[0], axis=0))
-    res = integrate(batch, X, spec.with_(t0=t0, periods=n, lyapunov_periods=n))
+    res = integrate(batch, X, spec.with_(collect=("samples", "exponent")))
     bad = [s for s in res.status if s != "ok"]
     if bad:
         raise FloatingPointError(f"the flow stopped: {bad[0]}")
-    return res.x
+    N = system.n
+    return res.x[0], (res.x[1 : N + 1, -1] - res.x[N + 1 :, -1]).T / (2.0 * h)
 
 
 def check_orbit(
@@ -128,26 +157,23 @@ def check_orbit(
         periods=n,
         valid_range="ignore",
         bound=1e6,
-        # the library with the variational equations, whose tangent is not used: it is
-        # the one a map's runs and the continued windows build, so a model is compiled
-        # once (the plain library would double the compilations of a sensitivity study)
-        collect=("samples", "exponent"),
+        # the library with the variational equations (the monodromy's tangents; the
+        # differences' runs do not use it): the one a map's runs and the continued
+        # windows build, so a model is compiled once
+        collect=("samples", "exponent", "monodromy"),
         lyapunov_periods=n,
     )
     residual = float("inf")
     for it in range(max_iter + 1):
-        h = _H * np.maximum(1.0, np.abs(x))
-        X = np.vstack([x, x + np.diag(h), x - np.diag(h)])
         try:
-            flows = _flows(system, X, n, phase0, spec)
+            path, M = _flow(system, x, n, phase0, spec)
         except FloatingPointError as err:
             return OrbitCheck(n, False, residual=residual, iterations=it, why=str(err))
-        G = flows[0, -1] - x
+        G = path[-1] - x
         residual = float(np.max(np.abs(G)))
-        M = (flows[1 : N + 1, -1] - flows[N + 1 :, -1]).T / (2.0 * h)
         scale = max(1.0, float(np.max(np.abs(x))))
         if residual <= tol * scale:
-            return _found(system, x, n, flows[0], M, residual, it, start)
+            return _found(system, x, n, path, M, residual, it, start)
         if it == max_iter:
             break
         try:
@@ -180,4 +206,5 @@ def _found(system, x, n, path, M, residual, iterations, start) -> OrbitCheck:
         minimal,
         np.linalg.eigvals(M),
         float(np.max(np.abs(x - start))),
+        method=_METHODS[system.piecewise],
     )

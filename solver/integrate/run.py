@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import hashlib
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import ModuleType
 
@@ -208,14 +208,59 @@ def _run_task(task: _Task) -> RunResult:
 
 
 def _run(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec, backend: str) -> RunResult:
+    if "monodromy" in spec.collect:
+        return _monodromy(module, P, X0, spec, backend)
+    return _engine(module, P, X0, spec, backend)
+
+
+def _engine(module, P, X0, spec: RunSpec, backend: str, tangent0=None) -> RunResult:
     if backend == "numpy":
         from .native.fallback import run_fallback
 
-        return run_fallback(module, P, X0, spec)
-    return _compiled(module, P, X0, spec)
+        return run_fallback(module, P, X0, spec, tangent0)
+    return _compiled(module, P, X0, spec, tangent0)
 
 
-def _compiled(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec) -> RunResult:
+def _monodromy(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec, backend: str) -> RunResult:
+    """Each point run once per state, the tangent starting from that unit vector (the
+    copies of a point side by side, so that a lock-step group holds them together): the
+    monodromy's column k is the tangent's end times its growth.  The point's samples,
+    extremes and exponent are those of its first copy; a copy that failed fails it."""
+    N, n = X0.shape
+    inner = spec.with_(collect=tuple(c for c in spec.collect if c != "monodromy"))
+    tangent0 = np.tile(np.eye(n), (N, 1))
+    P, X0 = np.repeat(P, n, axis=0), np.repeat(X0, n, axis=0)
+    res = _engine(module, P, X0, inner, backend, tangent0)
+    ends = res.tangent.reshape(N, n, n + 1)
+    M = (ends[:, :, :n] * np.exp(ends[:, :, n:])).transpose(0, 2, 1)
+    status = [res.status[i * n] for i in range(N)]
+    for i in range(N):
+        failed = [s for s in res.status[i * n : (i + 1) * n] if s != "ok"]
+        if failed:
+            status[i] = status[i] if status[i] != "ok" else failed[0]
+            M[i] = np.nan
+    first = slice(0, N * n, n)
+
+    def pick(a):
+        return None if a is None else a[first]
+
+    return replace(
+        res,
+        x=pick(res.x),
+        xmin=pick(res.xmin),
+        xmax=pick(res.xmax),
+        exponent=pick(res.exponent),
+        exits=pick(res.exits),
+        nfev=res.nfev.reshape(N, n).sum(axis=1),
+        nsteps=res.nsteps.reshape(N, n).max(axis=1),
+        status=tuple(status),
+        t_fail=pick(res.t_fail),
+        monodromy=M,
+        tangent=None,
+    )
+
+
+def _compiled(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec, tangent0=None) -> RunResult:
     """The compiled engine (``native/engine.py``), with how points share steps: a
     piecewise force law (the dead zone) would shrink a whole group's step at each point's
     kinks, so its sampled runs go point by point and its maps in groups of one; RK4 and a
@@ -224,7 +269,7 @@ def _compiled(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec) -> RunResult
 
     piecewise = Contract.of(module).piecewise
     if "extremes" in spec.collect or "exponent" in spec.collect:
-        return run_compiled(module, P, X0, spec.with_(group=1) if piecewise else spec)
+        return run_compiled(module, P, X0, spec.with_(group=1) if piecewise else spec, tangent0)
     if spec.time == "phase":
         return run_compiled(module, P, X0, spec)
     lockstep = spec.lockstep and not piecewise and spec.method != "rk4" and P.shape[0] > 1
@@ -251,6 +296,7 @@ def _join(parts: list[RunResult], wall_time: float) -> RunResult:
         xmax=cat("xmax"),
         exponent=cat("exponent"),
         exits=cat("exits"),
+        monodromy=cat("monodromy"),
         wall_time=wall_time,
         compile_seconds=max(r.compile_seconds for r in parts),
     )

@@ -29,8 +29,10 @@ __all__ = ["COLLECT", "INT64_MAX", "RunResult", "RunSpec", "TIME_MODES", "VALID_
 TIME_MODES = ("tau", "phase")
 # What a run keeps besides its work counters: the samples; each state's smallest and
 # largest value over the sampled window, at every accepted step; the running largest
-# Lyapunov exponent from a tangent vector (Benettin et al. 1980, renormalised each period).
-COLLECT = ("samples", "extremes", "exponent")
+# Lyapunov exponent from a tangent vector (Benettin et al. 1980, renormalised each period);
+# the monodromy matrix of the whole run from the variational equations (one tangent per
+# state: each point runs once per state, the tangent starting from that unit vector).
+COLLECT = ("samples", "extremes", "exponent", "monodromy")
 # At the force law's valid range (the contract's bounds): record the first exit and go on,
 # stop the point there, or do not check.
 VALID_RANGE = ("record", "stop", "ignore")
@@ -169,6 +171,11 @@ class RunSpec:
                 "collecting the exponent needs lyapunov_periods > 0, and lyapunov_periods "
                 "> 0 needs 'exponent' collected"
             )
+        if "monodromy" in collect and ("exponent" not in collect or self.lyapunov_periods != most):
+            raise ValueError(
+                "collecting the monodromy needs 'exponent' collected with lyapunov_periods "
+                f"= transient + periods ({most}): the tangent runs from the start"
+            )
         put(self, "seed", _whole("seed", self.seed, 0, 2**32 - 1))
         if self.valid_range not in VALID_RANGE:
             raise ValueError(
@@ -223,6 +230,13 @@ class RunResult:
         small``, ``left the valid range`` (with ``valid_range="stop"``).
     t_fail : ndarray, shape (N,)
         Where a point stopped early (its time mode), else its end.
+    monodromy : ndarray, shape (N, n, n), or None
+        ``d x(end) / d x(start)`` of each point, from the variational equations (its
+        columns: the tangents started from the unit vectors), when collected; NaN where the
+        point's run failed.
+    tangent : ndarray, shape (N, n + 1), or None
+        With a tangent start per point (the engines' ``tangent0``): each point's tangent at
+        the end (unit length) and its log growth from the start; how ``monodromy`` is built.
     exits : ndarray, shape (N, 3), or None
         ``(tau, state index, value)`` of each point's first exit from the valid range
         (``tau`` NaN: none), located on the accepted steps; None where not checked.
@@ -243,6 +257,8 @@ class RunResult:
     xmax: np.ndarray | None = None
     exponent: np.ndarray | None = None
     exits: np.ndarray | None = None
+    monodromy: np.ndarray | None = None
+    tangent: np.ndarray | None = None
     wall_time: float = 0.0
     compile_seconds: float = 0.0
 

@@ -251,6 +251,7 @@ def test_fallback_with_workers_and_a_diverging_point(monkeypatch):
 def _job_parts(module, N=2, **changes):
     """The arguments of abi.fill for a small sampled run of ``module``."""
     from gearsym.solver.contract import Contract
+    from gearsym.solver.integrate.native import abi
 
     n, n_p = len(Contract.of(module).states), len(Contract.of(module).parameters)
     P = np.ascontiguousarray(np.repeat(module.parameters()[None, :], N, axis=0))
@@ -264,7 +265,7 @@ def _job_parts(module, N=2, **changes):
         "t_fail": np.zeros(N),
     }
     ints = dict(
-        abi=1,
+        abi=abi.ABI_VERSION,
         n_points=N,
         n_states=n,
         n_params=n_p,
@@ -330,7 +331,7 @@ def test_the_c_refuses_what_python_would_have_caught_and_writes_nothing():
         ({}, {"x_len": 23}, "length"),
         ({"periods": 2**62, "samples_per_period": 4}, {}, "length"),
         ({"group": 10**9}, {}, "option"),
-        ({"abi": 2}, {}, "version"),
+        ({"abi": abi.ABI_VERSION + 1}, {}, "version"),
     ]
     for changes, lie, words in cases:
         ints, doubles, arrays, lengths = _job_parts(module, **changes)

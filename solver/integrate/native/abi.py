@@ -20,7 +20,7 @@ import numpy as np
 
 __all__ = ["ABI_VERSION", "ERRORS", "FLAGS", "Job", "LayoutMismatch", "bind", "call", "fill"]
 
-ABI_VERSION = 1
+ABI_VERSION = 2
 INT64_MIN, INT64_MAX = -(2**63), 2**63 - 1
 # gs_integrate's refusals (``GS_E_*`` of native_*.c); Python's checks come first, so one of
 # these means the two sides disagree (a bug), except memory.
@@ -50,6 +50,7 @@ ARRAYS = (
     ("xmin", np.float64),
     ("xmax", np.float64),
     ("exponent", np.float64),
+    ("tangent", np.float64),
     ("nfev", np.int64),
     ("nsteps", np.int64),
     ("status", np.int32),

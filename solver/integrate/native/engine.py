@@ -93,9 +93,11 @@ def _period(contract: Contract, P: np.ndarray, spec: RunSpec) -> tuple[float, in
     return 2.0 * np.pi / float(omega[0]), iw
 
 
-def run_compiled(module, P, X0, spec: RunSpec) -> RunResult:
+def run_compiled(module, P, X0, spec: RunSpec, tangent0=None) -> RunResult:
     """Integrate every row ``P[i]`` (N, n_p) from ``X0[i]`` (N, n) of ``module`` as
-    ``spec`` says, in the compiled engine.
+    ``spec`` says, in the compiled engine.  ``tangent0`` (N, n), with the exponent
+    collected from the run's start: each point's tangent start (default one unit vector
+    drawn from ``spec.seed`` for all), and the result's ``tangent`` gives its end.
 
     Returns a :class:`~..spec.RunResult` (``backend="native"``; ``exits`` in tau, None
     with ``valid_range="ignore"``).  Raises ``ValueError`` on inputs the spec cannot run,
@@ -109,6 +111,16 @@ def run_compiled(module, P, X0, spec: RunSpec) -> RunResult:
     N, n = X0.shape
     collect = set(spec.collect)
     tangent = "exponent" in collect
+    if tangent0 is not None:
+        tangent0 = np.ascontiguousarray(tangent0, dtype=float)
+        if (
+            not tangent
+            or tangent0.shape != (N, n)
+            or spec.lyapunov_periods != (spec.transient + spec.periods)
+        ):
+            raise ValueError(
+                f"tangent0 must be ({N}, {n}), with the exponent collected from the start"
+            )
     lib, facts = library(module, variational=tangent, shared=shared_parameters(P))
     K, L = spec.n_samples, spec.lyapunov_periods
     check = spec.valid_range != "ignore"
@@ -119,11 +131,12 @@ def run_compiled(module, P, X0, spec: RunSpec) -> RunResult:
         "P": P,
         "X0": X0,
         "bounds": bounds if check else None,
-        "tangent0": _tangent_start(n, spec.seed) if tangent else None,
+        "tangent0": _tangent_start(n, spec.seed) if tangent and tangent0 is None else tangent0,
         "x": np.empty((N, K, n)) if "samples" in collect else None,
         "xmin": np.empty((N, n)) if "extremes" in collect else None,
         "xmax": np.empty((N, n)) if "extremes" in collect else None,
         "exponent": np.empty((N, L)) if tangent else None,
+        "tangent": np.empty((N, n + 1)) if tangent0 is not None else None,
         "nfev": np.zeros(N, dtype=np.int64),
         "nsteps": np.zeros(N, dtype=np.int64),
         "status": np.zeros(N, dtype=np.int32),
@@ -134,11 +147,12 @@ def run_compiled(module, P, X0, spec: RunSpec) -> RunResult:
         "P": N * P.shape[1],
         "X0": N * n,
         "bounds": n,
-        "tangent0": n,
+        "tangent0": n if tangent0 is None else N * n,
         "x": N * K * n,
         "xmin": N * n,
         "xmax": N * n,
         "exponent": N * L,
+        "tangent": N * (n + 1),
         "nfev": N,
         "nsteps": N,
         "status": N,
@@ -195,6 +209,7 @@ def run_compiled(module, P, X0, spec: RunSpec) -> RunResult:
         xmax=out["xmax"],
         exponent=out["exponent"],
         exits=exits,
+        tangent=out["tangent"],
         wall_time=time.perf_counter() - started,
         compile_seconds=facts["seconds"],
     )

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import time
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -74,8 +74,9 @@ class _Setup:
     w0: np.ndarray | None  # tangent start, or None without the exponent
 
 
-def run_fallback(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec) -> RunResult:
+def run_fallback(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec, tangent0=None) -> RunResult:
     """Integrate ``P`` (N, P) from ``X0`` (N, n) as ``spec`` says, without compiled code.
+    ``tangent0`` (N, n): each point's tangent start, as the compiled engine takes it.
 
     The inputs as ``integrate()`` checked them (finite, ``omega > 0``, one ``omega`` in
     the time mode ``"tau"``). Returns a :class:`RunResult` with backend ``"numpy"``.
@@ -101,8 +102,20 @@ def run_fallback(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec) -> RunRes
         "nsteps": np.zeros(N, dtype=np.int64),
         "t_fail": np.full(N, np.nan),
         "exits": np.full((N, 3), np.nan),
+        "tangent": np.full((N, n + 1), np.nan),
     }
-    status = tuple(_one(module, setup, P[i], X0[i], float(P[i, iw]), i, out) for i in range(N))
+    status = tuple(
+        _one(
+            module,
+            setup if tangent0 is None else replace(setup, w0=np.asarray(tangent0[i], float)),
+            P[i],
+            X0[i],
+            float(P[i, iw]),
+            i,
+            out,
+        )
+        for i in range(N)
+    )
     if spec.time == "phase":
         out["exits"][:, 0] /= P[:, iw]  # the phase s = omega tau, back to tau
     keep = spec.collect
@@ -119,6 +132,7 @@ def run_fallback(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec) -> RunRes
         xmax=out["xmax"] if "extremes" in keep else None,
         exponent=out["exponent"] if tangent else None,
         exits=None if spec.valid_range == "ignore" else out["exits"],
+        tangent=None if tangent0 is None else out["tangent"],
         wall_time=time.perf_counter() - started,
     )
 
@@ -243,6 +257,8 @@ def _one(module, setup: _Setup, p, x0, omega: float, i: int, out: dict) -> str:
                 out["exponent"][i, k - lyap_from - 1] = growth / ((k - lyap_from) * tau_period)
     if state != "ok":
         out["exponent"][i] = np.nan
+    elif tangent:  # the tangent's end (unit length after the last stop), its log growth
+        out["tangent"][i] = np.r_[pt.z[n : 2 * n], growth]
     out["nfev"][i], out["nsteps"][i] = pt.nfev, pt.nsteps
     return state
 

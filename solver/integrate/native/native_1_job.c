@@ -27,7 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define GS_ABI_VERSION 1
+#define GS_ABI_VERSION 2
 
 /* a point's status */
 #define GS_OK 0
@@ -70,6 +70,7 @@
     X(p, double *, xmin) X(i, int64_t, xmin_len)                                           \
     X(p, double *, xmax) X(i, int64_t, xmax_len)                                           \
     X(p, double *, exponent) X(i, int64_t, exponent_len)                                   \
+    X(p, double *, tangent) X(i, int64_t, tangent_len)                                     \
     X(p, int64_t *, nfev) X(i, int64_t, nfev_len)                                          \
     X(p, int64_t *, nsteps) X(i, int64_t, nsteps_len)                                      \
     X(p, int32_t *, status) X(i, int64_t, status_len)                                      \

@@ -111,7 +111,11 @@ static double gs_start(gs_ctx *c, int64_t g0, int n)
         for (int k = 0; k < GS_NP; ++k) c->Pg[k * n + j] = p[k];
         for (int k = 0; k < GS_NQ; ++k) c->Qg[k * n + j] = q[k];
         for (int i = 0; i < GS_NSTATE; ++i) y[i] = J->X0[(g0 + j) * GS_NSTATE + i];
-        for (int i = GS_NSTATE; i < GS_NX; ++i) y[i] = J->tangent0[i - GS_NSTATE];
+        /* one tangent start for every point, or one per point */
+        const double *w0 = J->tangent0 + (J->tangent0_len > GS_NX - GS_NSTATE
+                                              ? (g0 + j) * (GS_NX - GS_NSTATE)
+                                              : 0);
+        for (int i = GS_NSTATE; i < GS_NX; ++i) y[i] = w0[i - GS_NSTATE];
         for (int i = 0; i < GS_NX; ++i) c->Y[i * n + j] = y[i];
         gs_rhs(J->t0, y, p, q, f);
         c->alive[j] = 1;
@@ -188,6 +192,14 @@ static void gs_group(gs_ctx *c, int64_t g0, int n)
         if (c->tangent && J->status[pt] != GS_OK)
             for (int64_t r = 0; r < J->lyapunov_periods; ++r)
                 J->exponent[pt * J->lyapunov_periods + r] = NAN;
+        /* the tangent's end (unit length after the last stop) and its log growth */
+        if (J->tangent) {
+            double *w = J->tangent + pt * (GS_NX - GS_NSTATE + 1);
+            const int ok = J->status[pt] == GS_OK;
+            for (int i = GS_NSTATE; i < GS_NX; ++i)
+                w[i - GS_NSTATE] = ok ? c->Y[(long)i * n + j] : NAN;
+            w[GS_NX - GS_NSTATE] = ok ? c->growth[j] : NAN;
+        }
     }
 }
 
@@ -249,7 +261,12 @@ static int gs_check_job(const gs_job *J)
     /* the exponent: the variational library, a tangent start, period stops */
     if (!gs_array_ok(J->exponent, J->exponent_len, N, L, 1) || (!J->exponent) != (L == 0) ||
         (J->exponent && (GS_NSTATE == GS_NX || !(J->flags & GS_PERIOD_STOPS))) ||
-        !gs_array_ok(J->tangent0, J->tangent0_len, GS_NX - GS_NSTATE, 1, GS_NSTATE == GS_NX))
+        (!gs_array_ok(J->tangent0, J->tangent0_len, GS_NX - GS_NSTATE, 1, GS_NSTATE == GS_NX) &&
+         !gs_array_ok(J->tangent0, J->tangent0_len, N, GS_NX - GS_NSTATE, 0)))
+        return GS_E_SIZE;
+    /* the tangent's end: with the exponent, the tangent from the run's start */
+    if (!gs_array_ok(J->tangent, J->tangent_len, N, GS_NX - GS_NSTATE + 1, 1) ||
+        (J->tangent && (!J->exponent || J->lyapunov_periods != J->transient + J->periods)))
         return GS_E_SIZE;
     if (J->time_mode == 1) {
         if (J->omega_index < 0 || J->omega_index >= GS_NP) return GS_E_OPTION;
