@@ -6,15 +6,17 @@ instabilities of their meshes' stiffness variation (issue 26).
     modal = gearsym.planetary.modes("lin-parker-1999-4")       # typed, with multiplicities
     table = gearsym.planetary.parametric_instabilities("lin-parker-1999-3-phased")
     table["bands"][0]                                          # harmonic, type, band in Hz
+    sweep = gearsym.planetary.carrier_sweep("lin-parker-1999-3", 0, 6000)  # vs carrier speed
 
-The same as ``gearsym modes SET`` and ``gearsym modes SET --parametric``.
+The same as ``gearsym modes SET``, ``gearsym modes SET --parametric`` and ``gearsym modes SET
+--speeds LO:HI``.
 """
 
 from __future__ import annotations
 
 import math
 
-__all__ = ["load", "modes", "parametric_instabilities"]
+__all__ = ["carrier_sweep", "load", "modes", "parametric_instabilities"]
 
 
 def load(target):
@@ -128,4 +130,104 @@ def parametric_instabilities(target, *, floquet: bool = False) -> dict:
         "ring_teeth": st.planetary.ring_teeth,
         "bands": bands,
         "combinations": combinations,
+    }
+
+
+def carrier_sweep(target, lo_rpm: float, hi_rpm: float, num: int = 41, harmonics: int = 3) -> dict:
+    """The natural frequencies of a planetary set against its carrier's speed (a Campbell
+    diagram, as Lin and Parker, 1999, give it), JSON-ready: at each of ``num`` speeds from
+    ``lo_rpm`` to ``hi_rpm`` every elastic mode's frequency seen from the carrier (Hz,
+    ascending: index k is the k-th lowest at each speed, so a track follows the envelope
+    through a veering) and its type; the speeds where the stiffness is indefinite (no
+    modes: the set diverges there) with the reason.  A lateral-torsional set gets the
+    rotating frame's terms at each speed (``derive.equations.planetary_frame.at_speed``,
+    the set derived once); a torsional model has none, so its frequencies do not move.
+
+    With ``ring_teeth`` known and the ring the one member held in rotation (a torsional
+    support on it alone: the carrier drives, the sun is driven or the reverse), the mesh
+    frequency is ``ring_teeth x n_c / 60`` (n_c the carrier's speed in rpm) and the speeds
+    where its first ``harmonics`` harmonics meet a mode are given (linear between two
+    speeds of the sweep).  Raises ``ValueError`` for a range the model cannot take."""
+    import numpy as np
+    from gearsym.derive.equations.planetary_frame import at_speed, bearing_limit_rpm
+    from gearsym.solver.analysis.modes import UnstableAtSpeed, planetary_modes
+
+    st = target if hasattr(target, "as_structure") else load(target)
+    ps = st.planetary
+    if not (0 <= lo_rpm < hi_rpm and math.isfinite(hi_rpm)) or num < 2:
+        raise ValueError(
+            f"speeds {lo_rpm:g} to {hi_rpm:g} rpm ({num}): give 0 <= LO < HI, NUM >= 2"
+        )
+    turning = ps.dofs != "torsional"
+    if turning and hi_rpm >= bearing_limit_rpm(ps):
+        raise ValueError(
+            f"{hi_rpm:g} rpm: the planets' bearings cannot hold them at or above "
+            f"{bearing_limit_rpm(ps):.6g} rpm (sqrt(k_p / m_p)); keep the speeds below it"
+        )
+    base = at_speed(st, 0.0)
+    speeds = np.linspace(lo_rpm, hi_rpm, num)
+    rows, labels, unstable = [], [], []
+    fixed = None if turning else planetary_modes(base.as_structure(), ps.name)
+    for n_c in speeds:
+        try:
+            res = fixed or planetary_modes(at_speed(base, float(n_c)).as_structure(), ps.name)
+        except UnstableAtSpeed as err:
+            rows.append(None)
+            labels.append(None)
+            unstable.append({"speed_rpm": float(n_c), "why": str(err)})
+            continue
+        elastic = [m for m in res.modes if m.label != "rigid-body"]
+        rows.append([m.frequency_hz for m in elastic])
+        labels.append([m.label for m in elastic])
+    count = max((len(r) for r in rows if r is not None), default=0)
+    modes_out = [
+        {
+            "index": k + 1,
+            "frequency_hz": [None if r is None else r[k] for r in rows],
+            "label": [None if lab is None else lab[k] for lab in labels],
+        }
+        for k in range(count)
+    ]
+    held = [j for j in ("carrier", "ring", "sun") if ps.members[j].torsional > 0]
+    mesh, crossings = None, []
+    if ps.ring_teeth is not None and held == ["ring"]:
+        mesh = {"held": "ring", "ring_teeth": ps.ring_teeth, "hz_per_rpm": ps.ring_teeth / 60.0}
+        for h in range(1, harmonics + 1):
+            for mode in modes_out:
+                f = mode["frequency_hz"]
+                for i in range(num - 1):
+                    if f[i] is None or f[i + 1] is None:
+                        continue
+                    a = f[i] - h * mesh["hz_per_rpm"] * speeds[i]
+                    b = f[i + 1] - h * mesh["hz_per_rpm"] * speeds[i + 1]
+                    if a == 0 or a * b < 0:
+                        n_x = speeds[i] + (speeds[i + 1] - speeds[i]) * a / (a - b)
+                        crossings.append(
+                            {
+                                "harmonic": h,
+                                "mode": mode["index"],
+                                "label": mode["label"][i],
+                                "speed_rpm": float(n_x),
+                                "frequency_hz": float(h * mesh["hz_per_rpm"] * n_x),
+                            }
+                        )
+        crossings.sort(key=lambda c: (c["speed_rpm"], c["harmonic"]))
+    why = None
+    if mesh is None:
+        why = (
+            "no ring_teeth in the file"
+            if ps.ring_teeth is None
+            else f"the members held in rotation are {held or 'none'}, not the ring alone"
+        )
+    return {
+        "model": ps.name,
+        "degrees_of_freedom": ps.dofs,
+        "frame": "the carrier's (frequencies seen from it)" if turning else "none: torsional",
+        "speeds_rpm": [float(v) for v in speeds],
+        "modes": modes_out,
+        "unstable": unstable,
+        "mesh": mesh,
+        "mesh_why_not": why,
+        "crossings": crossings,
+        "scene_speed_rpm": ps.carrier_speed_rpm,
     }

@@ -21,6 +21,7 @@ __all__ = [
     "bifurcation",
     "branches",
     "campbell",
+    "carrier",
     "frequency_response",
     "map",
     "modes",
@@ -144,6 +145,18 @@ def campbell(result, speeds_rpm=None, harmonics: int = 3):
 
 
 modes = campbell  # the figure of gearsym.modes' result
+
+
+def carrier(sweep):
+    """A planetary set's natural frequencies against its carrier's speed (a Campbell
+    diagram): each track coloured by its mode's type, the mesh harmonics and their
+    meetings with the modes where known, the speeds without modes shaded.
+
+    ``sweep``: the mapping of ``gearsym.planetary.carrier_sweep``.  Returns a Figure.
+    """
+    from gearsym.solver.plots_modes import carrier_figure
+
+    return carrier_figure(sweep)
 
 
 def parametric(table):

@@ -1,5 +1,5 @@
-"""The resonance (Campbell) diagram of a model's modes against its mesh frequency, and the
-parametric-instability diagram of a planetary set."""
+"""The resonance (Campbell) diagram of a model's modes against its mesh frequency, and a
+planetary set's parametric-instability diagram and its modes against the carrier's speed."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 from .analysis.modes import Modes
 from .plots_style import legend_below, plt
 
-__all__ = ["campbell_figure", "parametric_figure"]
+__all__ = ["campbell_figure", "carrier_figure", "parametric_figure"]
 
 _STYLE = {
     "torsional": ("tab:blue", "-"),
@@ -141,4 +141,83 @@ def parametric_figure(table: dict):
         "primary instability the planets' phasing cancels. gearsym modes --parametric "
         "--floquet checks the primary bands by Floquet multipliers.",
     )
+    return fig
+
+
+def carrier_figure(sweep: dict, harmonics: int = 3):
+    """A planetary set's natural frequencies against its carrier's speed (the mapping of
+    ``gearsym.planetary.carrier_sweep``): each track (the k-th lowest frequency) coloured
+    by its mode's type, the mesh frequency's harmonics where the ring is held and its teeth
+    known, a dot where they meet a mode, the speeds without modes shaded; returns the
+    ``Figure`` (nothing saved)."""
+    fig, ax = plt.subplots(figsize=(8, 5.5))
+    n = np.asarray(sweep["speeds_rpm"])
+    top = 0.0
+    shown = set()
+    for mode in sweep["modes"]:
+        f, labels = mode["frequency_hz"], mode["label"]
+        i = 0
+        while i < len(n):  # one line for each run of the same type
+            if f[i] is None:
+                i += 1
+                continue
+            j = i
+            while j + 1 < len(n) and f[j + 1] is not None and labels[j + 1] == labels[i]:
+                j += 1
+            stop = min(j + 2, len(n)) if j + 1 < len(n) and f[j + 1] is not None else j + 1
+            xs, ys = n[i:stop], [v for v in f[i:stop]]
+            label = labels[i] if labels[i] not in shown else None
+            shown.add(labels[i])
+            ax.plot(xs, ys, color=_TYPES.get(labels[i], "grey"), lw=1.3, label=label)
+            top = max(top, max(ys))
+            i = j + 1
+    mesh = sweep["mesh"]
+    if mesh is not None:
+        for h in range(1, harmonics + 1):
+            ax.plot(n, h * mesh["hz_per_rpm"] * n, color="black", lw=0.8 + 0.4 * (h == 1))
+            end = min(n[-1], 1.05 * top / (h * mesh["hz_per_rpm"]))
+            ax.annotate(
+                f"{h}× mesh",
+                (end, h * mesh["hz_per_rpm"] * end),
+                fontsize=8,
+                xytext=(3, 0),
+                textcoords="offset points",
+                va="center",
+            )
+        meet = [c for c in sweep["crossings"] if c["harmonic"] <= harmonics]
+        if meet:
+            ax.plot(
+                [c["speed_rpm"] for c in meet],
+                [c["frequency_hz"] for c in meet],
+                "o",
+                ms=4,
+                color="black",
+                label="a mesh harmonic meets a mode",
+            )
+    # each speed without modes shaded over half a step either side (runs merge)
+    step = (n[-1] - n[0]) / (len(n) - 1)
+    for k, u in enumerate(sweep["unstable"]):
+        at = u["speed_rpm"]
+        ax.axvspan(
+            max(n[0], at - step / 2),
+            min(n[-1], at + step / 2),
+            color="0.85",
+            lw=0,
+            label="no modes: the set diverges" if k == 0 else None,
+        )
+    scene = sweep.get("scene_speed_rpm") or 0.0
+    if scene and n[0] <= scene <= n[-1]:
+        ax.axvline(scene, color="grey", lw=0.8, ls="--", label="the file's carrier speed")
+    ax.set_xlim(n[0], n[-1])
+    ax.set_ylim(0, 1.05 * top if top else 1.0)
+    ax.set_xlabel("carrier speed (rpm)")
+    seen = "seen from the carrier" if sweep["frame"].startswith("the carrier") else "torsional"
+    ax.set_ylabel(f"natural frequency (Hz, {seen})")
+    ax.set_title(f"{sweep['model']}: natural frequencies against the carrier's speed")
+    caption = (
+        f"mesh frequency = {mesh['ring_teeth']} x carrier rpm / 60 (the ring held)"
+        if mesh is not None
+        else f"no mesh-frequency lines: {sweep['mesh_why_not']}"
+    )
+    legend_below(fig, [ax], caption)
     return fig

@@ -26,13 +26,15 @@ def register(sub) -> None:
     p.add_argument(
         "--speeds",
         metavar="LO:HI",
-        help="speed range of the first mesh's driver, rpm (default: 0 to twice the scene's)",
+        help="speed range of the first mesh's driver, rpm (default: 0 to twice the scene's); "
+        "of a planetary set, LO:HI[:NUM] the carrier's speeds (NUM of them, default 41): "
+        "its natural frequencies against them, the Campbell diagram with --plot",
     )
     p.add_argument(
         "--plot",
         metavar="FILE",
         help="write the resonance diagram (PNG, PDF, SVG); of a planetary set with "
-        "--parametric, its parametric-instability diagram",
+        "--parametric, its parametric-instability diagram, with --speeds its Campbell diagram",
     )
     p.add_argument("--out", metavar="DIR", help="also write modes.json, .csv, .mat (--format)")
     p.add_argument(
@@ -138,15 +140,18 @@ def _planetary(path, args) -> int:
     from gearsym.solver.analysis.modes import UnstableAtSpeed, planetary_modes
 
     if args.speeds:
-        raise Fail(
-            "--speeds: a planetary set's file gives no tooth-pass speed, so there is no mesh "
-            "frequency "
-            "to meet; run without it"
-        )
+        from ._carrier import carrier_speeds, run_carrier_sweep
+
+        carrier_speeds(args.speeds)  # its one-line error before the derivation
+        try:
+            st = derive_planetary(load_planetary(path))
+        except UnstableAtSpeed as err:
+            raise Fail(f"{path}: {err}") from None
+        return run_carrier_sweep(path, st, args)
     if args.plot and not args.parametric:
         raise Fail(
-            "--plot: a planetary set has no resonance diagram (no mesh frequency); "
-            "add --parametric for its parametric-instability diagram"
+            "--plot: a planetary set's diagrams are of --parametric (its parametric "
+            "instabilities) or --speeds LO:HI (its modes against the carrier's speed); add one"
         )
     if args.plot:
         figure_file(args.plot, "--plot")

@@ -92,6 +92,7 @@ import numpy as np
 import sympy as sp
 
 from ..input.planetary import CENTRAL, PlanetarySet
+from .planetary_frame import at_speed
 
 __all__ = [
     "PlanetaryStructure",
@@ -146,29 +147,6 @@ class PlanetaryStructure:
                 else {}
             ),
         }
-
-
-def _rotating_frame(
-    names: list[str], mass: list[float], speed: float, bearing: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """``(G, K_Omega)`` over the coordinates ``names`` at the carrier speed ``speed``
-    (rad/s) with the planets' bearing stiffness ``bearing`` (module docstring): every
-    body's pair of translations, ``x_j, y_j`` or ``zeta_n, eta_n``, and the planets'
-    bearing load on ``u_c``."""
-    G = np.zeros((len(names), len(names)))
-    K = np.zeros_like(G)
-    pairs = [(f"x_{s}", f"y_{s}") for s in _SHORT.values()]
-    pairs += [(n, "eta_" + n[len("zeta_") :]) for n in names if n.startswith("zeta_")]
-    for a, b in pairs:
-        i, j = names.index(a), names.index(b)
-        G[i, j], G[j, i] = -2.0 * mass[i], 2.0 * mass[j]
-        K[i, i], K[j, j] = mass[i], mass[j]
-    # the planets' bearings' centripetal load through the pins' second-order motion
-    planets = [mass[names.index(n)] for n in names if n.startswith("zeta_")]
-    K[names.index("u_c"), names.index("u_c")] -= sum(
-        bearing * m / (bearing - m * speed**2) for m in planets
-    )
-    return G, K
 
 
 def _lateral(ps: PlanetarySet):
@@ -254,33 +232,6 @@ def _lateral(ps: PlanetarySet):
     return q, members, motions, mass, springs, kinds, deflections, R, stiffness
 
 
-def _bearings_carry_the_load(ps, names, mass, R, k, kinds, speed, K_omega) -> None:
-    """Refuse a set whose meshes would share the planets' steady centripetal load (all its
-    members held and unequal pressure angles): the load term on ``u_c`` assumes the
-    planets' bearings carry all of it, and the geometric stiffness of a mesh's preload is
-    not modelled.  The static deflection under ``m_p Omega_c^2`` on each ``zeta`` (per unit
-    ``r_c``), and the mesh forces against the bearing forces in it."""
-    from ..input.reader import InputError
-
-    K = R.T @ (np.asarray(k)[:, None] * R) - speed**2 * K_omega
-    load = np.array(
-        [m * speed**2 if n.startswith("zeta_") else 0.0 for n, m in zip(names, mass, strict=True)]
-    )
-    q = np.linalg.lstsq(K, load, rcond=None)[0]
-    force = np.abs(np.asarray(k) * (R @ q))
-    mesh = max(f for f, kind in zip(force, kinds, strict=True) if kind == "mesh")
-    carried = max(f for f, kind in zip(force, kinds, strict=True) if kind == "planet bearing")
-    if mesh > 1e-9 * carried:
-        raise InputError(
-            ps.source,
-            "planetary.carrier_speed_rpm",
-            f"the meshes would carry {100 * mesh / (mesh + carried):.3g} % of the planets' "
-            "centripetal load (the sun, ring and carrier all held, unequal pressure angles): "
-            "the geometric stiffness of a mesh's preload is not modelled; free one member's "
-            "rotation or give the two meshes one pressure angle",
-        )
-
-
 def mesh_phases(ps: PlanetarySet) -> tuple[tuple[float, float], ...] | None:
     """``(gamma_sn, gamma_rn)`` of each planet in mesh periods, in [0, 1) (module
     docstring); None without tooth counts."""
@@ -319,22 +270,9 @@ def derive_planetary(ps: PlanetarySet) -> PlanetaryStructure:
         motions = ["rotation"] * len(keep)
         mass = list(np.diag(M))
         names = keep
-    speed = ps.carrier_speed_rpm * 2.0 * math.pi / 60.0
-    if speed and ps.dofs == "torsional":
-        raise ValueError("a carrier speed needs the lateral-torsional model (translations)")
-    bearing = ps.members["planet"].bearing
-    if speed and bearing <= ps.members["planet"].mass * speed**2:
-        raise ValueError(
-            f"at a carrier speed of {ps.carrier_speed_rpm:g} rpm the planets' bearings "
-            f"({bearing:g} N/m) cannot hold the planets against the centripetal "
-            f"stiffness m_p Omega_c^2 = {ps.members['planet'].mass * speed**2:.4g} N/m"
-        )
-    G, K_omega = _rotating_frame(names, mass, speed, bearing) if speed else (None, None)
-    if speed:
-        _bearings_carry_the_load(ps, names, mass, R, k, kinds, speed, K_omega)
     sv = np.linalg.svd(R, compute_uv=False) if R.size else np.zeros(0)
     rank = int(np.sum(sv > 1e-10 * (sv.max() if sv.size else 1.0)))
-    return PlanetaryStructure(
+    still = PlanetaryStructure(
         planetary=ps,
         physical=tuple(names),
         members=tuple(members),
@@ -347,10 +285,8 @@ def derive_planetary(ps: PlanetarySet) -> PlanetaryStructure:
         stiffness=tuple(float(v) for v in k),
         rigid_body_modes=len(names) - rank,
         phases=mesh_phases(ps),
-        carrier_speed_rad_s=speed,
-        gyroscopic=G,
-        centripetal=K_omega,
     )
+    return at_speed(still, ps.carrier_speed_rpm) if ps.carrier_speed_rpm else still
 
 
 def rectangular_wave(contact_ratio: float, amplitude: float, harmonics: int) -> tuple:
