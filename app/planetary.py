@@ -200,8 +200,15 @@ def carrier_sweep(target, lo_rpm: float, hi_rpm: float, num: int = 41, harmonics
                         continue
                     a = f[i] - h * mesh["hz_per_rpm"] * speeds[i]
                     b = f[i + 1] - h * mesh["hz_per_rpm"] * speeds[i + 1]
-                    if a == 0 or a * b < 0:
-                        n_x = speeds[i] + (speeds[i + 1] - speeds[i]) * a / (a - b)
+                    # a meeting on a sample belongs to the segment it starts, or to the
+                    # last segment before the end or a gap
+                    last = i + 2 >= num or f[i + 2] is None
+                    if a == 0 or a * b < 0 or (b == 0 and last):
+                        n_x = (
+                            speeds[i]
+                            if a == 0
+                            else speeds[i] + (speeds[i + 1] - speeds[i]) * a / (a - b)
+                        )
                         crossings.append(
                             {
                                 "harmonic": h,
@@ -229,5 +236,6 @@ def carrier_sweep(target, lo_rpm: float, hi_rpm: float, num: int = 41, harmonics
         "mesh": mesh,
         "mesh_why_not": why,
         "crossings": crossings,
+        "harmonics": harmonics,
         "scene_speed_rpm": ps.carrier_speed_rpm,
     }

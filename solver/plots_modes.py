@@ -144,12 +144,13 @@ def parametric_figure(table: dict):
     return fig
 
 
-def carrier_figure(sweep: dict, harmonics: int = 3):
+def carrier_figure(sweep: dict, harmonics: int | None = None):
     """A planetary set's natural frequencies against its carrier's speed (the mapping of
     ``gearsym.planetary.carrier_sweep``): each track (the k-th lowest frequency) coloured
     by its mode's type, the mesh frequency's harmonics where the ring is held and its teeth
-    known, a dot where they meet a mode, the speeds without modes shaded; returns the
-    ``Figure`` (nothing saved)."""
+    known (``harmonics`` of them, default the sweep's), a dot where they meet a mode, the
+    speeds without modes shaded; returns the ``Figure`` (nothing saved)."""
+    harmonics = sweep.get("harmonics", 3) if harmonics is None else harmonics
     fig, ax = plt.subplots(figsize=(8, 5.5))
     n = np.asarray(sweep["speeds_rpm"])
     top = 0.0
@@ -203,7 +204,7 @@ def carrier_figure(sweep: dict, harmonics: int = 3):
             min(n[-1], at + step / 2),
             color="0.85",
             lw=0,
-            label="no modes: the set diverges" if k == 0 else None,
+            label="no modes at this speed (why: --json)" if k == 0 else None,
         )
     scene = sweep.get("scene_speed_rpm") or 0.0
     if scene and n[0] <= scene <= n[-1]:

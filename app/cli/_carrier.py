@@ -90,12 +90,14 @@ def _print(sweep: dict) -> None:
         f"{sweep['model']}: {len(sweep['modes'])} elastic modes against the carrier speed, "
         f"{speeds[0]:g} to {speeds[-1]:g} rpm ({len(speeds)} speeds); {frame}"
     )
-    print(f"  {'#':>2}  {'type at LO':<13}  {'Hz at LO':>9}  {'Hz at HI':>9}")
+    print(f"  {'#':>2}  {'type at LO':<13}  {'Hz at LO':>9}  {'Hz at HI':>9}  (-: no modes there)")
+
+    def hz(v) -> str:
+        return f"{'-':>9}" if v is None else f"{v:9.1f}"
+
     for m in sweep["modes"]:
-        f = [v for v in m["frequency_hz"] if v is not None]
-        labels = [v for v in m["label"] if v is not None]
-        if f:
-            print(f"  {m['index']:2d}  {labels[0]:<13}  {f[0]:9.1f}  {f[-1]:9.1f}")
+        f, label = m["frequency_hz"], m["label"][0] or "-"
+        print(f"  {m['index']:2d}  {label:<13}  {hz(f[0])}  {hz(f[-1])}")
     for u in sweep["unstable"][:1]:
         print(
             f"  no modes at {len(sweep['unstable'])} speeds from {u['speed_rpm']:g} rpm: {u['why']}"
@@ -106,10 +108,12 @@ def _print(sweep: dict) -> None:
     mesh = sweep["mesh"]
     print(
         f"  mesh frequency {mesh['ring_teeth']} x carrier rpm / 60 (the ring held); "
-        f"{len(sweep['crossings'])} meetings with a mode up to the "
-        f"{max((c['harmonic'] for c in sweep['crossings']), default=1)}. harmonic"
+        f"its first 3 harmonics meet a mode {len(sweep['crossings'])} times"
     )
-    for c in [c for c in sweep["crossings"] if c["harmonic"] == 1][:10]:
+    first = [c for c in sweep["crossings"] if c["harmonic"] == 1]
+    if len(first) > 10:
+        print(f"    the first 10 of the 1x mesh's {len(first)}; all in --json, --out and --plot")
+    for c in first[:10]:
         print(
             f"    1x mesh meets mode {c['mode']} ({c['label']}) at {c['speed_rpm']:.1f} rpm, "
             f"{c['frequency_hz']:.1f} Hz"

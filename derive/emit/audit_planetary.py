@@ -79,7 +79,14 @@ def planetary_page(st: PlanetaryStructure, command: str, source: str) -> str:
         )
         + ", no damping. It gives the natural frequencies and modes "
         "(`gearsym modes`), each typed rotational, translational or planet with its "
-        "multiplicity.\n",
+        "multiplicity, and "
+        + (
+            "their frequencies against the carrier's speed (`gearsym modes --speeds LO:HI`)."
+            if ps.dofs != "torsional"
+            else "the mesh harmonics against the carrier's speed (`gearsym modes --speeds "
+            "LO:HI`; a torsional model's frequencies do not depend on it)."
+        )
+        + "\n",
         "The meshes' stiffness variation, each mesh delayed by its phase round the carrier, "
         "enters the linear analysis of parametric instability (`gearsym modes "
         "--parametric`, with a `[planetary.variation]` table and the tooth counts; "

@@ -164,11 +164,12 @@ def check_orbit(
         lyapunov_periods=n,
     )
     residual = float("inf")
+    how = {"method": _METHODS[system.piecewise]}
     for it in range(max_iter + 1):
         try:
             path, M = _flow(system, x, n, phase0, spec)
         except FloatingPointError as err:
-            return OrbitCheck(n, False, residual=residual, iterations=it, why=str(err))
+            return OrbitCheck(n, False, residual=residual, iterations=it, why=str(err), **how)
         G = path[-1] - x
         residual = float(np.max(np.abs(G)))
         scale = max(1.0, float(np.max(np.abs(x))))
@@ -179,14 +180,15 @@ def check_orbit(
         try:
             step = np.linalg.solve(M - np.eye(N), -G)
         except np.linalg.LinAlgError:
-            return OrbitCheck(n, False, residual=residual, iterations=it, why="singular step")
+            return OrbitCheck(
+                n, False, residual=residual, iterations=it, why="singular step", **how
+            )
         if not np.all(np.isfinite(step)) or np.max(np.abs(step)) > 0.5 * scale:
             why = "the Newton step left the run's neighbourhood"
-            return OrbitCheck(n, False, residual=residual, iterations=it, why=why)
+            return OrbitCheck(n, False, residual=residual, iterations=it, why=why, **how)
         x = x + step
-    return OrbitCheck(
-        n, False, residual=residual, iterations=max_iter, why=f"no convergence in {max_iter}"
-    )
+    why = f"no convergence in {max_iter}"
+    return OrbitCheck(n, False, residual=residual, iterations=max_iter, why=why, **how)
 
 
 def _found(system, x, n, path, M, residual, iterations, start) -> OrbitCheck:

@@ -223,9 +223,11 @@ def _engine(module, P, X0, spec: RunSpec, backend: str, tangent0=None) -> RunRes
 
 def _monodromy(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec, backend: str) -> RunResult:
     """Each point run once per state, the tangent starting from that unit vector (the
-    copies of a point side by side, so that a lock-step group holds them together): the
+    copies of a point side by side, so that a lock-step group mostly holds them together;
+    copies in other groups differ by the steps only, about 1e-12): the
     monodromy's column k is the tangent's end times its growth.  The point's samples,
-    extremes and exponent are those of its first copy; a copy that failed fails it."""
+    extremes and exponent are those of its first copy, or of its first copy that failed
+    (which fails the point, its monodromy NaN)."""
     N, n = X0.shape
     inner = spec.with_(collect=tuple(c for c in spec.collect if c != "monodromy"))
     tangent0 = np.tile(np.eye(n), (N, 1))
@@ -233,16 +235,16 @@ def _monodromy(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec, backend: st
     res = _engine(module, P, X0, inner, backend, tangent0)
     ends = res.tangent.reshape(N, n, n + 1)
     M = (ends[:, :, :n] * np.exp(ends[:, :, n:])).transpose(0, 2, 1)
-    status = [res.status[i * n] for i in range(N)]
+    # each point's first copy, or its first failed one (a failed copy fails the point)
+    rows = np.arange(0, N * n, n)
     for i in range(N):
-        failed = [s for s in res.status[i * n : (i + 1) * n] if s != "ok"]
+        failed = [k for k in range(i * n, (i + 1) * n) if res.status[k] != "ok"]
         if failed:
-            status[i] = status[i] if status[i] != "ok" else failed[0]
+            rows[i] = failed[0]
             M[i] = np.nan
-    first = slice(0, N * n, n)
 
     def pick(a):
-        return None if a is None else a[first]
+        return None if a is None else a[rows]
 
     return replace(
         res,
@@ -253,7 +255,7 @@ def _monodromy(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec, backend: st
         exits=pick(res.exits),
         nfev=res.nfev.reshape(N, n).sum(axis=1),
         nsteps=res.nsteps.reshape(N, n).max(axis=1),
-        status=tuple(status),
+        status=tuple(res.status[k] for k in rows),
         t_fail=pick(res.t_fail),
         monodromy=M,
         tangent=None,

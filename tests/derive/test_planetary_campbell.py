@@ -117,3 +117,19 @@ def test_the_api_draws_it():
         "rotational",
         "the file's carrier speed",
     }
+
+
+def test_a_meeting_on_the_last_speed_is_found_once(tmp_path):
+    path = variant(
+        tmp_path, "torsional", "lin-parker-1999-3-phased", DOFS, 'degrees_of_freedom = "torsional"'
+    )
+    f = carrier_sweep(path, 0.0, 1000.0, num=3)["modes"][0]["frequency_hz"][0]
+    for h in (1, 2, 3):
+        top = 60 * f / (h * 89)  # the h-th harmonic meets mode 1 exactly at HI
+        for num in (3, 4):
+            meets = [
+                c
+                for c in carrier_sweep(path, 0.0, top, num=num)["crossings"]
+                if c["mode"] == 1 and c["harmonic"] == h
+            ]
+            assert len(meets) == 1 and meets[0]["speed_rpm"] == pytest.approx(top, rel=1e-12)

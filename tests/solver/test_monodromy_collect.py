@@ -99,3 +99,13 @@ def test_the_monodromy_needs_the_tangent_from_the_start():
         _spec(2).with_(lyapunov_periods=1)
     with pytest.raises(ValueError, match="needs 'exponent' collected"):
         _spec(2).with_(collect=("samples", "monodromy"), lyapunov_periods=0)
+
+
+def test_the_orbit_check_names_its_route_when_it_fails_too():
+    from gearsym.solver.analysis.orbit_check import check_orbit
+
+    x = np.array([0.9, 0.7, 0.1, -0.2])
+    failed = check_orbit(System.load("reference_dead_zone"), x, 1, max_iter=0)
+    assert not failed.converged and "central-difference" in failed.describe()["method"]
+    smooth = check_orbit(System.load("reference_light"), x, 1, max_iter=0)
+    assert not smooth.converged and "variational" in smooth.describe()["method"]
