@@ -103,6 +103,15 @@ class OrbitCheck:
             "attracting": self.attracting,
             "method": self.method,
             **({"why": self.why} if self.why else {}),
+            **(
+                {
+                    "multiplier_error_note": "that of the differences on a smooth flow; "
+                    "near a grazing contact of the piecewise force law it can be larger "
+                    "(orbit_check.py)"
+                }
+                if self.method == _METHODS[True]
+                else {}
+            ),
         }
 
 

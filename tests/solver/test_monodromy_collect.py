@@ -107,5 +107,7 @@ def test_the_orbit_check_names_its_route_when_it_fails_too():
     x = np.array([0.9, 0.7, 0.1, -0.2])
     failed = check_orbit(System.load("reference_dead_zone"), x, 1, max_iter=0)
     assert not failed.converged and "central-difference" in failed.describe()["method"]
+    assert "grazing" in failed.describe()["multiplier_error_note"]
     smooth = check_orbit(System.load("reference_light"), x, 1, max_iter=0)
     assert not smooth.converged and "variational" in smooth.describe()["method"]
+    assert "multiplier_error_note" not in smooth.describe()
