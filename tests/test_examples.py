@@ -47,8 +47,23 @@ def test_every_example_is_tested_here():
         "notebook.py",
         "orbit_and_continuation.py",
         "own_scene.py",
+        "planetary.py",
         "sweep_with_figure.py",
     ]
+
+
+def test_planetary(tmp_path):
+    # the marine stage's fixed-carrier modes: 1 rigid-body, 6 translational pairs, 5
+    # rotational (Lin and Parker's structure for 3 planets: no planet modes)
+    out, stdout = _run("planetary.py", tmp_path)
+    assert "mode types: 1 rigid-body, 12 translational, 5 rotational" in stdout
+    # no mesh frequency in a planetary set's file: its summary says so, with no NaN
+    assert "(no mesh frequency stated)" in stdout and "nan" not in stdout.lower()
+    assert "907.4088 Hz, translational, x2" in stdout
+    assert "the mesh frequency first meets mode 1 (translational)" in stdout
+    _written(out, "campbell.png", "carrier_sweep.json", "parametric.png")
+    sweep = __import__("json").loads((out / "carrier_sweep.json").read_text(encoding="utf-8"))
+    assert len(sweep["speeds_rpm"]) == 31 and sweep["mesh"]["ring_teeth"] == 100
 
 
 def test_orbit_and_continuation(tmp_path):

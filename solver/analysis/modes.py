@@ -65,38 +65,50 @@ class Modes:
     reference_teeth: int
     reference_driver: str = ""  # the first mesh's driver, whose speed the diagram uses
 
+    @property
+    def has_mesh_frequency(self) -> bool:
+        """Whether the model states a mesh frequency (a planetary set's file does not)."""
+        return math.isfinite(self.mesh_frequency_hz) and self.mesh_frequency_hz > 0
+
     def __repr__(self) -> str:
         elastic = [m for m in self.modes if m.label != "rigid-body"]
         first = f"; lowest {elastic[0].frequency_hz:.4g} Hz" if elastic else ""
+        mesh = (
+            f"; mesh frequency {self.mesh_frequency_hz:.4g} Hz" if self.has_mesh_frequency else ""
+        )
         return (
             f"Modes({self.model}: {len(self.modes)} modes, "
-            f"{len(self.modes) - len(elastic)} rigid-body{first}; mesh frequency "
-            f"{self.mesh_frequency_hz:.4g} Hz)"
+            f"{len(self.modes) - len(elastic)} rigid-body{first}{mesh})"
         )
 
     def summary(self) -> str:
-        """One line per mode (at most 12): frequency, over the mesh frequency, its kind."""
+        """One line per mode (at most 12): frequency, over the mesh frequency where the
+        model states one, its kind (and, of a planetary set, its multiplicity)."""
         lines = [
             f"modes of {self.model}; mesh frequency {self.mesh_frequency_hz:.6g} Hz "
             f"({self.reference_teeth} teeth of {self.reference_driver or 'the driver'})"
+            if self.has_mesh_frequency
+            else f"modes of {self.model} (no mesh frequency stated)"
         ]
         for m in self.modes[:12]:
-            lines.append(
-                f"  {m.index}: {m.frequency_hz:10.4f} Hz ({self.over_mesh(m):.3f} x mesh), "
-                f"{m.label}"
-            )
+            ratio = f" ({self.over_mesh(m):.3f} x mesh)" if self.has_mesh_frequency else ""
+            times = f", x{m.multiplicity}" if m.multiplicity > 1 else ""
+            lines.append(f"  {m.index}: {m.frequency_hz:10.4f} Hz{ratio}, {m.label}{times}")
         if len(self.modes) > 12:
             lines.append(f"  ... {len(self.modes) - 12} more")
         return "\n".join(lines)
 
-    def over_mesh(self, mode: Mode) -> float:
+    def over_mesh(self, mode: Mode) -> float | None:
+        """The mode's frequency over the mesh frequency (None where none is stated)."""
+        if not self.has_mesh_frequency:
+            return None
         return mode.frequency_hz / self.mesh_frequency_hz
 
     def resonances(self, speeds_rpm: tuple[float, float], harmonics: int = 3) -> list[dict]:
         """Speeds of the reference driver where a mesh-frequency harmonic meets a mode:
-        ``h z n / 60 = f``."""
+        ``h z n / 60 = f`` (none without a stated mesh frequency)."""
         out = []
-        for mode in self.modes:
+        for mode in self.modes if self.has_mesh_frequency else ():
             if mode.label == "rigid-body":
                 continue
             for h in range(1, harmonics + 1):
@@ -105,10 +117,13 @@ class Modes:
                     out.append({"mode": mode.index, "harmonic": h, "speed_rpm": rpm})
         return sorted(out, key=lambda r: r["speed_rpm"])
 
-    def to_json(self, speeds_rpm: tuple[float, float]) -> dict:
+    def to_json(self, speeds_rpm: tuple[float, float] | None) -> dict:
+        """The modes as JSON-ready values; without a mesh frequency (a planetary set) its
+        ratio, speed range and resonances are None and empty."""
+        mesh = self.has_mesh_frequency
         return {
             "model": self.model,
-            "mesh_frequency_hz": self.mesh_frequency_hz,
+            "mesh_frequency_hz": self.mesh_frequency_hz if mesh else None,
             "reference_driver": self.reference_driver,
             "reference_teeth": self.reference_teeth,
             "modes": [
@@ -124,14 +139,14 @@ class Modes:
                 }
                 for m in self.modes
             ],
-            "speed_range_rpm": list(speeds_rpm),
-            "resonances": self.resonances(speeds_rpm),
+            "speed_range_rpm": list(speeds_rpm) if mesh and speeds_rpm else None,
+            "resonances": self.resonances(speeds_rpm) if mesh and speeds_rpm else [],
         }
 
     def to_dict(self, speeds_rpm: tuple[float, float] | None = None) -> dict:
         """:meth:`to_json` over ``speeds_rpm`` (default 0 to twice the scene's speed of
         the reference driver)."""
-        if speeds_rpm is None:
+        if speeds_rpm is None and self.has_mesh_frequency:
             speeds_rpm = (0.0, 120.0 * self.mesh_frequency_hz / self.reference_teeth)
         return self.to_json(speeds_rpm)
 

@@ -133,3 +133,18 @@ def test_a_meeting_on_the_last_speed_is_found_once(tmp_path):
                 if c["mode"] == 1 and c["harmonic"] == h
             ]
             assert len(meets) == 1 and meets[0]["speed_rpm"] == pytest.approx(top, rel=1e-12)
+
+
+def test_a_planetary_sets_modes_read_without_a_mesh_frequency():
+    # its file states none: the API's summary, repr, dict and table say so, with no NaN
+    # and no division by its zero tooth count
+    import gearsym
+
+    modal = gearsym.planetary.modes("lin-parker-1999-4")
+    text = modal.summary() + repr(modal)
+    assert "nan" not in text.lower() and "no mesh frequency stated" in text
+    data = modal.to_dict()
+    json.dumps(data, allow_nan=False)
+    assert data["mesh_frequency_hz"] is None and data["resonances"] == []
+    assert modal.resonances((0.0, 1000.0)) == []
+    assert all(row[2] is None for row in modal.to_table()[1])
