@@ -49,8 +49,9 @@ def shipped_planetary() -> list[Path]:
     return sorted((builtin_root() / "planetary").glob("*.toml"))
 
 
-def planetary_files(paths) -> dict[str, str]:
-    """``docs/derivation/<name>.md`` of each planetary set in ``paths``."""
+def planetary_files(paths, derived: dict | None = None) -> dict[str, str]:
+    """``docs/derivation/<name>.md`` of each planetary set in ``paths``; ``derived``, if
+    given, receives each path's derived set (the index reads them again)."""
     from .emit.audit_planetary import planetary_name, planetary_page
     from .equations.planetary import derive_planetary
     from .input.planetary import load_planetary
@@ -58,6 +59,8 @@ def planetary_files(paths) -> dict[str, str]:
     files = {}
     for path in paths:
         st = derive_planetary(load_planetary(path))
+        if derived is not None:
+            derived[path] = st
         command = f"gearsym derive {display_path(path)}"
         page = planetary_page(st, command, display_path(path))
         files[f"docs/derivation/{planetary_name(st.planetary.name)}.md"] = page
@@ -87,7 +90,8 @@ def build_files(
         raise InputError(
             str(planetary[0]), "--set", "a planetary set takes no --set yet; edit its file"
         )
-    files.update(planetary_files(planetary + (shipped_planetary() if index else [])))
+    derived: dict = {}
+    files.update(planetary_files(planetary + (shipped_planetary() if index else []), derived))
     for path in [p for p in paths if p not in planetary]:
         scene = with_open_values(load_target(path, rest or None), **opened)
         model = derive_model(scene)
@@ -106,10 +110,8 @@ def build_files(
         )
     if index:
         from .emit.audit_planetary import planetary_index
-        from .equations.planetary import derive_planetary
-        from .input.planetary import load_planetary
 
-        sets = [derive_planetary(load_planetary(p)) for p in shipped_planetary()]
+        sets = [derived[p] for p in shipped_planetary()]
         files["docs/derivation.md"] = index_page(models, "gearsym derive") + planetary_index(sets)
         files[STIFFNESS_PAGE] = stiffness_page(
             load_topology(_reference_topology()), "gearsym derive", Path(STIFFNESS_FIGURE).name
@@ -168,10 +170,11 @@ def differs(old: str, new: str) -> str:
     return "differs"
 
 
-def check(root: Path | None = None) -> list[str]:
-    """Files under ``root`` that differ from a fresh regeneration of the shipped set."""
+def check(root: Path | None = None, built: Built | None = None) -> list[str]:
+    """Files under ``root`` that differ from a fresh regeneration of the shipped set
+    (``built``: that regeneration, when already made in this process)."""
     root = Path(root) if root is not None else project_root()
-    built = build_files(shipped_targets(), index=True)
+    built = built or build_files(shipped_targets(), index=True)
     stale = []
     for rel, text in built.files.items():
         path = root / rel
