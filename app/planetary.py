@@ -149,7 +149,8 @@ def carrier_sweep(target, lo_rpm: float, hi_rpm: float, num: int = 41, harmonics
     where its first ``harmonics`` harmonics meet a mode are given (linear between two
     speeds of the sweep).  Raises ``ValueError`` for a range the model cannot take."""
     import numpy as np
-    from gearsym.derive.equations.planetary_frame import at_speed, bearing_limit_rpm
+    from gearsym.derive.equations.planetary_frame import at_speed
+    from gearsym.derive.input.planetary import bearing_limit_rpm
     from gearsym.solver.analysis.modes import UnstableAtSpeed, planetary_modes
 
     st = target if hasattr(target, "as_structure") else load(target)
@@ -159,10 +160,11 @@ def carrier_sweep(target, lo_rpm: float, hi_rpm: float, num: int = 41, harmonics
             f"speeds {lo_rpm:g} to {hi_rpm:g} rpm ({num}): give 0 <= LO < HI, NUM >= 2"
         )
     turning = ps.dofs != "torsional"
-    if turning and hi_rpm >= bearing_limit_rpm(ps):
+    limit = bearing_limit_rpm(ps.members["planet"])
+    if turning and hi_rpm >= limit:
         raise ValueError(
             f"{hi_rpm:g} rpm: the planets' bearings cannot hold them at or above "
-            f"{bearing_limit_rpm(ps):.6g} rpm (sqrt(k_p / m_p)); keep the speeds below it"
+            f"{limit:.6g} rpm (sqrt(k_p / m_p)); keep the speeds below it"
         )
     base = at_speed(st, 0.0)
     speeds = np.linspace(lo_rpm, hi_rpm, num)

@@ -15,7 +15,9 @@ from dataclasses import replace
 
 import numpy as np
 
-__all__ = ["at_speed", "bearing_limit_rpm", "rotating_frame"]
+from ..input.planetary import balanced, bearing_limit_rpm
+
+__all__ = ["at_speed", "rotating_frame"]
 
 _PAIRS = (("x_c", "y_c"), ("x_r", "y_r"), ("x_s", "y_s"))
 
@@ -43,13 +45,6 @@ def rotating_frame(
     return G, K
 
 
-def bearing_limit_rpm(ps) -> float:
-    """The carrier speed at which the planets' bearings can no longer hold them against
-    the centripetal stiffness: ``sqrt(k_p / m_p)``, in rpm."""
-    planet = ps.members["planet"]
-    return math.sqrt(planet.bearing / planet.mass) * 30.0 / math.pi
-
-
 def at_speed(st, rpm: float):
     """The derived set ``st`` (a ``PlanetaryStructure``) with its carrier turning at
     ``rpm``: the rotating frame's ``G`` and ``K_Omega`` for it (none at 0).  Raises
@@ -67,16 +62,13 @@ def at_speed(st, rpm: float):
         )
     if ps.dofs == "torsional":
         raise ValueError("a carrier speed needs the lateral-torsional model (translations)")
-    balance = abs(
-        sum(complex(math.cos(math.radians(a)), math.sin(math.radians(a))) for a in ps.angles_deg)
-    )
-    if balance > 1e-9 * len(ps.angles_deg):
+    if not balanced(ps.angles_deg):
         raise ValueError(
             "a carrier speed needs balanced planets (equally spaced, or in opposite pairs)"
         )
     speed = rpm * 2.0 * math.pi / 60.0
     bearing = ps.members["planet"].bearing
-    if abs(rpm) >= bearing_limit_rpm(ps):
+    if abs(rpm) >= bearing_limit_rpm(ps.members["planet"]):
         raise ValueError(
             f"at a carrier speed of {rpm:g} rpm the planets' bearings ({bearing:g} N/m) "
             "cannot hold the planets against the centripetal stiffness m_p Omega_c^2 = "

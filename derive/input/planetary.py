@@ -55,7 +55,17 @@ from pathlib import Path
 
 from .reader import InputError, Table, load_toml
 
-__all__ = ["DOFS", "Member", "PlanetarySet", "Variation", "is_planetary", "load_planetary"]
+__all__ = [
+    "DOFS",
+    "Member",
+    "PlanetarySet",
+    "Variation",
+    "balanced",
+    "bearing_limit_rpm",
+    "imbalance",
+    "is_planetary",
+    "load_planetary",
+]
 
 DOFS = ("torsional", "lateral-torsional")
 CENTRAL = ("carrier", "ring", "sun")  # Lin and Parker's order of the central members
@@ -178,6 +188,25 @@ def _variation(t: Table, teeth: bool) -> Variation:
     return Variation(waves[0], waves[1], phase, harmonics)
 
 
+def imbalance(angles_deg) -> float:
+    """The length of the sum of the planets' unit vectors (0: balanced)."""
+    return abs(
+        sum(complex(math.cos(math.radians(a)), math.sin(math.radians(a))) for a in angles_deg)
+    )
+
+
+def balanced(angles_deg) -> bool:
+    """Whether planets at ``angles_deg`` balance (equally spaced, or in opposite pairs):
+    a turning carrier needs it (the module text)."""
+    return imbalance(angles_deg) <= 1e-9 * len(angles_deg)
+
+
+def bearing_limit_rpm(planet: Member) -> float:
+    """The carrier speed at which the planets' bearings can no longer hold them against
+    the centripetal stiffness ``m_p Omega_c^2``: ``sqrt(k_p / m_p)``, in rpm."""
+    return math.sqrt(planet.bearing / planet.mass) * 30.0 / math.pi
+
+
 def load_planetary(path: Path | str) -> PlanetarySet:
     """Read and check a planetary set's topology file (module docstring)."""
     path = Path(path)
@@ -235,10 +264,8 @@ def load_planetary(path: Path | str) -> PlanetarySet:
             'gyroscopic and centripetal terms act; use degrees_of_freedom = "lateral-'
             'torsional", or leave the carrier speed out',
         )
-    balance = abs(
-        sum(complex(math.cos(math.radians(a)), math.sin(math.radians(a))) for a in angles)
-    )
-    if speed != 0.0 and balance > 1e-9 * len(angles):
+    if speed != 0.0 and not balanced(angles):
+        balance = imbalance(angles)
         raise p.error(
             "carrier_speed_rpm",
             f"the planets at {[round(a, 6) for a in angles]} deg do not balance (the sum of "
@@ -251,8 +278,7 @@ def load_planetary(path: Path | str) -> PlanetarySet:
     members = {m: _member(p.table(m), m, False) for m in CENTRAL}
     members["planet"] = _member(p.table("planet"), "planet", True)
     planet = members["planet"]
-    if speed != 0.0 and planet.bearing <= planet.mass * (speed * math.pi / 30.0) ** 2:
-        limit = math.sqrt(planet.bearing / planet.mass) * 30.0 / math.pi
+    if speed != 0.0 and abs(speed) >= (limit := bearing_limit_rpm(planet)):
         raise p.error(
             "carrier_speed_rpm",
             f"{speed:g} rpm: the planets' bearings ({planet.bearing:g} N/m) cannot hold the "
