@@ -7,6 +7,10 @@ instabilities of their meshes' stiffness variation (issue 26).
     table = gearsym.planetary.parametric_instabilities("lin-parker-1999-3-phased")
     table["bands"][0]                                          # harmonic, type, band in Hz
     sweep = gearsym.planetary.carrier_sweep("lin-parker-1999-3", 0, 6000)  # vs carrier speed
+    system = gearsym.planetary.dynamics("marine-stage-3")      # the nonlinear model
+    tr = gearsym.simulate(system, gearsym.planetary.loaded_state(system))
+    gearsym.planetary.contact(tr)                              # each mesh's time apart
+    resp = gearsym.planetary.mesh_response("lin-parker-1999-3-backlash", 500, 4000)
 
 The same as ``gearsym modes SET``, ``gearsym modes SET --parametric`` and ``gearsym modes SET
 --speeds LO:HI``.
@@ -16,7 +20,18 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["carrier_sweep", "load", "modes", "parametric_instabilities"]
+from .planetary_dynamics import contact, dynamics, loaded_state, mesh_response
+
+__all__ = [
+    "carrier_sweep",
+    "contact",
+    "dynamics",
+    "loaded_state",
+    "mesh_response",
+    "load",
+    "modes",
+    "parametric_instabilities",
+]
 
 
 def load(target):

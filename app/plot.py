@@ -24,6 +24,7 @@ __all__ = [
     "carrier",
     "frequency_response",
     "map",
+    "mesh_response",
     "modes",
     "multipliers",
     "parametric",
@@ -170,3 +171,15 @@ def parametric(table):
     from gearsym.solver.plots_modes import parametric_figure
 
     return parametric_figure(table)
+
+
+def mesh_response(resp):
+    """A planetary set's mesh frequency response: each kind of mesh's largest and smallest
+    deflection against the mesh frequency, up and down, the band where teeth separate
+    shaded and the resonances with the stiffness variation's harmonics dotted.
+
+    ``resp``: the mapping of ``gearsym.planetary.mesh_response``.  Returns a Figure.
+    """
+    from gearsym.solver.plots_response import mesh_response_figure
+
+    return mesh_response_figure(resp)

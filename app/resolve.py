@@ -300,6 +300,9 @@ def load(target: str | Path | ModuleType, **values) -> System:
         return System.load(target, **values)
     if Path(str(target)).suffix == ".py":
         return System.load(Path(target), **values)
+    path = planetary_path(target)
+    if path is not None:
+        return planetary_system(path, **values)
     module = module_for(target)
     opened, rest = split_open_values(values, module)
     return System.load(module_for(target, opened) if opened else module, **rest)
@@ -327,3 +330,37 @@ def needs_derivation(name: str, module: ModuleType | None = None) -> bool:
     except ImportError:  # a derive layer without open values
         return False
     return is_open_value(name)
+
+
+def planetary_path(target) -> Path | None:
+    """The file of ``target`` (a built-in name or a path) when it is a planetary set, else
+    None (a target that names no file is left to the caller's own message)."""
+    from gearsym.derive.input.planetary import is_planetary
+    from gearsym.derive.input.scene import resolve_target
+
+    try:
+        path = resolve_target(target)
+    except (OSError, ValueError):
+        return None
+    return Path(path) if is_planetary(path) else None
+
+
+def planetary_system(path: Path, **values) -> System:
+    """The nonlinear model of the planetary set at ``path`` (``gearsym.planetary.dynamics``),
+    derived once into the model cache under the hash of its file, this package's version
+    and the module's format; a set without a ``[planetary.dynamics]`` table is refused in
+    one line before any derivation."""
+    from gearsym.derive.emit.planetary_module import inputs_hash, planetary_module
+    from gearsym.derive.equations.planetary import derive_planetary
+    from gearsym.derive.equations.planetary_dynamics import derive_dynamics, needs_dynamics
+    from gearsym.derive.input.planetary import load_planetary
+
+    ps = load_planetary(path)
+    needs_dynamics(ps)
+    where = cached_module(f"{ps.name}_dynamics", inputs_hash(path))
+    module = load_cached(where)
+    if module is None:
+        dyn = derive_dynamics(derive_planetary(ps))
+        store_cached(where, planetary_module(dyn, f"gearsym.planetary.dynamics({ps.name!r})"))
+        module = load_cached(where)
+    return System.load(module, **values)

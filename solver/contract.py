@@ -102,6 +102,10 @@ class Contract:
         The right-hand side has kinks (``switching_surfaces``) that integrators locate.
     switching_surfaces : tuple of (int, float)
         ``(i, c)``: the kink ``x[i] = c``.
+    switching_rows : tuple of (tuple of float, float)
+        ``(a, c)``: a kink on ``a . x = c`` that is not a coordinate's (a mesh of a
+        planetary set, whose deflection is a sum of body coordinates); integrators do not
+        locate these, their adaptive steps resolve them.
     valid_range : dict or None
         coordinate -> bound ``a``: the force law holds for ``|x| <= a`` only.
     functions : tuple of str
@@ -124,6 +128,7 @@ class Contract:
     valid_range: dict | None
     functions: tuple[str, ...] = ("parameters", "rhs", "jacobian", "casadi_functions")
     force_sign: dict = field(default_factory=dict)
+    switching_rows: tuple = ()
 
     def __post_init__(self):
         if not self.force_sign:
@@ -172,6 +177,10 @@ class Contract:
             else {k: float(v) for k, v in dict(data["valid_range"]).items()},
             functions=tuple(str(f) for f in data.get("functions", cls.functions)),
             force_sign=_force_signs(data.get("force_sign", {}), name),
+            switching_rows=tuple(
+                (tuple(float(a) for a in row), float(v))
+                for row, v in data.get("switching_rows", ())
+            ),
         )
         c._check(name)
         absent = [f for f in c.functions if not callable(getattr(module, f, None))]
@@ -212,8 +221,10 @@ class Contract:
             problems.append("a load that is not a parameter")
         if any(not 0 <= i < n for i, _ in self.switching_surfaces):
             problems.append("a switching surface outside the state")
-        if self.piecewise != bool(self.switching_surfaces):
+        if self.piecewise != bool(self.switching_surfaces or self.switching_rows):
             problems.append("piecewise must go with switching surfaces and smooth with none")
+        if any(len(row) != n for row, _ in self.switching_rows):
+            problems.append("a switching row that is not one coefficient per state")
         if problems:
             raise ValueError(f"model '{name}': inconsistent CONTRACT ({'; '.join(problems)})")
 

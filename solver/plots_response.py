@@ -15,7 +15,7 @@ import numpy as np  # noqa: E402
 
 from .plots_style import BIFURCATIONS, SWEEPS, legend_below  # noqa: E402
 
-__all__ = ["METHODS", "frequency_response_figure"]
+__all__ = ["METHODS", "frequency_response_figure", "mesh_response_figure"]
 
 METHODS = {"hb": "#1b9e77", "shooting": "#7570b3"}  # one colour per method, every figure
 _NAMES = {"hb": "harmonic balance", "shooting": "shooting", "integration": "integration"}
@@ -102,4 +102,83 @@ def frequency_response_figure(resp, physical: bool = False, title: str = ""):
     if title:
         axes[0, 0].set_title(title, fontsize=10)
     legend_below(fig, axes.ravel())  # one legend: each entry once, not once per panel
+    return fig
+
+
+def mesh_response_figure(resp: dict):
+    """A planetary set's mesh frequency response (``gearsym.planetary.mesh_response``): one
+    panel per kind of mesh, the largest and smallest deflection over its meshes (half
+    backlashes) against the mesh frequency, the up sweep and the down sweep; the teeth
+    apart (``|u| <= 1``) shaded grey, the frequencies where a mesh of the panel's kind
+    separates shaded red, and each resonance ``l f_mesh = f_k`` of a natural frequency
+    with the stiffness variation's harmonics dotted (labelled ``f_k/l`` where there is
+    room).  Returns the
+    ``Figure`` (nothing saved)."""
+    kinds = [k for k in ("sun-planet", "ring-planet") if k in resp["up"]]
+    f = np.asarray(resp["frequencies_hz"])
+    fig, axes = plt.subplots(len(kinds), 1, figsize=(8, 3.2 * len(kinds)), sharex=True)
+    axes = np.atleast_1d(axes)
+    step = (f[1] - f[0]) / 2 if f.size > 1 else 0.0
+    for ax, kind in zip(axes, kinds, strict=True):
+        seen = []
+        for direction in ("up", "down"):
+            style, marker = _SWEPT[direction]
+            row = resp[direction][kind]
+            for key, ls in (("u_max", "-"), ("u_min", "--")):
+                y = np.array([np.nan if v is None else v for v in row[key]], dtype=float)
+                seen.append(y)
+                ax.plot(
+                    f,
+                    y,
+                    ls,
+                    marker=marker,
+                    ms=3,
+                    lw=1.0,
+                    color=SWEEPS[style]["color"],
+                    label=f"{'largest' if key == 'u_max' else 'smallest'} deflection, "
+                    f"{direction} sweep",
+                )
+        data = np.concatenate(seen)
+        lo, hi = np.nanmin(data), np.nanmax(data)
+        pad = 0.1 * max(hi - lo, 0.02)
+        ax.set_ylim(min(lo - pad, 1.0 - pad), hi + pad)
+        ax.axhspan(-1.0, 1.0, color="0.85", zorder=0, label="|u| <= 1: the teeth apart")
+        for a, b in resp.get("band_hz_by_kind", {}).get(kind, resp["band_hz"]):
+            ax.axvspan(
+                a - step,
+                b + step,
+                color="#d62728",
+                alpha=0.15,
+                zorder=0,
+                label="a mesh of this kind separates (either sweep)",
+            )
+        for r in resp.get("resonances", ()):
+            ax.axvline(r["mesh_hz"], color="0.5", ls=":", lw=0.7, zorder=0)
+        ax.set_ylabel(f"{kind} mesh deflection\n(half backlashes)")
+        ax.grid(alpha=0.3)
+    room, last = 0.025 * (f[-1] - f[0]), -np.inf
+    for r in resp.get("resonances", ()):
+        if r["mesh_hz"] - last < room:
+            continue
+        last = r["mesh_hz"]
+        axes[0].annotate(
+            f"{r['natural_hz']:.0f}/{r['harmonic']}",
+            (r["mesh_hz"], 1.0),
+            xycoords=("data", "axes fraction"),
+            rotation=90,
+            fontsize=7,
+            va="bottom",
+            ha="center",
+            color="0.3",
+        )
+    axes[-1].set_xlabel("mesh frequency (Hz)")
+    runs = resp["runs"]
+    legend_below(
+        fig,
+        axes,
+        f"{resp['model']}: sun force {resp['sun_force_N']:.4g} N; each point "
+        f"{runs['transient']} + {runs['periods']} mesh periods from the previous point's end "
+        "(the first from the loaded equilibrium); dotted: a natural frequency over a "
+        "harmonic of the stiffness variation (Hz/l, every mesh in contact)",
+    )
     return fig

@@ -11,7 +11,7 @@ import re
 
 import pytest
 from gearsym.cli import _notes, main
-from gearsym.cli._common import system_of
+from gearsym.cli._system import system_of
 from gearsym.derive import load_target
 from gearsym.derive.mesh.force_sign import polynomial_sign
 from gearsym.resolve import module_for

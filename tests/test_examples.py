@@ -61,9 +61,16 @@ def test_planetary(tmp_path):
     assert "(no mesh frequency stated)" in stdout and "nan" not in stdout.lower()
     assert "907.4088 Hz, translational, x2" in stdout
     assert "the mesh frequency first meets mode 1 (translational)" in stdout
-    _written(out, "campbell.png", "carrier_sweep.json", "parametric.png")
+    _written(out, "campbell.png", "carrier_sweep.json", "parametric.png", "mesh_response.png")
     sweep = __import__("json").loads((out / "carrier_sweep.json").read_text(encoding="utf-8"))
     assert len(sweep["speeds_rpm"]) == 31 and sweep["mesh"]["ring_teeth"] == 100
+    # the nonlinear model: the ring meshes' teeth part near 6986 / 2 Hz, the sun meshes' not
+    # (tests/derive/test_planetary_dynamics.py checks the band against the hand assembly)
+    apart = __import__("re").search(r"teeth apart at 3500 Hz: (\{.*\})", stdout).group(1)
+    apart = __import__("ast").literal_eval(apart)
+    assert apart["rp1"] > 0 and apart["sp1"] == 0
+    resp = __import__("json").loads((out / "mesh_response.json").read_text(encoding="utf-8"))
+    assert resp["band_hz_by_kind"]["ring-planet"] and not resp["band_hz_by_kind"]["sun-planet"]
 
 
 def test_orbit_and_continuation(tmp_path):

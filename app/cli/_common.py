@@ -27,7 +27,6 @@ __all__ = [
     "parse_set",
     "refuse_conflicts",
     "require",
-    "system_of",
     "write_json",
 ]
 
@@ -177,31 +176,6 @@ def parse_range(text: str, given: str | None = None, negative: str | None = None
             f"give different ends, or {start:g}:{stop:g}:1{tail}"
         )
     return np.linspace(start, stop, num)
-
-
-def system_of(scene_arg: str, sets: dict[str, float]):
-    """The System of a scene (name or path) with ``--set`` values (``gearsym.resolve``),
-    a polynomial backlash noted once (``_notes``); a bad scene raises its own InputError."""
-    from gearsym.cli._notes import note_backlash
-    from gearsym.resolve import module_for, split_open_values
-    from gearsym.solver.system import System
-
-    module = module_for(scene_arg)
-    opened, rest = split_open_values(sets, module)
-    module = module_for(scene_arg, opened) if opened else module
-    try:
-        return note_backlash(System.load(module, **rest))
-    except KeyError as err:
-        from gearsym.derive.input.open_values import OPEN_VALUE_BASES
-        from gearsym.derive.input.reader import nearest
-
-        unknown = [k for k in rest if k not in module.PARAMETERS]
-        hint = nearest(unknown[0], OPEN_VALUE_BASES) if unknown else ""
-        more = f"{hint}; open values (derived anew): {', '.join(sorted(OPEN_VALUE_BASES))}"
-        raise Fail(f"--set: {err.args[0]}{more}") from None
-    except ValueError as err:
-        given = " ".join(f"{k}={v}" for k, v in rest.items())
-        raise Fail(f"--set {given}: {err}" if given else f"{scene_arg}: {err}") from None
 
 
 def at_most(*sizes: tuple[str, float, float], unit: str = "") -> None:

@@ -20,7 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._common import Fail, parse_set, system_of
+from ._common import Fail, parse_set
+from ._system import system_of
 
 __all__ = ["Start", "resolve_start", "start_options"]
 

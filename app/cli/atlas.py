@@ -16,9 +16,9 @@ from ._common import (
     parse_set,
     refuse_conflicts,
     require,
-    system_of,
 )
 from ._output import format_option, units_option, write_result
+from ._system import system_of
 
 __all__ = ["register"]
 

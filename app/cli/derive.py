@@ -179,7 +179,11 @@ def _cmd_derive(args) -> int:
         if rel.startswith("docs/derivation/") and Path(rel).stem not in {
             m.name for m in built.models
         }:
-            print(f"{Path(rel).stem}  (a planetary set: its audit page; modes by gearsym modes)")
+            print(
+                f"{Path(rel).stem}  (a planetary set: its audit page; modes by gearsym modes; "
+                "its nonlinear model, where its file has [planetary.dynamics], derived on "
+                "first use)"
+            )
     if where is None:
         for path in written:
             print(f"wrote {path}")

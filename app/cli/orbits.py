@@ -15,11 +15,11 @@ from ._common import (
     parse_set,
     refuse_conflicts,
     require,
-    system_of,
 )
 from ._limits import MAX_PERIOD, MAX_SEGMENTS, MAX_SETTLED, MAX_TRIES, MIN_STEP, bounded_shoot
 from ._output import branches_document, format_option, units_option, write_result
 from ._start import resolve_start, start_options
+from ._system import system_of
 
 __all__ = ["register"]
 

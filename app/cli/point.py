@@ -15,10 +15,10 @@ from ._common import (
     parse_set,
     refuse_conflicts,
     require,
-    system_of,
 )
 from ._output import format_option, units_option, write_result
 from ._start import resolve_start, start_options
+from ._system import system_of
 
 __all__ = ["register"]
 
@@ -122,6 +122,10 @@ def _cmd_simulate(args) -> int:
     units = Units.of(system, args.units)
     in_units = point_in_units(result, units)
     data["in_units"] = in_units
+    if hasattr(system.module, "MESHES"):  # a planetary set: its meshes are not coordinates
+        from gearsym.planetary import contact
+
+        data["meshes"] = contact(result.trajectory)
     if args.out:
         from gearsym.solver import plots
 
@@ -188,6 +192,12 @@ def _cmd_simulate(args) -> int:
                     else ""
                 )
             )
+    for mesh, row in data.get("meshes", {}).items():
+        print(
+            f"  mesh {mesh}: deflection [{row['min']:.4f}, {row['max']:.4f}] half backlashes; "
+            f"teeth apart {row['apart']:.2f}, loaded flank {row['loaded_flank']:.2f}, back "
+            f"flank {row['back_flank']:.2f} of {row['samples']} samples"
+        )
     if tr.left_valid_range is not None:
         t, c, v = tr.left_valid_range
         print(

@@ -14,10 +14,10 @@ from ._common import (
     parse_set,
     refuse_conflicts,
     require,
-    system_of,
 )
 from ._limits import MAX_PERIOD
 from ._output import format_option, units_option, write_result
+from ._system import system_of
 
 __all__ = ["register"]
 

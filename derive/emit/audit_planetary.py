@@ -91,10 +91,9 @@ def planetary_page(st: PlanetaryStructure, command: str, source: str) -> str:
         "enters the linear analysis of parametric instability (`gearsym modes "
         "--parametric`, with a `[planetary.variation]` table and the tooth counts; "
         "`docs/analysis.md`).\n",
+        _nonlinear(st),
         "**Not modelled yet** (issue 26): the rotating frame's terms in the parametric "
-        "analysis; backlash and tooth separation, damping, and therefore simulation, "
-        "sweeps, maps, periodic orbits and frequency responses of a planetary set: those "
-        "commands refuse it.\n",
+        "analysis and in the nonlinear model; transmission error.\n",
         "## Kinematic graph\n",
         f"Bodies ({bodies}): carrier `c`, ring `r`, sun `s` and {n} planets, {spacing}, at "
         f"ψ = {angles} round the carrier. Each planet meshes with the sun (external) and "
@@ -150,6 +149,40 @@ def planetary_page(st: PlanetaryStructure, command: str, source: str) -> str:
         lines.append(f"* `{spring}`: $\\delta = {sp.latex(delta)}$")
     lines += ["", *_phase_lines(st)]
     return "\n".join(line for line in lines if line is not None) + "\n"
+
+
+def _nonlinear(st: PlanetaryStructure) -> str:
+    """The paragraph on the nonlinear model (``[planetary.dynamics]``)."""
+    from ..equations.planetary_dynamics import scales
+
+    ps = st.planetary
+    head = (
+        "**The nonlinear model** (`derive/equations/planetary_dynamics.py`, with a "
+        "`[planetary.dynamics]` table): every mesh a dead zone `k (1 + v(t)) b g(δ / b)` "
+        "along its line of action, every spring a damper on its own equivalent mass, the "
+        "sun driven and the carrier taking the reaction; simulate, sweep, map, shoot, "
+        "continue and frequency-response take it, and `gearsym.planetary.mesh_response` "
+        "gives each mesh's deflection and where its teeth separate. "
+    )
+    if ps.dynamics is None or ps.carrier_speed_rpm or st.rigid_body_modes > 1:
+        return head + "This set's file does not give it (no table, a turning carrier or more "
+        "than one rigid-body mode): those commands refuse it in one line.\n"
+    d, s = ps.dynamics, scales(st)
+    removed = (
+        f"the rigid-body rotation removed by measuring every coordinate from the rotation "
+        f"that carries the set's momentum (`{s['pivot']}` follows from the others)"
+        if s["pivot"]
+        else "no rigid-body mode to remove"
+    )
+    return head + (
+        f"Here: sun force {d.sun_force:g} N on its base circle, half backlashes "
+        f"{d.backlash_sun * 1e6:g} µm (sun-planet) and {d.backlash_ring * 1e6:g} µm "
+        f"(ring-planet), damping ratio {d.damping_ratio:g}, {removed}. Lengths in "
+        f"{s['length_m'] * 1e6:g} µm, time `τ = ω_n t` with ω_n = {s['omega_n']:.6g} rad/s "
+        f"(`{s['reference']}`'s stiffness on the mass its deflection sees); operating point "
+        f"{d.mesh_frequency_hz:g} Hz of mesh frequency, ω = {s['omega']:.6g}, and "
+        f"f_s = {s['f_s']:.6g}.\n"
+    )
 
 
 def planetary_index(structures: list) -> str:

@@ -32,6 +32,12 @@ the carrier are equally spaced unless given.
     ring_planet = { contact_ratio = 1.8, amplitude = 0.2 }
     ring_sun_phase = 0.0                          # mesh periods, sun mesh to ring mesh
     harmonics = 3
+    [planetary.dynamics]                          # optional: gearsym.planetary.dynamics
+    sun_force_N = 2000                            # the sun's torque over its base radius
+    sun_planet_half_backlash_um = 50              # each mesh's half backlash
+    ring_planet_half_backlash_um = 50
+    mesh_frequency_hz = 1000                      # the operating point (omega)
+    damping_ratio = 0.03                          # every spring's, on its own mass
 
 The ``torsional`` model keeps each member's rotation only: translations are held and
 each planet's centre moves with the carrier (its bearing rigid), as in the purely
@@ -57,6 +63,7 @@ from .reader import InputError, Table, load_toml
 
 __all__ = [
     "DOFS",
+    "Dynamics",
     "Member",
     "PlanetarySet",
     "Variation",
@@ -101,6 +108,21 @@ class Variation:
 
 
 @dataclass(frozen=True)
+class Dynamics:
+    """What the nonlinear model adds to the linear one (``[planetary.dynamics]``): the
+    sun's load as a force on its base circle (its torque over its base radius; the
+    carrier takes the reaction), each kind of mesh's half backlash (m), the mesh
+    frequency of the operating point (Hz) and the damping ratio of every spring on its
+    own equivalent mass."""
+
+    sun_force: float
+    backlash_sun: float
+    backlash_ring: float
+    mesh_frequency_hz: float
+    damping_ratio: float
+
+
+@dataclass(frozen=True)
 class PlanetarySet:
     name: str
     description: str
@@ -117,6 +139,7 @@ class PlanetarySet:
     ring_teeth: int | None = None
     variation: Variation | None = None  # [planetary.variation] (optional)
     carrier_speed_rpm: float = 0.0  # the rotating frame's terms when not zero
+    dynamics: Dynamics | None = None  # [planetary.dynamics] (optional)
 
     @property
     def planets(self) -> int:
@@ -186,6 +209,16 @@ def _variation(t: Table, teeth: bool) -> Variation:
     harmonics = t.integer("harmonics", 3, low=1, high=32)
     t.finish()
     return Variation(waves[0], waves[1], phase, harmonics)
+
+
+def _dynamics(t: Table) -> Dynamics:
+    force = t.number("sun_force_N", low=0.0, low_open=True)
+    b_s = t.number("sun_planet_half_backlash_um", low=0.0, low_open=True) * 1e-6
+    b_r = t.number("ring_planet_half_backlash_um", low=0.0, low_open=True) * 1e-6
+    f_m = t.number("mesh_frequency_hz", low=0.0, low_open=True)
+    zeta = t.number("damping_ratio", 0.03, low=0.0, high=1.0)
+    t.finish()
+    return Dynamics(force, b_s, b_r, f_m, zeta)
 
 
 def imbalance(angles_deg) -> float:
@@ -287,6 +320,8 @@ def load_planetary(path: Path | str) -> PlanetarySet:
         )
     variation = p.table("variation", None)
     variation = None if variation is None else _variation(variation, z_s is not None)
+    dynamics = p.table("dynamics", None)
+    dynamics = None if dynamics is None else _dynamics(dynamics)
     p.finish()
     top.finish()
     if any(not math.isfinite(a) for a in angles):
@@ -307,4 +342,5 @@ def load_planetary(path: Path | str) -> PlanetarySet:
         z_r,
         variation,
         speed,
+        dynamics,
     )

@@ -259,8 +259,9 @@ def run(*args):
 
 
 def test_cli_modes_and_refusals(tmp_path):
-    """`gearsym modes` prints the typed modes; the commands a planetary set does not have
-    yet, and a file that gives both a count and angles of planets, say so in one line."""
+    """`gearsym modes` prints the typed modes; a set without the nonlinear model's table
+    (simulate needs it), and a file that gives both a count and angles of planets, say so
+    in one line."""
     done = run("modes", "lin-parker-1999-4")
     assert done.returncode == 0, done.stderr
     assert "1808.2  planet" in done.stdout
@@ -268,7 +269,7 @@ def test_cli_modes_and_refusals(tmp_path):
     done = run("simulate", "lin-parker-1999-3")
     assert done.returncode == 2
     assert len(done.stderr.strip().splitlines()) == 1
-    assert "gearsym modes" in done.stderr
+    assert "[planetary.dynamics]" in done.stderr and "gearsym modes" in done.stderr
     text = resolve_target("lin-parker-1999-3").read_text(encoding="utf-8")
     bad = tmp_path / "bad.toml"
     bad.write_text(text.replace("planets = 3", "planets = 3\nplanet_angles_deg = [0, 120, 240]"))
