@@ -44,19 +44,31 @@ def loaded_state(system):
 
 def contact(tr) -> dict:
     """Each mesh's share of the samples of trajectory ``tr`` (a planetary set's nonlinear
-    model) with its teeth apart (``|u| <= 1``), in contact on the loaded flank (``u > 1``)
-    and on the back flank (``u < -1``), and its deflection's extremes in its half
-    backlashes; read from the samples (``samples_per_period`` of the run), so a contact
-    loss shorter than a sample can be missed."""
+    model) with its teeth apart (``|u| <= 1``), in contact on the loaded flank (``u > 1``:
+    the sun's force is positive) and on the back flank (``u < -1``), its deflection's
+    extremes in its half backlashes, and its force's extremes over its mean stiffness
+    times its half backlash (``(1 + v(tau)) g(u)``, the stiffness variation included); read
+    from the samples (``samples_per_period`` of the run), so a contact loss shorter than a
+    sample can be missed."""
+    module = tr.system.module
+    omega = tr.system.p[list(module.PARAMETERS).index("omega")]
+    tau = np.asarray(tr.t, dtype=float)
     out = {}
-    for mesh, u in tr.system.module.mesh_deflections(tr.x).items():
+    for mesh, u in module.mesh_deflections(tr.x).items():
         u = np.asarray(u, dtype=float)
+        v = sum(
+            c * np.cos(h * omega * tau) + s * np.sin(h * omega * tau)
+            for h, (c, s) in enumerate(module.MESHES[mesh]["wave"], start=1)
+        )
+        force = (1.0 + v) * np.where(u > 1.0, u - 1.0, np.where(u < -1.0, u + 1.0, 0.0))
         out[mesh] = {
             "apart": float(np.mean(np.abs(u) <= 1.0)),
             "loaded_flank": float(np.mean(u > 1.0)),
             "back_flank": float(np.mean(u < -1.0)),
             "min": float(u.min()),
             "max": float(u.max()),
+            "force_min": float(force.min()),
+            "force_max": float(force.max()),
             "samples": int(u.size),
         }
     return out
@@ -80,10 +92,11 @@ def mesh_response(
     each direction and kind of mesh (sun-planet, ring-planet) at each frequency: the
     largest and smallest deflection over the set's meshes of that kind (half backlashes:
     ``|u| <= 1`` the teeth apart), the largest share of samples a mesh spends apart, and
-    the dynamic factor (the largest mesh force over the static one, ``(u_max - 1) /
-    (u_static - 1)``).  ``band_hz``: the frequencies where a mesh's teeth separate in
-    either direction (``band_hz_by_kind``: each kind's); ``natural_hz``: the linear
-    model's elastic natural frequencies (every mesh in contact, its mean stiffness);
+    the dynamic factor (the largest mesh force, its stiffness variation included, over its
+    static force at the mean stiffness, ``max (1 + v) (u - 1) / (u_static - 1)``).
+    ``band_hz``: the frequencies where a mesh's teeth separate in either direction
+    (``band_hz_by_kind``: each kind's); ``natural_hz``: the linear model's elastic natural
+    frequencies (every mesh in contact, its mean stiffness);
     ``resonances``: where a harmonic ``l`` of the stiffness variation meets one,
     ``l f_mesh = f_k``, in the range.  ``values``: the
     model's (``sun_force_N``, ``damping_ratio``, ...)."""
@@ -125,7 +138,7 @@ def mesh_response(
                 r["u_min"].append(min(c[m]["min"] for m in here))
                 r["apart"].append(max(c[m]["apart"] for m in here))
                 r["dynamic_factor"].append(
-                    max((c[m]["max"] - 1.0) / (float(static[m]) - 1.0) for m in here)
+                    max(c[m]["force_max"] / (float(static[m]) - 1.0) for m in here)
                 )
         if direction == "down":
             status = status[::-1]

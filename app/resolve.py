@@ -334,15 +334,19 @@ def needs_derivation(name: str, module: ModuleType | None = None) -> bool:
 
 def planetary_path(target) -> Path | None:
     """The file of ``target`` (a built-in name or a path) when it is a planetary set, else
-    None (a target that names no file is left to the caller's own message)."""
+    None.  Looked up without the derivation (no SymPy): a command on a tree model must
+    not pay for the question."""
+    from gearsym import scenes
     from gearsym.derive.input.planetary import is_planetary
-    from gearsym.derive.input.scene import resolve_target
 
-    try:
-        path = resolve_target(target)
-    except (OSError, ValueError):
-        return None
-    return Path(path) if is_planetary(path) else None
+    path = Path(str(target))
+    if path.suffix != ".toml" and not path.exists():
+        folder = Path(scenes.__file__).parent / "planetary"
+        names = dict.fromkeys((str(target), str(target).replace("_", "-")))
+        path = next((folder / f"{n}.toml" for n in names if (folder / f"{n}.toml").exists()), None)
+        if path is None:
+            return None
+    return path if is_planetary(path) else None
 
 
 def planetary_system(path: Path, **values) -> System:

@@ -164,8 +164,9 @@ def _cmd_simulate(args) -> int:
         line = f"  {c}: range [{num(low)}, {num(high)}]  peaks at {peaks or 'n/a'}"
         if units.physical:
             orders = ", ".join(f"{p['order']:.3g}" for p in row["peaks"])
+            what = "displacement" if hasattr(system.module, "MESHES") else "dynamic TE"
             line = (
-                f"  {c}: dynamic TE [{num(low, '.2f')}, {num(high, '.2f')}] µm  peaks at "
+                f"  {c}: {what} [{num(low, '.2f')}, {num(high, '.2f')}] µm  peaks at "
                 f"{peaks or 'n/a'} Hz (orders {orders or 'n/a'})"
             )
             if row.get("force_range"):

@@ -277,7 +277,8 @@ def _cmd_response(args) -> int:
         print(
             "note: a piecewise force law (dead zone): Hill's stability is approximate here "
             "(multipliers within about 1e-3 on orbits that cross the kinks; "
-            "docs/analysis.md); --method all adds shooting, which locates the kinks"
+            "docs/analysis.md); --method all adds shooting"
+            + (", which locates the kinks" if system.contract.switching_surfaces else "")
         )
     for c in resp.curves:
         stable = int(c.stable.sum())

@@ -154,6 +154,7 @@ def planetary_page(st: PlanetaryStructure, command: str, source: str) -> str:
 def _nonlinear(st: PlanetaryStructure) -> str:
     """The paragraph on the nonlinear model (``[planetary.dynamics]``)."""
     from ..equations.planetary_dynamics import scales
+    from ..input.reader import InputError
 
     ps = st.planetary
     head = (
@@ -164,10 +165,11 @@ def _nonlinear(st: PlanetaryStructure) -> str:
         "continue and frequency-response take it, and `gearsym.planetary.mesh_response` "
         "gives each mesh's deflection and where its teeth separate. "
     )
-    if ps.dynamics is None or ps.carrier_speed_rpm or st.rigid_body_modes > 1:
-        return head + "This set's file does not give it (no table, a turning carrier or more "
-        "than one rigid-body mode): those commands refuse it in one line.\n"
-    d, s = ps.dynamics, scales(st)
+    try:
+        s = scales(st)
+    except InputError as err:
+        return head + f"This set does not give it, and those commands refuse it: {err.message}.\n"
+    d = ps.dynamics
     removed = (
         f"the rigid-body rotation removed by measuring every coordinate from the rotation "
         f"that carries the set's momentum (`{s['pivot']}` follows from the others)"

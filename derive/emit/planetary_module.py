@@ -6,7 +6,7 @@ its coordinates: no coordinate is a mesh, so the contract names no contact edges
 meshes are stated as data instead (``MESHES``: each mesh's deflection in half backlashes as
 a row over the coordinates), with :func:`mesh_deflections` and :func:`static_state`.
 Only numbers and names this package makes reach the code; the set's name is a string
-literal, its description a comment (``escape.text``).
+literal, its description escaped text in the module's docstring (``escape.text``).
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from .printer import CodePrinter, function_body
 
 __all__ = ["FORMAT", "inputs_hash", "planetary_module"]
 
-FORMAT = 1  # of this module's text: a new one derives the cached files again
+FORMAT = 2  # of this module's text: a new one derives the cached files again
 
 
 def inputs_hash(path) -> str:
@@ -77,9 +77,9 @@ def planetary_module(dyn: PlanetaryDynamics, command: str) -> str:
         "valid_range": None,
         "functions": ("parameters", "rhs", "jacobian", "casadi_functions"),
     }
-    k_ref = dyn.structure.stiffness[dyn.structure.springs.index(next(iter(dyn.meshes)))]
+    k_ref = dyn.k_ref
     meshes = {
-        k: {key: v[key] for key in ("row", "half_backlash_m", "kind", "weight")}
+        k: {key: v[key] for key in ("row", "half_backlash_m", "kind", "weight", "wave")}
         for k, v in dyn.meshes.items()
     }
     src = [
@@ -172,10 +172,11 @@ def planetary_module(dyn: PlanetaryDynamics, command: str) -> str:
         "        v = float(v)",
         "        if not np.isfinite(v):",
         "            raise ValueError(f'{k} = {v} is not a finite number')",
-        "        name = PHYSICAL.get(k, k)",
+        "        name = PHYSICAL.get(k, k)  # in the unit the user gave it",
+        "        if (name == 'zeta' and not 0 <= v <= 1) or (name != 'zeta' and v <= 0):",
+        "            rule = 'in [0, 1]' if name == 'zeta' else '> 0'",
+        "            raise ValueError(f'{k} must be {rule}, got {v:g}')",
         "        p[PARAMETERS.index(name)] = v * scale.get(k, 1.0)",
-        "    if p[0] <= 0:",
-        "        raise ValueError(f'omega must be > 0, got {p[0]:g}')",
         "    return np.array(p, dtype=float)",
         "",
         "",

@@ -27,7 +27,7 @@ the rigid coordinate stays at rest and ``T^T M T y'' = T^T (F - R^T f)`` is exac
 one rigid-body mode (two members free with nothing holding the set) is refused.
 
 **Scales.**  Lengths in the sun-planet half backlash ``b``, time ``tau = omega_n t`` with
-``omega_n = sqrt(k_sp m_sp)`` of the first sun-planet mesh: ``y = b ybar``, and
+``omega_n = sqrt(k_sp / m_sp)`` of the first sun-planet mesh: ``y = b ybar``, and
 
     ``ybar'' = A^-1 [f e - sum_j t_j (kappa_j (1 + v_j) beta_j g(u_j) + 2 zeta mu_j u_j'...)]``,
 
@@ -74,6 +74,7 @@ class PlanetaryDynamics:
     omega_n: float  # rad/s
     stiffness: np.ndarray  # K_bar (y x y): the mean stiffness, every mesh's teeth touching
     load_direction: np.ndarray  # T^T F per unit f (static: K_bar ybar = f this + gaps)
+    k_ref: float  # N/m: the reference (first sun-planet) mesh's mean stiffness
 
 
 def _pivot(st: PlanetaryStructure):
@@ -138,13 +139,32 @@ def needs_dynamics(ps) -> None:
         )
 
 
+def _load(st: PlanetaryStructure, phi) -> np.ndarray:
+    """F per unit sun force: 1 on ``u_s``, and the carrier's reaction where the set can
+    turn as a whole (``phi``: its rigid-body rotation, or None)."""
+    F = np.zeros(len(st.physical))
+    F[st.physical.index("u_s")] = 1.0
+    if phi is not None:
+        c = st.physical.index("u_c")
+        if abs(phi[c]) < 1e-12 * np.max(np.abs(phi)):
+            raise InputError(
+                st.planetary.source,
+                "planetary.carrier",
+                "the carrier does not turn with the set's rigid-body rotation, so it "
+                "cannot take the sun's reaction; free the carrier and hold the ring",
+            )
+        F[c] = -phi[st.physical.index("u_s")] / phi[c]
+    return F
+
+
 def scales(st: PlanetaryStructure) -> dict:
     """The nonlinear model's numbers that need no SymPy (for the audit page): the pivot,
     the length and time scales, and the defaults of its parameters."""
     ps = st.planetary
     needs_dynamics(ps)
     d = ps.dynamics
-    _, pivot, _ = _pivot(st)
+    _, pivot, phi = _pivot(st)
+    _load(st, phi)  # refused where the carrier cannot take the reaction
     R, k, names = st.incidence, np.asarray(st.stiffness), st.springs
     ref = next(j for j, kind in enumerate(st.kinds) if kind == "mesh" and names[j][0] == "s")
     m_ref = 1.0 / float(np.sum(R[ref] ** 2 / np.asarray(st.mass)))
@@ -178,18 +198,7 @@ def derive_dynamics(st: PlanetaryStructure) -> PlanetaryDynamics:
     scale = scales(st)
     omega_n = scale["omega_n"]
     # the load: F_s on u_s, the carrier's reaction where the set can turn as a whole
-    F = np.zeros(len(st.physical))
-    F[st.physical.index("u_s")] = 1.0
-    if phi is not None:
-        c = st.physical.index("u_c")
-        if abs(phi[c]) < 1e-12 * np.max(np.abs(phi)):
-            raise InputError(
-                ps.source,
-                "planetary.carrier",
-                "the carrier does not turn with the set's rigid-body rotation, so it "
-                "cannot take the sun's reaction; free the carrier and hold the ring",
-            )
-        F[c] = -phi[st.physical.index("u_s")] / phi[c]
+    F = _load(st, phi)
     A = T.T @ M @ T / m_ref
     Ainv = np.linalg.inv(A)
     e = Ainv @ (T.T @ F)  # per unit f
@@ -241,6 +250,8 @@ def derive_dynamics(st: PlanetaryStructure) -> PlanetaryDynamics:
             "half_backlash_m": float(beta[j] * b),
             # kappa beta^2: its spring is weight row^T row, its closed gap weight row
             "weight": float(kappa[j] * beta[j] ** 2),
+            # v(tau) = sum_l c_l cos(l omega tau) + s_l sin(l omega tau): its variation
+            "wave": tuple(wave.get(j, ())),
             "kind": "sun-planet" if names[j].startswith("s") else "ring-planet",
         }
         for j in meshes
@@ -263,4 +274,5 @@ def derive_dynamics(st: PlanetaryStructure) -> PlanetaryDynamics:
         omega_n=omega_n,
         stiffness=K_bar,
         load_direction=T.T @ F,
+        k_ref=float(k_ref),
     )

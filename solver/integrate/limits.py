@@ -65,7 +65,14 @@ def samples_for(periods: int, wanted: int = 64) -> int:
 def default_initial_state(system: System) -> np.ndarray:
     """Each coordinate pressed into contact by its static load (past the contact edge on
     the load's side by the load, ``u = 1 + f`` for a forward load), at rest: close to the
-    loaded equilibrium for a force law near the dead zone."""
+    loaded equilibrium for a force law near the dead zone.  A module that states its own
+    loaded equilibrium (``static_state(p)``: a planetary set's, whose meshes are not
+    coordinates) starts there."""
+    static = getattr(system.module, "static_state", None)
+    if static is not None:  # a model that states its loaded equilibrium (a planetary set's)
+        x0 = static(system.p)
+        if x0 is not None:
+            return np.asarray(x0, dtype=float)
     c = system.contract
     x0 = np.zeros(system.n)
     for coord, load in c.loads.items():

@@ -8,7 +8,9 @@ its own:
 * its equilibrium has the closed form of an equally spaced set: each planet takes a third
   of the sun's force in both its meshes (the planet's moment balance);
 * undamped and without variation it conserves the energy of its linear model over 1,000
-  periods (a conservation law);
+  periods (a conservation law; the energy is built from the derivation's own reduced mass
+  and stiffness, so this checks the emitted, compiled equations against them, and the
+  frequencies above check the matrices);
 * with its stiffness variation, the ring meshes' teeth separate where the second harmonic
   meets the 6986 Hz translational pair of the hand assembly (6986 / 2 Hz).
 """
@@ -149,6 +151,11 @@ def test_simulate_reports_each_mesh_and_refuses_what_it_cannot_model(tmp_path):
     done = run("simulate", "lin-parker-1999-3-backlash", "--set", "sun_torque_Nm=3")
     assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1
     assert "sun_force_N" in done.stderr
+    # a value out of range is refused in the unit and under the name it was given
+    for given, rule in (("mesh_frequency_hz=-5", "> 0"), ("damping_ratio=5", "in [0, 1]")):
+        done = run("simulate", "lin-parker-1999-3-backlash", "--set", given)
+        assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1
+        assert given.split("=")[0] in done.stderr and rule in done.stderr, done.stderr
     # two members free to turn: two rigid-body modes, refused in one line
     text = resolve_target("lin-parker-1999-3-backlash").read_text(encoding="utf-8")
     free = tmp_path / "free.toml"
