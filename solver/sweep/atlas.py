@@ -9,7 +9,8 @@ every step, the exponent's variational system beside the state):
 * ``backward``: the same swept down in x;
 * ``random-k`` (k = 3 .. K): a state drawn uniformly from ``box`` (per state, ``(lo, hi)``;
   default: coordinates from one half backlash beyond the lower contact edge to one beyond
-  the upper, velocities in [-1, 1]); each draw depends only on (seed, grid point, k).
+  the upper, or within one unit of a planetary set's loaded equilibrium, velocities in
+  [-1, 1]); each draw depends only on (seed, grid point, k).
 
 Without a working C compiler the runs go through SciPy's integrators instead (the same
 results to the tolerance, much slower: ``integrate/native/fallback.py``), after one warning
@@ -51,10 +52,18 @@ __all__ = ["default_box", "regime_map"]
 
 
 def default_box(system: System) -> dict[str, tuple[float, float]]:
-    """Where random initial states are drawn: see the module text."""
+    """Where random initial states are drawn: see the module text.  A model that states
+    its loaded equilibrium and has no mesh coordinates (a planetary set's body
+    coordinates) draws each coordinate within one unit of it instead."""
     c = system.contract
     box = {s: (-1.0, 1.0) for s in c.states}
+    static = getattr(system.module, "static_state", None)
+    at = static(system.p) if static is not None and not c.contact else None
     for coord in c.coordinates:
+        if at is not None:
+            mid = float(at[c.index(coord)])
+            box[coord] = (mid - 1.0, mid + 1.0)
+            continue
         lower, upper = c.contact.get(coord, (-1.0, 1.0))
         box[coord] = (lower - 1.0, upper + 1.0)
     return box

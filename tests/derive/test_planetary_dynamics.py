@@ -168,3 +168,14 @@ def test_simulate_reports_each_mesh_and_refuses_what_it_cannot_model(tmp_path):
 def test_a_set_without_the_table_is_refused_before_any_derivation():
     with pytest.raises(InputError, match=r"\[planetary.dynamics\]"):
         derive_dynamics(derive_planetary(example(3)))
+
+
+def test_a_maps_random_starts_lie_round_the_loaded_equilibrium(three):
+    from gearsym.solver.sweep.atlas import default_box
+
+    _, _, system = three
+    box = default_box(system)
+    x = system.module.static_state(system.p)
+    for k, c in enumerate(system.coordinates):
+        assert box[c] == pytest.approx((x[k] - 1.0, x[k] + 1.0))
+    assert box["du_s"] == (-1.0, 1.0)
