@@ -17,13 +17,12 @@ from pathlib import Path
 
 from .._version import __version__
 from ..equations.planetary_dynamics import PlanetaryDynamics
-from ..escape import code_names, literal, text
-from .c import c_source
-from .printer import CodePrinter, function_body
+from ..escape import literal, text
+from .functions import Emitted
 
 __all__ = ["FORMAT", "inputs_hash", "planetary_module"]
 
-FORMAT = 2  # of this module's text: a new one derives the cached files again
+FORMAT = 3  # of this module's text: a new one derives the cached files again
 
 
 def inputs_hash(path) -> str:
@@ -40,19 +39,7 @@ def _rows(matrix) -> str:
 
 def planetary_module(dyn: PlanetaryDynamics, command: str) -> str:
     """Source text of the generated module of ``dyn``."""
-    names = code_names((*dyn.state_symbols, *dyn.parameter_symbols))
-    npp, cap = CodePrinter("np", names), CodePrinter("ca", names)
-    n, n_p = len(dyn.states), len(dyn.parameters)
-    rhs_lines, rhs_out = function_body(dyn, list(dyn.rhs), npp)
-    jac_lines, jac_out = function_body(dyn, list(dyn.jacobian), npp)
-    ca_lines, ca_out = function_body(dyn, list(dyn.rhs), cap)
-    jac_rows = ",\n        ".join(
-        "(" + ", ".join(jac_out[i * n : (i + 1) * n]) + ",)" for i in range(n)
-    )
-    c_plain, c_var = c_source(dyn), c_source(dyn, variational=True)
-    for c_text in (c_plain, c_var):
-        if '"""' in c_text or c_text.rstrip("\n").endswith("\\"):
-            raise ValueError("the C source cannot be held in a raw triple-quoted string")
+    emitted = Emitted(dyn)
     coords = dyn.coordinates
     m = len(coords)
     ps = dyn.structure.planetary
@@ -122,37 +109,10 @@ def planetary_module(dyn: PlanetaryDynamics, command: str) -> str:
         *(f"    {k!r}: {v!r}," for k, v in contract.items()),
         "}",
         "",
-        'C_SOURCE = r"""',
-        c_plain.rstrip("\n"),
-        '"""',
-        "",
-        'C_SOURCE_VARIATIONAL = r"""',
-        c_var.rstrip("\n"),
-        '"""',
-        "",
-        "",
-        "def rhs(tau, x, p):",
-        '    """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); result (n,) or (n, N)."""',
-        *rhs_lines,
-        "    return np.array(np.broadcast_arrays(",
-        *(f"        {o}," for o in rhs_out),
-        "    ))",
-        "",
-        "",
-        "def jacobian(tau, x, p):",
-        '    """d rhs / d X, shape (n, n) or (n, n, N)."""',
-        *jac_lines,
-        "    return np.array(_broadcast(",
-        f"        {jac_rows},",
-        "    ))",
-        "",
-        "",
-        "def _broadcast(*rows):",
-        "    flat = np.broadcast_arrays(*(e for row in rows for e in row))",
-        "    n = len(rows)",
-        "    return [flat[i * n:(i + 1) * n] for i in range(n)]",
-        "",
-        "",
+        *emitted.c_lines(),
+        *emitted.rhs_lines(),
+        *emitted.jacobian_lines(),
+        *emitted.broadcast_lines(),
         "PHYSICAL = {'mesh_frequency_hz': 'omega', 'sun_force_N': 'f_s',",
         "            'damping_ratio': 'zeta'}",
         "",
@@ -207,21 +167,6 @@ def planetary_module(dyn: PlanetaryDynamics, command: str) -> str:
         "    return None",
         "",
         "",
-        "def casadi_functions():",
-        '    """CasADi SX functions ``rhs(tau, x, p)`` and ``jacobian(tau, x, p)`` (AD)."""',
-        "    import casadi as ca",
-        "",
-        "    tau = ca.SX.sym('tau')",
-        f"    x = ca.SX.sym('x', {n})",
-        f"    p = ca.SX.sym('p', {n_p})",
-        *ca_lines,
-        "    xdot = ca.vertcat(",
-        *(f"        {o}," for o in ca_out),
-        "    )",
-        "    f = ca.Function('rhs', [tau, x, p], [xdot], ['tau', 'x', 'p'], ['xdot'])",
-        "    j = ca.Function('jacobian', [tau, x, p], [ca.jacobian(xdot, x)],",
-        "                    ['tau', 'x', 'p'], ['jac'])",
-        "    return f, j",
-        "",
+        *emitted.casadi_lines(),
     ]
     return "\n".join(src)
