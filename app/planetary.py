@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 
-from .planetary_dynamics import contact, dynamics, loaded_state, mesh_response
+from .planetary_dynamics import contact, dynamics, loaded_state, mesh_response, shaft_torques
 
 __all__ = [
     "carrier_sweep",
@@ -31,6 +31,7 @@ __all__ = [
     "load",
     "modes",
     "parametric_instabilities",
+    "shaft_torques",
 ]
 
 

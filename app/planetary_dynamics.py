@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-__all__ = ["contact", "dynamics", "loaded_state", "mesh_response"]
+__all__ = ["contact", "dynamics", "loaded_state", "mesh_response", "shaft_torques"]
 
 
 def dynamics(target, **values):
@@ -21,14 +21,20 @@ def dynamics(target, **values):
     ``mesh_frequency_hz``, ``sun_force_N``, ``damping_ratio``), derived once into the
     model cache; every analysis of a System takes it (``simulate``, ``sweep``, ``shoot``),
     and so does every command (``gearsym simulate SET``).  Raises ``InputError`` (one
-    line) where the set's file cannot give one."""
+    line) where the set's file cannot give one.  A gear train with closed loops (a
+    ``[train]`` file: ``derive.equations.train``) is taken too, its values ``omega``, ``f``,
+    ``zeta`` or ``mesh_frequency_hz``, ``load_factor``, ``damping_ratio``."""
     from gearsym.derive.input.planetary import is_planetary
     from gearsym.derive.input.scene import resolve_target
+    from gearsym.derive.input.train import is_train
     from gearsym.resolve import planetary_system
 
     path = resolve_target(target)
-    if not is_planetary(path):
-        raise ValueError(f"{target}: not a planetary set (a file with a [planetary] table)")
+    if not (is_planetary(path) or is_train(path)):
+        raise ValueError(
+            f"{target}: not a planetary set or a gear train with closed loops (a file with "
+            "a [planetary] or [train] table)"
+        )
     return planetary_system(path, **values)
 
 
@@ -44,8 +50,9 @@ def loaded_state(system):
 
 def contact(tr) -> dict:
     """Each mesh's share of the samples of trajectory ``tr`` (a planetary set's nonlinear
-    model) with its teeth apart (``|u| <= 1``), in contact on the loaded flank (``u > 1``:
-    the sun's force is positive) and on the back flank (``u < -1``), its deflection's
+    model, or a gear train's) with its teeth apart (``|u| <= 1``), in contact on the flank
+    ``u > 1`` (``loaded_flank``: of a planetary set, where the sun's force is positive) and on
+    the flank ``u < -1`` (``back_flank``), its deflection's
     extremes in its half backlashes, and its force's extremes over its mean stiffness
     times its half backlash (``(1 + v(tau)) g(u)``, the stiffness variation included); read
     from the samples (``samples_per_period`` of the run), so a contact loss shorter than a
@@ -58,7 +65,7 @@ def contact(tr) -> dict:
         u = np.asarray(u, dtype=float)
         v = sum(
             c * np.cos(h * omega * tau) + s * np.sin(h * omega * tau)
-            for h, (c, s) in enumerate(module.MESHES[mesh]["wave"], start=1)
+            for h, c, s in module.MESHES[mesh]["wave"]
         )
         force = (1.0 + v) * np.where(u > 1.0, u - 1.0, np.where(u < -1.0, u + 1.0, 0.0))
         out[mesh] = {
@@ -70,6 +77,29 @@ def contact(tr) -> dict:
             "force_min": float(force.min()),
             "force_max": float(force.max()),
             "samples": int(u.size),
+        }
+    return out
+
+
+def shaft_torques(tr) -> dict:
+    """Each shaft's torque over trajectory ``tr`` of a gear train's nonlinear model (N m):
+    ``k (theta_a - theta_b - f Delta)``, ``a`` and ``b`` its bodies in the file's order and
+    ``Delta`` its assembly twist, so a shaft of a loaded loop carries its share of the
+    locked-in torque; its mean, least and largest over the samples.  Empty for a model
+    without shafts (a planetary set's)."""
+    module = tr.system.module
+    f = tr.system.p[1]  # the load factor
+    x = np.asarray(tr.x, dtype=float)[: len(module.COORDINATES)]
+    out = {}
+    for shaft, v in getattr(module, "SHAFTS", {}).items():
+        torque = v["stiffness_Nm_per_rad"] * (
+            np.tensordot(np.asarray(v["row"]), x, axes=1) - f * v["assembly_twist_rad"]
+        )
+        out[shaft] = {
+            "mean_Nm": float(torque.mean()),
+            "min_Nm": float(torque.min()),
+            "max_Nm": float(torque.max()),
+            "bodies": list(v["bodies"]),
         }
     return out
 

@@ -333,38 +333,53 @@ def needs_derivation(name: str, module: ModuleType | None = None) -> bool:
 
 
 def planetary_path(target) -> Path | None:
-    """The file of ``target`` (a built-in name or a path) when it is a planetary set, else
-    None.  Looked up without the derivation (no SymPy): a command on a tree model must
-    not pay for the question."""
+    """The file of ``target`` (a built-in name or a path) when it is a model in body
+    coordinates (a planetary set, ``[planetary]``, or a gear train with closed loops,
+    ``[train]``), else None.  Looked up without the derivation (no SymPy): a command on a
+    tree model must not pay for the question."""
     from gearsym import scenes
     from gearsym.derive.input.planetary import is_planetary
+    from gearsym.derive.input.train import is_train
 
     path = Path(str(target))
     if path.suffix != ".toml" and not path.exists():
-        folder = Path(scenes.__file__).parent / "planetary"
+        root = Path(scenes.__file__).parent
         names = dict.fromkeys((str(target), str(target).replace("_", "-")))
-        path = next((folder / f"{n}.toml" for n in names if (folder / f"{n}.toml").exists()), None)
+        found = (root / folder / f"{n}.toml" for folder in ("planetary", "trains") for n in names)
+        path = next((p for p in found if p.exists()), None)
         if path is None:
             return None
-    return path if is_planetary(path) else None
+    return path if is_planetary(path) or is_train(path) else None
 
 
 def planetary_system(path: Path, **values) -> System:
-    """The nonlinear model of the planetary set at ``path`` (``gearsym.planetary.dynamics``),
-    derived once into the model cache under the hash of its file, this package's version
-    and the module's format; a set without a ``[planetary.dynamics]`` table is refused in
-    one line before any derivation."""
+    """The nonlinear model of the planetary set or gear train at ``path``
+    (``gearsym.planetary.dynamics``), derived once into the model cache under the hash of
+    its file, this package's version and the module's format; a file without its dynamics
+    table (``[planetary.dynamics]``, ``[train.dynamics]``) is refused in one line before any
+    derivation."""
     from gearsym.derive.emit.planetary_module import inputs_hash, planetary_module
-    from gearsym.derive.equations.planetary import derive_planetary
-    from gearsym.derive.equations.planetary_dynamics import derive_dynamics, needs_dynamics
-    from gearsym.derive.input.planetary import load_planetary
+    from gearsym.derive.input.train import is_train
 
-    ps = load_planetary(path)
-    needs_dynamics(ps)
-    where = cached_module(f"{ps.name}_dynamics", inputs_hash(path))
+    if is_train(path):
+        from gearsym.derive.equations.train import derive_train, derive_train_dynamics
+        from gearsym.derive.input.train import load_train
+
+        train = load_train(path)
+        name, derive = train.name, lambda: derive_train_dynamics(derive_train(train))
+        command = f"gearsym.train.dynamics({name!r})"
+    else:
+        from gearsym.derive.equations.planetary import derive_planetary
+        from gearsym.derive.equations.planetary_dynamics import derive_dynamics, needs_dynamics
+        from gearsym.derive.input.planetary import load_planetary
+
+        ps = load_planetary(path)
+        needs_dynamics(ps)
+        name, derive = ps.name, lambda: derive_dynamics(derive_planetary(ps))
+        command = f"gearsym.planetary.dynamics({name!r})"
+    where = cached_module(f"{name}_dynamics", inputs_hash(path))
     module = load_cached(where)
     if module is None:
-        dyn = derive_dynamics(derive_planetary(ps))
-        store_cached(where, planetary_module(dyn, f"gearsym.planetary.dynamics({ps.name!r})"))
+        store_cached(where, planetary_module(derive(), command))
         module = load_cached(where)
     return System.load(module, **values)

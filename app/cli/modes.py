@@ -69,6 +69,7 @@ def _speeds(text: str | None, scene_rpm: float) -> tuple[float, float]:
 def _cmd_modes(args) -> int:
     from gearsym.derive.input.planetary import is_planetary
     from gearsym.derive.input.scene import resolve_target
+    from gearsym.derive.input.train import is_train
     from gearsym.resolve import module_for
     from gearsym.solver.analysis.modes import modes
 
@@ -82,7 +83,12 @@ def _cmd_modes(args) -> int:
         )
     if args.plot:
         figure_file(args.plot, "--plot")
-    module = module_for(args.target)
+    if is_train(path):  # a train with closed loops: its model in body coordinates
+        from gearsym.resolve import planetary_system
+
+        module = planetary_system(path).module
+    else:
+        module = module_for(args.target)
     result = modes(module)
     scene_rpm = 60.0 * result.mesh_frequency_hz / result.reference_teeth
     speeds = _speeds(args.speeds, scene_rpm)

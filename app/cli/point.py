@@ -126,6 +126,10 @@ def _cmd_simulate(args) -> int:
         from gearsym.planetary import contact
 
         data["meshes"] = contact(result.trajectory)
+        if hasattr(system.module, "SHAFTS"):  # a gear train's: their locked-in torque
+            from gearsym.planetary import shaft_torques
+
+            data["shafts"] = shaft_torques(result.trajectory)
     if args.out:
         from gearsym.solver import plots
 
@@ -196,8 +200,14 @@ def _cmd_simulate(args) -> int:
     for mesh, row in data.get("meshes", {}).items():
         print(
             f"  mesh {mesh}: deflection [{row['min']:.4f}, {row['max']:.4f}] half backlashes; "
-            f"teeth apart {row['apart']:.2f}, loaded flank {row['loaded_flank']:.2f}, back "
-            f"flank {row['back_flank']:.2f} of {row['samples']} samples"
+            f"teeth apart {row['apart']:.2f}, on the flank u > 1 {row['loaded_flank']:.2f}, "
+            f"u < -1 {row['back_flank']:.2f} of {row['samples']} samples"
+        )
+    for shaft, row in data.get("shafts", {}).items():
+        a, b = row["bodies"]
+        print(
+            f"  shaft {shaft} ({a} to {b}): torque mean {row['mean_Nm']:.6g} N m, range "
+            f"[{row['min_Nm']:.6g}, {row['max_Nm']:.6g}]"
         )
     if tr.left_valid_range is not None:
         t, c, v = tr.left_valid_range

@@ -18,20 +18,11 @@ carrier takes the reaction that leaves that rotation unforced, ``phi_0^T F = 0``
 steady operation of a set whose output is the carrier.  A set that no member's support
 leaves free to turn carries the load in its supports.
 
-**The rigid-body rotation** is removed, not integrated: its coordinate would drift with
-any round-off in its speed and give every periodic orbit a multiplier 1.  ``q`` is measured
-from the rigid rotation that carries the set's momentum, ``phi_0^T M q = 0``, which fixes
-the coordinate with the largest ``|M_ii phi_0,i|`` (the pivot) by the others: ``q = T y``,
-``y`` every other coordinate.  Because ``phi_0^T M T = 0``, ``R phi_0 = 0`` and ``phi_0^T F = 0``,
-the rigid coordinate stays at rest and ``T^T M T y'' = T^T (F - R^T f)`` is exact.  More than
-one rigid-body mode (two members free with nothing holding the set) is refused.
-
-**Scales.**  Lengths in the sun-planet half backlash ``b``, time ``tau = omega_n t`` with
-``omega_n = sqrt(k_sp / m_sp)`` of the first sun-planet mesh: ``y = b ybar``, and
-
-    ``ybar'' = A^-1 [f e - sum_j t_j (kappa_j (1 + v_j) beta_j g(u_j) + 2 zeta mu_j u_j'...)]``,
-
-written out in :func:`derive_dynamics`.  Forcing frequency ``omega``: the mesh frequency
+**The rigid-body rotation** is removed and the equations scaled as ``body_dynamics.py``
+states (one pivot coordinate follows from the others; more than one rigid-body mode, two
+members free with nothing holding the set, is refused): lengths in the sun-planet half
+backlash ``b``, time ``tau = omega_n t`` with ``omega_n = sqrt(k_sp / m_sp)`` of the first
+sun-planet mesh, forcing frequency ``omega``: the mesh frequency
 over ``omega_n``; ``f = F_s / (k_sp b)``.  The stiffness variation enters as
 ``v_j = sum_l a_l cos(l (omega tau - 2 pi gamma_j)) + b_l sin(l (omega tau - 2 pi gamma_j))``.
 No transmission error.  The carrier's rotating frame is not modelled here (a turning
@@ -41,48 +32,22 @@ carrier's set is refused).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
-import sympy as sp
 
 from ..input.reader import InputError
+from .body_dynamics import Bodies, BodyDynamics, build, reduction
 from .planetary import PlanetaryStructure, planetary_meshes
 
 __all__ = ["PlanetaryDynamics", "derive_dynamics", "needs_dynamics", "scales"]
 
 
-@dataclass(frozen=True)
-class PlanetaryDynamics:
-    """The nonlinear model of a planetary set in the emitters' terms (``states``,
-    ``state_symbols``, ``parameter_symbols``, ``rhs``, ``jacobian`` flat, ``parameters``),
-    with what the generated module states about it."""
-
-    structure: PlanetaryStructure
-    name: str
-    coordinates: tuple[str, ...]  # y: every body coordinate but the pivot
-    pivot: str | None  # the coordinate fixed by the others (None: no rigid-body mode)
-    states: tuple[str, ...]
-    state_symbols: tuple[sp.Symbol, ...]
-    parameter_symbols: tuple[sp.Symbol, ...]
-    parameters: tuple[tuple[str, float], ...]  # (name, default)
-    rhs: tuple[sp.Expr, ...]
-    jacobian: tuple[sp.Expr, ...]  # row-major, n x n
-    meshes: dict  # mesh -> {"row": coefficients of u_j over y, "half_backlash_m", ...}
-    transform: np.ndarray  # T (q x y): q = b T ybar
-    length_m: float  # b
-    omega_n: float  # rad/s
-    stiffness: np.ndarray  # K_bar (y x y): the mean stiffness, every mesh's teeth touching
-    load_direction: np.ndarray  # T^T F per unit f (static: K_bar ybar = f this + gaps)
-    k_ref: float  # N/m: the reference (first sun-planet) mesh's mean stiffness
+# the model's record: the same for every model in body coordinates
+PlanetaryDynamics = BodyDynamics
 
 
 def _pivot(st: PlanetaryStructure):
     """(T, pivot name or None, phi_0): the reduction of the rigid-body rotation."""
-    n = len(st.physical)
-    R = st.incidence
-    if st.rigid_body_modes == 0:
-        return np.eye(n), None, None
     if st.rigid_body_modes > 1:
         raise InputError(
             st.planetary.source,
@@ -90,20 +55,12 @@ def _pivot(st: PlanetaryStructure):
             f"{st.rigid_body_modes} rigid-body modes: the nonlinear model removes one (the "
             "set turning as a whole); hold another member (its torsional_N_per_m)",
         )
-    _, _, vt = np.linalg.svd(R)
-    phi = vt[-1]
-    m = np.asarray(st.mass)
-    p = int(np.argmax(np.abs(m * phi)))
-    keep = [i for i in range(n) if i != p]
-    T = np.zeros((n, n - 1))
-    for col, i in enumerate(keep):
-        T[i, col] = 1.0
-        T[p, col] = -m[i] * phi[i] / (m[p] * phi[p])
-    return T, st.physical[p], phi
+    return reduction(st.physical, st.mass, st.incidence, st.rigid_body_modes)
 
 
 def _variation(st: PlanetaryStructure) -> dict:
-    """mesh row index -> ((c_l, s_l), ...): v_j's coefficients of cos and sin of l omega tau."""
+    """mesh row index -> ((l, c_l, s_l), ...): v_j's coefficients of cos and sin of l omega
+    tau."""
     if st.planetary.variation is None or st.phases is None:
         return {}
     rows, phases, waves = planetary_meshes(st)
@@ -113,7 +70,7 @@ def _variation(st: PlanetaryStructure) -> dict:
         for h, (a, b) in enumerate(wave, start=1):
             phi = 2 * math.pi * h * gamma
             c, s = math.cos(phi), math.sin(phi)
-            terms.append((a * c - b * s, a * s + b * c))
+            terms.append((h, a * c - b * s, a * s + b * c))
         out[j] = tuple(terms)
     return out
 
@@ -185,94 +142,44 @@ def derive_dynamics(st: PlanetaryStructure) -> PlanetaryDynamics:
     ps = st.planetary
     needs_dynamics(ps)
     d = ps.dynamics
-    R, k, kinds, names = st.incidence, np.asarray(st.stiffness), st.kinds, st.springs
-    M = np.diag(st.mass)
-    Minv = np.diag(1.0 / np.asarray(st.mass))
-    T, pivot, phi = _pivot(st)
-    n_y = T.shape[1]
-    meshes = [j for j, kind in enumerate(kinds) if kind == "mesh"]
-    sun_meshes = [j for j in meshes if names[j].startswith("s")]
-    ref = sun_meshes[0]
-    m_j = 1.0 / np.einsum("ji,i,ji->j", R, np.diag(Minv), R)
-    k_ref, m_ref, b = k[ref], m_j[ref], d.backlash_sun
-    scale = scales(st)
-    omega_n = scale["omega_n"]
-    # the load: F_s on u_s, the carrier's reaction where the set can turn as a whole
-    F = _load(st, phi)
-    A = T.T @ M @ T / m_ref
-    Ainv = np.linalg.inv(A)
-    e = Ainv @ (T.T @ F)  # per unit f
-    rows = R @ T  # delta_j = b rows_j ybar
-    beta = np.array(
-        [
-            (d.backlash_sun if names[j].startswith("s") else d.backlash_ring) / b
-            if kinds[j] == "mesh"
-            else 1.0
-            for j in range(len(k))
-        ]
+    names, kinds = st.springs, st.kinds
+    _, _, phi = _pivot(st)
+    ref = next(j for j, kind in enumerate(kinds) if kind == "mesh" and names[j][0] == "s")
+    bodies = Bodies(
+        physical=st.physical,
+        mass=st.mass,
+        springs=names,
+        kinds=kinds,
+        incidence=st.incidence,
+        stiffness=st.stiffness,
+        rigid_body_modes=st.rigid_body_modes,
+        half_backlash_m={
+            j: d.backlash_sun if names[j].startswith("s") else d.backlash_ring
+            for j, kind in enumerate(kinds)
+            if kind == "mesh"
+        },
+        waves=_variation(st),
+        labels={
+            j: "sun-planet" if names[j].startswith("s") else "ring-planet"
+            for j, kind in enumerate(kinds)
+            if kind == "mesh"
+        },
+        # the load: F_s on u_s, the carrier's reaction where the set can turn as a whole
+        load=_load(st, phi),
+        reference=ref,
     )
-    kappa = k / k_ref
-    mu = np.sqrt(kappa * m_j / m_ref)  # c_j omega_n / k_ref over 2 zeta
-    wave = _variation(st)
-
-    tau = sp.Symbol("tau")
-    omega, f, zeta = sp.symbols("omega f_s zeta")
-    coords = tuple(c for c in st.physical if c != pivot)
-    y = tuple(sp.Symbol(c, real=True) for c in coords)
-    dy = tuple(sp.Symbol(f"d{c}", real=True) for c in coords)
-    forces = []
-    for j in range(len(k)):
-        delta = sum(float(rows[j, i]) * y[i] for i in range(n_y) if rows[j, i] != 0.0)
-        rate = sum(float(rows[j, i]) * dy[i] for i in range(n_y) if rows[j, i] != 0.0)
-        if kinds[j] == "mesh":
-            u = delta / float(beta[j])
-            g = sp.Piecewise((u - 1, u > 1), (u + 1, u < -1), (0, True))
-            var = 1 + sum(
-                c_l * sp.cos(h * omega * tau) + s_l * sp.sin(h * omega * tau)
-                for h, (c_l, s_l) in enumerate(wave.get(j, ()), start=1)
-            )
-            elastic = float(kappa[j] * beta[j]) * var * g
-        else:
-            elastic = float(kappa[j]) * delta
-        forces.append(elastic + 2 * zeta * float(mu[j]) * rate)
-    G = Ainv @ rows.T  # column j: A^-1 t_j
-    acc = []
-    for i in range(n_y):
-        terms = [float(G[i, j]) * forces[j] for j in range(len(k)) if abs(G[i, j]) > 1e-15]
-        acc.append(f * float(e[i]) - sp.Add(*terms))
-    rhs = tuple(dy) + tuple(acc)
-    states = tuple(y) + dy
-    jac = tuple(sp.diff(r, s) for r in rhs for s in states)
-    K_bar = rows.T @ np.diag(kappa) @ rows  # every mesh's teeth touching
-    mesh_info = {
-        names[j]: {
-            "row": tuple(float(v / beta[j]) for v in rows[j]),
-            "half_backlash_m": float(beta[j] * b),
-            # kappa beta^2: its spring is weight row^T row, its closed gap weight row
-            "weight": float(kappa[j] * beta[j] ** 2),
-            # v(tau) = sum_l c_l cos(l omega tau) + s_l sin(l omega tau): its variation
-            "wave": tuple(wave.get(j, ())),
-            "kind": "sun-planet" if names[j].startswith("s") else "ring-planet",
-        }
-        for j in meshes
-    }
-    defaults = (("omega", scale["omega"]), ("f_s", scale["f_s"]), ("zeta", d.damping_ratio))
-    return PlanetaryDynamics(
+    scale = scales(st)
+    return BodyDynamics(
         structure=st,
         name=ps.name,
-        coordinates=coords,
-        pivot=pivot,
-        states=coords + tuple(f"d{c}" for c in coords),
-        state_symbols=states,
-        parameter_symbols=(omega, f, zeta),
-        parameters=defaults,
-        rhs=rhs,
-        jacobian=jac,
-        meshes=mesh_info,
-        transform=T,
-        length_m=b,
-        omega_n=omega_n,
-        stiffness=K_bar,
-        load_direction=T.T @ F,
-        k_ref=float(k_ref),
+        description=ps.description,
+        source=str(ps.source),
+        title="planetary set",
+        parameters=(("omega", scale["omega"]), ("f_s", scale["f_s"]), ("zeta", d.damping_ratio)),
+        physical=(
+            ("mesh_frequency_hz", "omega", "hz", "positive", "the mesh frequency in Hz"),
+            ("sun_force_N", "f_s", "force", "positive", "the sun's force on its base circle in N"),
+            ("damping_ratio", "zeta", 1.0, "unit", "the damping ratio"),
+        ),
+        **build(bodies, ("omega", "f_s", "zeta")),
     )

@@ -129,11 +129,14 @@ def resolve_target(name: str, *, kind: str | None = None) -> Path:
         if kind in (None, "topology"):
             candidates.append(root / "topologies" / f"{spelling}.toml")
             candidates.append(root / "planetary" / f"{spelling}.toml")
+            candidates.append(root / "trains" / f"{spelling}.toml")
     for c in candidates:
         if c.exists():
             return c
     known = sorted(p.stem for p in root.glob("*.toml")) + sorted(
-        p.stem for folder in ("topologies", "planetary") for p in (root / folder).glob("*.toml")
+        p.stem
+        for folder in ("topologies", "planetary", "trains")
+        for p in (root / folder).glob("*.toml")
     )
     raise InputError(
         name,

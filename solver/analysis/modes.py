@@ -38,6 +38,7 @@ __all__ = [
 DOMINANT = 0.8  # kinetic-energy share of one group that names a mode
 _GROUPS = {
     "theta": "torsional",
+    "u": "torsional",  # u = r theta: a body's rotation in a train with closed loops
     "x": "translational",
     "y": "translational",
     "z": "axial",

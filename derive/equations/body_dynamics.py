@@ -1,0 +1,200 @@
+"""Newton's law in body coordinates with every mesh a dead zone (issue 26): what a planetary
+set's nonlinear model (``planetary_dynamics.py``) and a closed-loop train's
+(``train_dynamics.py``) share.
+
+The linear model of the bodies (``M`` diagonal over the body coordinates ``q``, each
+spring a row ``r_j`` of ``R`` with its mean stiffness ``k_j``) with each mesh's force
+``k_j (1 + v_j(t)) b_j g(delta_j / b_j)`` along its line of action, ``g`` the exact dead zone
+(``g(u) = u - 1`` beyond the gap, ``u + 1`` before it, zero inside: the teeth apart), ``b_j``
+its half backlash and ``v_j`` its stiffness variation; every other spring linear; every
+spring a damper ``c_j delta_j'`` with ``c_j = 2 zeta sqrt(k_j m_j)``, ``1 / m_j = r_j M^-1
+r_j^T`` (the mass its deflection sees), the mesh's whether or not its teeth touch (as in the
+tree models, after Kahraman and Singh, 1990).  With a load ``F`` per unit ``f``:
+
+    ``M q'' = f F - sum_j r_j^T (k_j (1 + v_j) b_j g(r_j q / b_j) + c_j r_j q')``.
+
+**The rigid-body rotation** (``R phi_0 = 0``, at most one) is removed, not integrated: its
+coordinate would drift with any round-off in its speed and give every periodic orbit a
+multiplier 1.  ``q`` is measured from the rigid rotation that carries the bodies' momentum,
+``phi_0^T M q = 0``, which fixes the coordinate with the largest ``|M_ii phi_0,i|`` (the
+pivot) by the others: ``q = T y``.  Because ``phi_0^T M T = 0``, ``R phi_0 = 0`` and ``phi_0^T F
+= 0`` (the caller's load leaves that rotation unforced), the rigid coordinate stays at rest
+and ``T^T M T y'' = T^T (f F - R^T f_springs)`` is exact.
+
+**Scales.**  Lengths in the reference mesh's half backlash ``b``, time ``tau = omega_n t``
+with ``omega_n = sqrt(k_ref / m_ref)`` of that mesh: ``y = b ybar``, ``A = T^T M T / m_ref``,
+
+    ``ybar'' = A^-1 [f e - sum_j t_j (kappa_j (1 + v_j) beta_j g(u_j) + 2 zeta mu_j u_j')]``
+
+with ``t_j = T^T r_j^T``, ``kappa_j = k_j / k_ref``, ``beta_j = b_j / b``, ``mu_j = sqrt(kappa_j
+m_j / m_ref)``, ``u_j = r_j T ybar / beta_j`` and ``e = A^-1 T^T F / (k_ref b)`` per unit ``f``
+(the caller gives ``F / (k_ref b)``).
+The variation ``v_j = sum_l c_l cos(h_l omega tau) + s_l sin(h_l omega tau)``, each term at
+its own multiple ``h_l`` of the forcing frequency ``omega``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import sympy as sp
+
+__all__ = ["BodyDynamics", "Bodies", "build", "reduction"]
+
+
+@dataclass(frozen=True)
+class Bodies:
+    """What :func:`build` needs of a model in body coordinates."""
+
+    physical: tuple[str, ...]  # q
+    mass: tuple[float, ...]  # M's diagonal
+    springs: tuple[str, ...]  # the name of each row of R
+    kinds: tuple[str, ...]  # "mesh" or any other (linear)
+    incidence: np.ndarray  # R (springs x q)
+    stiffness: tuple[float, ...]  # k_j
+    rigid_body_modes: int  # 0 or 1 (the caller refuses more)
+    half_backlash_m: dict  # mesh row index -> b_j
+    waves: dict  # mesh row index -> ((h, c, s), ...)
+    labels: dict  # mesh row index -> its kind's name in MESHES ("sun-planet", "mesh", ...)
+    load: np.ndarray  # F / (k_ref b) per unit f on each q (phi_0^T F = 0)
+    reference: int  # the mesh row whose k, m and b set the scales
+
+
+@dataclass(frozen=True)
+class BodyDynamics:
+    """A nonlinear model in body coordinates in the emitters' terms (``states``,
+    ``state_symbols``, ``parameter_symbols``, ``rhs``, ``jacobian`` flat, ``parameters``),
+    with what the generated module states about it."""
+
+    structure: object  # the linear model it was built from (planetary or train)
+    name: str
+    description: str
+    source: str  # the file it was derived from
+    title: str  # "planetary set", "gear train"
+    coordinates: tuple[str, ...]  # y: every body coordinate but the pivot
+    pivot: str | None  # the coordinate fixed by the others (None: no rigid-body mode)
+    states: tuple[str, ...]
+    state_symbols: tuple[sp.Symbol, ...]
+    parameter_symbols: tuple[sp.Symbol, ...]
+    parameters: tuple[tuple[str, float], ...]  # (name, default)
+    rhs: tuple[sp.Expr, ...]
+    jacobian: tuple[sp.Expr, ...]  # row-major, n x n
+    meshes: dict  # mesh -> {"row": coefficients of u_j over y, "half_backlash_m", ...}
+    transform: np.ndarray  # T (q x y): q = b T ybar
+    length_m: float  # b
+    omega_n: float  # rad/s
+    stiffness: np.ndarray  # K_bar (y x y): the mean stiffness, every mesh's teeth touching
+    load_direction: np.ndarray  # T^T F / (k_ref b) per unit f (static: K_bar ybar = f this + gaps)
+    k_ref: float  # N/m: the reference mesh's mean stiffness
+    # (user name, parameter, factor to it, rule "positive" | "unit" | "nonnegative", words)
+    physical: tuple = ()
+    data: dict = field(default_factory=dict)  # more data the module states (name -> value)
+
+
+def reduction(physical, mass, R, rigid: int):
+    """(T, pivot name or None, phi_0): the reduction of the one rigid-body rotation
+    (module docstring); ``rigid`` 0: none, T the identity."""
+    n = len(physical)
+    if rigid == 0:
+        return np.eye(n), None, None
+    _, _, vt = np.linalg.svd(R)
+    phi = vt[-1]
+    m = np.asarray(mass)
+    p = int(np.argmax(np.abs(m * phi)))
+    keep = [i for i in range(n) if i != p]
+    T = np.zeros((n, n - 1))
+    for col, i in enumerate(keep):
+        T[i, col] = 1.0
+        T[p, col] = -m[i] * phi[i] / (m[p] * phi[p])
+    return T, physical[p], phi
+
+
+def reference_scales(b: Bodies) -> tuple[float, float]:
+    """(k_ref, omega_n) of the reference mesh."""
+    R, k = b.incidence, np.asarray(b.stiffness)
+    m_ref = 1.0 / float(np.sum(R[b.reference] ** 2 / np.asarray(b.mass)))
+    return float(k[b.reference]), float(np.sqrt(k[b.reference] / m_ref))
+
+
+def build(b: Bodies, symbols=("omega", "f", "zeta")) -> dict:
+    """The fields of :class:`BodyDynamics` that the equations give (``coordinates``,
+    ``pivot``, ``states``, the symbols, ``rhs``, ``jacobian``, ``meshes``, ``transform``,
+    ``length_m``, ``omega_n``, ``stiffness``, ``load_direction``, ``k_ref``); ``symbols``:
+    the names of the forcing frequency, the load and the damping ratio."""
+    R, k, kinds = b.incidence, np.asarray(b.stiffness), b.kinds
+    M = np.diag(b.mass)
+    T, pivot, _ = reduction(b.physical, b.mass, R, b.rigid_body_modes)
+    n_y = T.shape[1]
+    m_j = 1.0 / np.einsum("ji,i,ji->j", R, 1.0 / np.asarray(b.mass), R)
+    ref = b.reference
+    k_ref, m_ref, length = k[ref], m_j[ref], b.half_backlash_m[ref]
+    omega_n = float(np.sqrt(k_ref / m_ref))
+    A = T.T @ M @ T / m_ref
+    Ainv = np.linalg.inv(A)
+    load = T.T @ b.load
+    e = Ainv @ load  # per unit f
+    rows = R @ T  # delta_j = b rows_j ybar
+    beta = np.array(
+        [b.half_backlash_m[j] / length if kinds[j] == "mesh" else 1.0 for j in range(len(k))]
+    )
+    kappa = k / k_ref
+    mu = np.sqrt(kappa * m_j / m_ref)  # c_j omega_n / k_ref over 2 zeta
+
+    tau = sp.Symbol("tau")
+    omega, f, zeta = sp.symbols(" ".join(symbols))
+    coords = tuple(c for c in b.physical if c != pivot)
+    y = tuple(sp.Symbol(c, real=True) for c in coords)
+    dy = tuple(sp.Symbol(f"d{c}", real=True) for c in coords)
+    forces = []
+    for j in range(len(k)):
+        delta = sum(float(rows[j, i]) * y[i] for i in range(n_y) if rows[j, i] != 0.0)
+        rate = sum(float(rows[j, i]) * dy[i] for i in range(n_y) if rows[j, i] != 0.0)
+        if kinds[j] == "mesh":
+            u = delta / float(beta[j])
+            g = sp.Piecewise((u - 1, u > 1), (u + 1, u < -1), (0, True))
+            var = 1 + sum(
+                c_l * sp.cos(h * omega * tau) + s_l * sp.sin(h * omega * tau)
+                for h, c_l, s_l in b.waves.get(j, ())
+            )
+            elastic = float(kappa[j] * beta[j]) * var * g
+        else:
+            elastic = float(kappa[j]) * delta
+        forces.append(elastic + 2 * zeta * float(mu[j]) * rate)
+    G = Ainv @ rows.T  # column j: A^-1 t_j
+    acc = []
+    for i in range(n_y):
+        terms = [float(G[i, j]) * forces[j] for j in range(len(k)) if abs(G[i, j]) > 1e-15]
+        acc.append(f * float(e[i]) - sp.Add(*terms))
+    rhs = tuple(dy) + tuple(acc)
+    states = tuple(y) + dy
+    jac = tuple(sp.diff(r, s) for r in rhs for s in states)
+    meshes = {
+        b.springs[j]: {
+            "row": tuple(float(v / beta[j]) for v in rows[j]),
+            "half_backlash_m": float(beta[j] * length),
+            # kappa beta^2: its spring is weight row^T row, its closed gap weight row
+            "weight": float(kappa[j] * beta[j] ** 2),
+            # v(tau) = sum_l c_l cos(h_l omega tau) + s_l sin(h_l omega tau): its variation
+            "wave": tuple(b.waves.get(j, ())),
+            "kind": b.labels[j],
+        }
+        for j in range(len(k))
+        if kinds[j] == "mesh"
+    }
+    return {
+        "coordinates": coords,
+        "pivot": pivot,
+        "states": coords + tuple(f"d{c}" for c in coords),
+        "state_symbols": states,
+        "parameter_symbols": (omega, f, zeta),
+        "rhs": rhs,
+        "jacobian": jac,
+        "meshes": meshes,
+        "transform": T,
+        "length_m": float(length),
+        "omega_n": omega_n,
+        "stiffness": rows.T @ np.diag(kappa) @ rows,  # every mesh's teeth touching
+        "load_direction": load,
+        "k_ref": float(k_ref),
+    }
