@@ -32,6 +32,7 @@ __all__ = [
     "project_root",
     "planetary_files",
     "shipped_planetary",
+    "shipped_trains",
     "shipped_targets",
     "write_files",
     "write_stiffness_figure",
@@ -47,6 +48,29 @@ def shipped_targets() -> list[Path]:
 def shipped_planetary() -> list[Path]:
     """Built-in planetary sets (``scenes/planetary``): an audit page each, no module."""
     return sorted((builtin_root() / "planetary").glob("*.toml"))
+
+
+def shipped_trains() -> list[Path]:
+    """Built-in gear trains with closed loops (``scenes/trains``): an audit page each, their
+    nonlinear model derived on first use into the cache."""
+    return sorted((builtin_root() / "trains").glob("*.toml"))
+
+
+def train_files(paths, derived: dict | None = None) -> dict[str, str]:
+    """``docs/derivation/<name>.md`` of each gear train in ``paths``; ``derived``, if given,
+    receives each path's linear model (the index reads them again)."""
+    from .emit.audit_train import train_page
+    from .equations.train import derive_train
+    from .input.train import load_train
+
+    files = {}
+    for path in paths:
+        st = derive_train(load_train(path))
+        if derived is not None:
+            derived[path] = st
+        page = train_page(st, f"gearsym derive {display_path(path)}", display_path(path))
+        files[f"docs/derivation/{st.train.name.replace('-', '_')}.md"] = page
+    return files
 
 
 def planetary_files(paths, derived: dict | None = None) -> dict[str, str]:
@@ -81,18 +105,24 @@ def build_files(
     give each target's variant."""
     from .input.open_values import is_open_value, with_open_values
     from .input.planetary import is_planetary
+    from .input.train import is_train
 
     models, files = [], {}
     opened = {k: v for k, v in (overrides or {}).items() if is_open_value(k)}
     rest = {k: v for k, v in (overrides or {}).items() if k not in opened}
     planetary = [p for p in paths if is_planetary(p)]
-    if planetary and overrides:
+    trains = [p for p in paths if is_train(p)]
+    if (planetary or trains) and overrides:
         raise InputError(
-            str(planetary[0]), "--set", "a planetary set takes no --set yet; edit its file"
+            str((planetary + trains)[0]),
+            "--set",
+            "a planetary set or gear train takes no --set in derive; edit its file (or give "
+            "--set to the command that runs it)",
         )
     derived: dict = {}
     files.update(planetary_files(planetary + (shipped_planetary() if index else []), derived))
-    for path in [p for p in paths if p not in planetary]:
+    files.update(train_files(trains + (shipped_trains() if index else []), derived))
+    for path in [p for p in paths if p not in planetary and p not in trains]:
         scene = with_open_values(load_target(path, rest or None), **opened)
         model = derive_model(scene)
         command = f"gearsym derive {display_path(path)}"
@@ -110,9 +140,14 @@ def build_files(
         )
     if index:
         from .emit.audit_planetary import planetary_index
+        from .emit.audit_train import train_index
 
         sets = [derived[p] for p in shipped_planetary()]
-        files["docs/derivation.md"] = index_page(models, "gearsym derive") + planetary_index(sets)
+        files["docs/derivation.md"] = (
+            index_page(models, "gearsym derive")
+            + planetary_index(sets)
+            + train_index([derived[p] for p in shipped_trains()])
+        )
         files[STIFFNESS_PAGE] = stiffness_page(
             load_topology(_reference_topology()), "gearsym derive", Path(STIFFNESS_FIGURE).name
         )

@@ -137,12 +137,12 @@ def _cmd_derive(args) -> int:
                 file=sys.stderr,
             )
             return 1
-        from gearsym.derive.build import shipped_planetary
+        from gearsym.derive.build import shipped_planetary, shipped_trains
 
         print(
             "generated/ and docs/ match a fresh regeneration of "
-            f"{len(shipped_targets())} shipped targets and {len(shipped_planetary())} "
-            "planetary sets"
+            f"{len(shipped_targets())} shipped targets, {len(shipped_planetary())} "
+            f"planetary sets and {len(shipped_trains())} gear trains with closed loops"
         )
         return 0
 
@@ -180,9 +180,9 @@ def _cmd_derive(args) -> int:
             m.name for m in built.models
         }:
             print(
-                f"{Path(rel).stem}  (a planetary set: its audit page; modes by gearsym modes; "
-                "its nonlinear model, where its file has [planetary.dynamics], derived on "
-                "first use)"
+                f"{Path(rel).stem}  (a planetary set or gear train with closed loops: its "
+                "audit page; its nonlinear model, where its file has a dynamics table, "
+                "derived on first use)"
             )
     if where is None:
         for path in written:
@@ -196,9 +196,11 @@ def _as_shipped(paths, overrides) -> bool:
     """The shipped scenes and topologies as they are: their files belong in the project
     (that is what ``derive --check`` compares).  Anything else (a user's scene, or a
     shipped one with --set) never writes into the installed package."""
-    from gearsym.derive.build import shipped_planetary, shipped_targets
+    from gearsym.derive.build import shipped_planetary, shipped_targets, shipped_trains
 
-    shipped = {Path(p).resolve() for p in [*shipped_targets(), *shipped_planetary()]}
+    shipped = {
+        Path(p).resolve() for p in [*shipped_targets(), *shipped_planetary(), *shipped_trains()]
+    }
     return not overrides and all(Path(p).resolve() in shipped for p in paths)
 
 

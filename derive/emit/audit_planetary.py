@@ -195,10 +195,10 @@ def planetary_index(structures: list) -> str:
         "\n## Planetary sets\n",
         "A planetary set closes gear loops (each planet meshes with the sun and the ring), so "
         "it is written as a `[planetary]` table and derived in each body's own coordinates "
-        "(`derive/equations/planetary.py`). So far its linear model is derived: its modes "
-        "and the parametric instabilities of its meshes' stiffness variation (`gearsym "
-        "modes`, `--parametric`); the nonlinear commands take trees of meshes only (issue "
-        "26).\n",
+        "(`derive/equations/planetary.py`): its modes and the parametric instabilities of "
+        "its meshes' stiffness variation (`gearsym modes`, `--parametric`), and, where its "
+        "file has a `[planetary.dynamics]` table, its nonlinear model with backlash in every "
+        "mesh, which every command takes.\n",
         "| set | planets | model | rigid-body modes | page |",
         "|---|---|---|---|---|",
     ]

@@ -214,3 +214,14 @@ def test_simulate_prints_each_shafts_torque_and_each_meshs_contact():
     mean = abs(data["shafts"]["pinion_shaft"]["mean_Nm"])
     assert mean == pytest.approx(closed_form_torque(), rel=0.01)  # the variation moves it
     assert all(row["apart"] == 0.0 for row in data["meshes"].values())
+
+
+def test_the_audit_page_states_the_loop_and_its_rigid_rotation():
+    from gearsym.derive.build import build_files
+
+    page = build_files([RIG]).files["docs/derivation/back_to_back_rig.md"]
+    assert "1 independent closed loop" in page
+    assert "Rigid-body modes (the null space of `R`, relative tolerance 1e-10): **1**" in page
+    # the wheels turn at r_p / r_w of the pinions' speed, the other way
+    assert f"| {-R_P / R_W:+.6g} |" in page
+    assert "`u_2/r2 − u_3/r3`" in page  # the wheel shaft's twist
