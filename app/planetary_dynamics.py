@@ -44,7 +44,11 @@ def loaded_state(system):
     where the set operates.  ``ValueError`` when no contact pattern balances the load."""
     x = system.module.static_state(system.p)
     if x is None:
-        raise ValueError(f"{system.name}: no static contact pattern carries the load")
+        raise ValueError(
+            f"{system.name}: no unique loaded equilibrium: at this load the meshes' teeth "
+            "stay apart (the bodies free inside the backlash), or no contact pattern "
+            "balances it; raise the load"
+        )
     return x
 
 

@@ -367,7 +367,7 @@ def planetary_system(path: Path, **values) -> System:
 
         train = load_train(path)
         name, derive = train.name, lambda: derive_train_dynamics(derive_train(train))
-        command = f"gearsym.train.dynamics({name!r})"
+        command = f"gearsym.planetary.dynamics({name!r})"
     else:
         from gearsym.derive.equations.planetary import derive_planetary
         from gearsym.derive.equations.planetary_dynamics import derive_dynamics, needs_dynamics

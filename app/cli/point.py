@@ -161,11 +161,19 @@ def _cmd_simulate(args) -> int:
     shares = meshing_states(tr)
     if units.physical:
         print(f"  operating point: {in_units['operating_point']}")
+    module = result.trajectory.system.module
+    bodies = (
+        dict(zip(module.STRUCTURE["physical"], module.BODIES, strict=True))
+        if hasattr(module, "BODIES")
+        else {}
+    )
     for c, k in result.classification.items():
         row = in_units["coordinates"][c]
         low, high = row["range"] or (None, None)
         peaks = ", ".join(f"{p['frequency']:.4g}" for p in row["peaks"])
-        line = f"  {c}: range [{num(low)}, {num(high)}]  peaks at {peaks or 'n/a'}"
+        body = bodies.get(c)  # a gear train's coordinate is a body's rotation
+        label = f"{c} ({body})" if body else c
+        line = f"  {label}: range [{num(low)}, {num(high)}]  peaks at {peaks or 'n/a'}"
         if units.physical:
             orders = ", ".join(f"{p['order']:.3g}" for p in row["peaks"])
             what = "displacement" if hasattr(system.module, "MESHES") else "dynamic TE"

@@ -37,10 +37,7 @@ def train_page(st: TrainStructure, command: str, source: str) -> str:
     tr = st.train
     n, links = len(tr.bodies), len(st.springs)
     loops = links - n + 1  # of a connected graph (the loader refuses unjoined groups)
-    speeds = None
-    if st.rigid is not None:
-        theta = np.array([st.rigid[i] / b.radius for i, b in enumerate(tr.bodies)])
-        speeds = theta / theta[0]
+    speeds = st.speeds
     lines = [
         f"# Derivation audit: `{markdown(_name(tr.name), code=True)}` (gear train with "
         "closed loops)\n",
@@ -55,7 +52,7 @@ def train_page(st: TrainStructure, command: str, source: str) -> str:
         "as a coordinate. Every rotation is counted in one sense: an external mesh "
         "strains `u_a + u_b`, an internal one `u_a − u_b` (b the ring), a shaft "
         "`θ_a − θ_b`.\n",
-        f"Rigid-body modes (the null space of `R`, relative tolerance 1e-10): "
+        f"Rigid-body modes (from the teeth, going round the graph): "
         f"**{st.rigid_body_modes}**. "
         + (
             "The train turns as a whole with the speeds below (each over the first body's); "
@@ -65,24 +62,27 @@ def train_page(st: TrainStructure, command: str, source: str) -> str:
             else "Going round a loop the speed ratios do not come back to 1: the loop is "
             "locked and cannot turn; only its modes are derived.\n"
         ),
-        "| body | coordinate | teeth | base radius (mm) | inertia (kg m²) | mass I/r² (kg) "
-        "| speed in the rigid rotation |",
-        "|---|---|---|---|---|---|---|",
+        "A gear's base radius as used is its teeth times the base pitch it shares with the "
+        "gears it meshes with, so that the speed ratios are the teeth's exactly.\n",
+        "| body | coordinate | teeth | base radius given (mm) | as used (mm) | inertia (kg m²) "
+        "| mass I/r² (kg) | speed in the rigid rotation |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for i, b in enumerate(tr.bodies):
-        speed = f"{speeds[i]:+.6g}" if speeds is not None else "—"
+        speed = f"{'+' if speeds[i] > 0 else ''}{speeds[i]}" if speeds is not None else "—"
         lines.append(
             f"| `{markdown(b.id, code=True)}` | `{st.physical[i]}` | {b.teeth or '—'} | "
-            f"{b.radius * 1e3:.6g} | {b.inertia:.6g} | {st.mass[i]:.6g} | {speed} |"
+            f"{b.radius * 1e3:.6g} | {st.radius[i] * 1e3:.6g} | {b.inertia:.6g} | "
+            f"{st.mass[i]:.6g} | {speed} |"
         )
-    multiples = mesh_multiples(st) if st.rigid is not None else (math.nan,) * len(tr.meshes)
+    multiples = mesh_multiples(st) if st.speeds is not None else ("—",) * len(tr.meshes)
     lines += [
         "",
         "## Links\n",
         "Each link a spring along its deflection `δ = R q`, `K = Rᵀ diag(k) R`; a mesh's "
         "force is the dead zone of its half backlash, its stiffness `k (1 + v(t))`.\n",
         "| link | kind | between | deflection | stiffness | half backlash / assembly twist "
-        "| frequency over the first mesh's | phase (mesh periods) |",
+        "| frequency over the first mesh's | phase (its mesh periods) |",
         "|---|---|---|---|---|---|---|---|",
     ]
     for j, link in enumerate((*tr.meshes, *tr.shafts)):
@@ -91,7 +91,7 @@ def train_page(st: TrainStructure, command: str, source: str) -> str:
             kind = "internal mesh" if link.internal else "external mesh"
             stiff = f"{link.stiffness:.6g} N/m"
             gap = f"{link.half_backlash * 1e6:.6g} µm"
-            extra = f"{multiples[j]:.6g} | {link.phase:.6g}"
+            extra = f"{multiples[j]} | {link.phase:.6g}"
         else:
             kind, stiff = "shaft", f"{link.stiffness:.6g} N m/rad"
             gap = f"{math.degrees(link.twist):.6g}°" if link.twist else "—"

@@ -25,7 +25,7 @@ from .functions import Emitted
 
 __all__ = ["FORMAT", "inputs_hash", "planetary_module"]
 
-FORMAT = 4  # of this module's text: a new one derives the cached files again
+FORMAT = 5  # of this module's text: a new one derives the cached files again
 
 
 def inputs_hash(path) -> str:
@@ -50,6 +50,7 @@ def planetary_module(dyn: BodyDynamics, command: str) -> str:
     physical = {name: param for name, param, _, _, _ in dyn.physical}
     rules = {name: rule for name, _, _, rule, _ in dyn.physical}
     words = ", ".join(w for *_, w in dyn.physical)
+    kind = {"planetary set": "planetary", "gear train": "train"}[dyn.title]
     contract = {
         "format": 2,
         "states": dyn.states,
@@ -102,12 +103,12 @@ def planetary_module(dyn: BodyDynamics, command: str) -> str:
         f"LENGTH_M = {dyn.length_m!r}  # every coordinate's unit: the reference half backlash",
         f"HALF_BACKLASH = {dict.fromkeys(coords, dyn.length_m)!r}  # m, each coordinate's unit",
         f"K_REF = {float(k_ref)!r}  # N/m, the reference mesh's mean stiffness",
-        f"FEATURES = {{'backlash': 'dead-zone', {dyn.title.split()[-1]!r}: True}}",
+        f"FEATURES = {{'backlash': 'dead-zone', {kind!r}: True}}",
         "SCENE_PARAMETERS = {}",
         f"PIVOT = {dyn.pivot!r}  # the coordinate the rigid-body rotation fixes (None: none)",
         "# each mesh: its deflection in its own half backlashes = row . coordinates",
         f"MESHES = {meshes!r}",
-        "# the mean stiffness with every mesh's teeth touching, and the load per unit f_s",
+        "# the mean stiffness with every mesh's teeth touching, and the load per unit load",
         f"STATIC = {{'stiffness': {_rows(dyn.stiffness)},",
         f"          'load': {tuple(map(float, dyn.load_direction))!r}}}",
         *(f"{k.upper()} = {v!r}" for k, v in dyn.data.items()),
@@ -178,10 +179,9 @@ def planetary_module(dyn: BodyDynamics, command: str) -> str:
         "    for _ in range(64):",
         "        offset = sum(side[k] * _CONTACT[k] for k in MESHES)",
         "        apart = sum((1 - abs(side[k])) * _SPRING[k] for k in MESHES)",
-        "        try:",
-        "            step = np.linalg.solve(K - apart, load + offset)",
-        "        except np.linalg.LinAlgError:  # bodies left free by the meshes apart",
+        "        if np.linalg.cond(K - apart) > 1e12:  # bodies left free by the meshes apart",
         "            return None",
+        "        step = np.linalg.solve(K - apart, load + offset)",
         "        if pattern(step) == side:",
         f"            return np.concatenate([step, np.zeros({m})])",
         "        if x is None:",

@@ -11,23 +11,28 @@ is counted in one sense:
 * shaft from ``a`` to ``b``: its twist ``theta_a - theta_b = u_a / r_a - u_b / r_b``, its
   stiffness in N m/rad.
 
-``M = diag(I_i / r_i^2)`` and ``K = R^T diag(k) R``.  **Rigid-body modes** are the null space
-of ``R`` (relative tolerance 1e-10 of its largest singular value), found from the
-kinematic graph the links draw: a train that turns has one.  A loop whose ratios do not
-close (going round it the speeds do not come back to themselves) has none and cannot
-turn: its nonlinear model is refused, its modes are those of the locked structure.  Bodies
-in two unjoined groups are refused.
+``M = diag(I_i / r_i^2)`` and ``K = R^T diag(k) R``.  **Rigid-body modes** come from the
+kinematic graph the links draw, exactly from the teeth: going out from the first body, an
+external mesh turns its second gear the other way at ``z_a / z_b`` of the first's speed,
+an internal mesh the same way, a shaft alike.  A train that turns has one rigid-body
+mode; a loop whose speeds do not come back to themselves (two pairs of unequal ratio in a
+back-to-back rig) is locked and cannot turn, and its nonlinear model is refused; bodies in
+groups no link joins are refused.  A gear's base radius is taken as its teeth times the
+base pitch it shares with the gears it meshes with (their mean ``r / z``; the file's radii
+may differ from it by rounding, by at most 1e-3, else the mesh is refused), so that
+``R phi_0 = 0`` holds to round-off whatever the radii's rounding.
 
 **The nonlinear model** (``[train.dynamics]``): ``body_dynamics.py`` with every mesh a dead
 zone, its stiffness variation ``v_j = sum_l c_l cos(l (h_j omega tau - 2 pi gamma_j)) + s_l
-sin(...)``, ``h_j`` its frequency over the first mesh's (whole, from the teeth and the
-rigid rotation; a mesh turning at a fraction of the first one's is refused, so the model's
-forcing period is the first mesh's) and ``gamma_j`` its ``phase``.  The load per unit
-``f`` (the ``load_factor``): each body's torque ``tau_i`` as the force ``tau_i / r_i`` on
-``u_i``, and each shaft's assembly twist ``Delta_j`` as ``R_j^T k_j Delta_j`` (its spring
-``k_j (delta_j - f Delta_j)``).  The twists leave the rigid rotation unforced by
+sin(...)``, ``h_j`` its frequency over the first mesh's (whole, from the teeth and the rigid
+rotation; a mesh turning at a fraction of the first one's is refused, so the model's forcing
+period is the first mesh's) and ``gamma_j`` its ``phase`` in its own mesh periods. The load
+per unit ``f`` (the ``load_factor``): each body's torque ``tau_i`` as the force ``tau_i /
+r_i`` on ``u_i``, and each shaft's assembly twist ``Delta_j`` as ``R_j^T k_j Delta_j`` (its
+spring ``k_j (delta_j - f Delta_j)``). The twists leave the rigid rotation unforced by
 themselves (``R phi_0 = 0``); the torques must too (their power ``sum tau_i theta_i'`` zero,
-no losses being modelled), else the train would speed up, and are refused.
+no losses being modelled), else the train would speed up, and are refused (what is left of
+their power by rounding, at most 1e-9 of it, is taken out along the rigid rotation).
 
 **Locked-in torque** of a loop of two pairs of equal ratio ``i`` joined by two shafts (a
 back-to-back rig), the meshes' teeth touching: going round the loop, the twists and the
@@ -43,6 +48,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from fractions import Fraction
 
 import numpy as np
 
@@ -65,6 +71,8 @@ class TrainStructure:
     stiffness: tuple[float, ...]
     rigid_body_modes: int
     rigid: np.ndarray | None  # phi_0 over q (one rigid-body mode), else None
+    radius: tuple[float, ...] = ()  # m: each body's radius as used (a gear's: its pitch's)
+    speeds: tuple[Fraction, ...] | None = None  # theta' over the first body's, from the teeth
 
     def as_structure(self, omega_n: float | None = None) -> dict:
         """The ``STRUCTURE`` mapping of a generated module (``solver.analysis.modes``)."""
@@ -78,65 +86,66 @@ class TrainStructure:
             "stiffness": self.stiffness,
             "members": self.members,
             "motions": ("rotation",) * len(self.physical),
-            "reference_teeth": self.train.bodies[self._index(first.bodies[0])].teeth,
+            "reference_teeth": self.train.bodies[self.members.index(first.bodies[0])].teeth,
             "reference_driver": first.bodies[0],
         }
         return out | ({"omega_n": omega_n} if omega_n is not None else {})
 
-    def _index(self, body: str) -> int:
-        return [b.id for b in self.train.bodies].index(body)
+
+def _groups(train: Train) -> list[list[str]]:
+    """The bodies in groups that the links (``meshes`` and ``shafts``) join."""
+    parent = {b.id: b.id for b in train.bodies}
+
+    def root(x: str) -> str:
+        while parent[x] != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+
+    for link in (*train.meshes, *train.shafts):
+        parent[root(link.bodies[0])] = root(link.bodies[1])
+    groups: dict = {}
+    for b in train.bodies:
+        groups.setdefault(root(b.id), []).append(b.id)
+    return list(groups.values())
 
 
-def derive_train(train: Train) -> TrainStructure:
-    """The linear model of ``train`` (module docstring)."""
+def _speeds(train: Train) -> tuple[Fraction, ...] | None:
+    """Each body's speed over the first body's in the rigid rotation, exact from the teeth
+    (an external mesh turns its gears the other way at the inverse ratio of their teeth,
+    an internal one the same way, a shaft its two bodies alike); None where a loop does not
+    close (the train is locked)."""
     ids = [b.id for b in train.bodies]
-    radius = {b.id: b.radius for b in train.bodies}
-    links = (*train.meshes, *train.shafts)
-    R = np.zeros((len(links), len(ids)))
-    for j, link in enumerate(links):
-        a, b = (ids.index(x) for x in link.bodies)
-        if link.kind == "mesh":
-            R[j, a], R[j, b] = 1.0, (-1.0 if link.internal else 1.0)
-        else:
-            R[j, a], R[j, b] = 1.0 / radius[link.bodies[0]], -1.0 / radius[link.bodies[1]]
-    sv = np.linalg.svd(R, compute_uv=False)
-    rank = int(np.sum(sv > 1e-10 * sv.max()))
-    rigid = len(ids) - rank
-    if rigid > 1:
-        raise InputError(
-            train.source,
-            "train",
-            f"the bodies form {rigid} groups that no mesh or shaft joins; join them (or "
-            "describe each group in its own file)",
-        )
-    phi = np.linalg.svd(R)[2][-1] if rigid else None
-    return TrainStructure(
-        train=train,
-        physical=tuple(f"u_{i + 1}" for i in range(len(ids))),
-        members=tuple(ids),
-        mass=tuple(b.inertia / b.radius**2 for b in train.bodies),
-        springs=tuple(link.id for link in links),
-        kinds=tuple(link.kind for link in links),
-        incidence=R,
-        stiffness=tuple(link.stiffness for link in links),
-        rigid_body_modes=rigid,
-        rigid=phi,
-    )
+    teeth = {b.id: b.teeth for b in train.bodies}
+    speed: dict = {ids[0]: Fraction(1)}
+    links = [
+        (m.bodies, Fraction(teeth[m.bodies[0]], teeth[m.bodies[1]]) * (1 if m.internal else -1))
+        for m in train.meshes
+    ] + [(s.bodies, Fraction(1)) for s in train.shafts]
+    changed = True
+    while changed:
+        changed = False
+        for (a, b), ratio in links:  # theta_b' = ratio theta_a'
+            if a in speed and b in speed:
+                if speed[b] != ratio * speed[a]:
+                    return None
+            elif a in speed:
+                speed[b], changed = ratio * speed[a], True
+            elif b in speed:
+                speed[a], changed = speed[b] / ratio, True
+    return tuple(speed[i] for i in ids)
 
 
-def mesh_multiples(st: TrainStructure) -> tuple[float, ...]:
-    """Each mesh's frequency over the first mesh's in the rigid rotation: ``z_a |theta_a'|``
-    of its first gear, ``theta' = phi_0 / r``; also checks that each mesh's two gears pass
-    teeth at one rate (their teeth and base radii agree)."""
-    train = st.train
-    ids = [b.id for b in train.bodies]
+def _radii(train: Train) -> tuple[float, ...]:
+    """Each body's radius as the model uses it: a gear's base radius made exactly its
+    teeth times the base pitch its meshing partners share (their mean over the gears that
+    mesh together; the file's radii may differ from it by rounding, at most 1e-3 of it),
+    so that the meshes' speed ratios are the teeth's; a body without teeth keeps its own."""
     body = {b.id: b for b in train.bodies}
-    speed = {i: abs(st.rigid[ids.index(i)]) / body[i].radius for i in ids}
-    rates = []
     for m in train.meshes:
         a, b = (body[x] for x in m.bodies)
-        ra, rb = a.teeth * speed[a.id], b.teeth * speed[b.id]
-        if abs(ra - rb) > 1e-3 * max(ra, rb):
+        pa, pb = a.radius / a.teeth, b.radius / b.teeth
+        if abs(pa - pb) > 1e-3 * max(pa, pb):
             raise InputError(
                 train.source,
                 f"train.mesh {m.id}",
@@ -144,31 +153,88 @@ def mesh_multiples(st: TrainStructure) -> tuple[float, ...]:
                 f"({a.teeth}, {b.teeth}) and base radii ({a.radius * 1e3:g}, "
                 f"{b.radius * 1e3:g} mm) disagree; a mesh's gears share a base pitch",
             )
-        rates.append(ra)
+    meshed = Train(train.name, "", "", train.bodies, train.meshes, (), {}, None)
+    pitch = {}
+    for group in _groups(meshed):
+        gears = [body[g] for g in group if body[g].teeth is not None]
+        p = sum(g.radius / g.teeth for g in gears) / len(gears) if gears else None
+        pitch.update(dict.fromkeys(group, p))
+    in_mesh = {x for m in train.meshes for x in m.bodies}
+    return tuple(pitch[b.id] * b.teeth if b.id in in_mesh else b.radius for b in train.bodies)
+
+
+def derive_train(train: Train) -> TrainStructure:
+    """The linear model of ``train`` (module docstring)."""
+    groups = _groups(train)
+    if len(groups) > 1:
+        raise InputError(
+            train.source,
+            "train",
+            f"the bodies form {len(groups)} groups that no mesh or shaft joins ("
+            + "; ".join(", ".join(g) for g in groups)
+            + "): join them, or describe each group in its own file",
+        )
+    ids = [b.id for b in train.bodies]
+    radius = _radii(train)
+    links = (*train.meshes, *train.shafts)
+    R = np.zeros((len(links), len(ids)))
+    for j, link in enumerate(links):
+        a, b = (ids.index(x) for x in link.bodies)
+        if link.kind == "mesh":
+            R[j, a], R[j, b] = 1.0, (-1.0 if link.internal else 1.0)
+        else:
+            R[j, a], R[j, b] = 1.0 / radius[a], -1.0 / radius[b]
+    speeds = _speeds(train)
+    phi = None
+    if speeds is not None:  # the rigid rotation in u = r theta
+        phi = np.array([r * float(w) for r, w in zip(radius, speeds, strict=True)])
+        phi /= np.linalg.norm(phi)
+    return TrainStructure(
+        train=train,
+        physical=tuple(f"u_{i + 1}" for i in range(len(ids))),
+        members=tuple(ids),
+        mass=tuple(b.inertia / r**2 for b, r in zip(train.bodies, radius, strict=True)),
+        springs=tuple(link.id for link in links),
+        kinds=tuple(link.kind for link in links),
+        incidence=R,
+        stiffness=tuple(link.stiffness for link in links),
+        rigid_body_modes=0 if speeds is None else 1,
+        rigid=phi,
+        radius=radius,
+        speeds=speeds,
+    )
+
+
+def mesh_multiples(st: TrainStructure) -> tuple[Fraction, ...]:
+    """Each mesh's frequency over the first mesh's in the rigid rotation, exact: ``z_a
+    |theta_a'|`` of its first gear."""
+    ids = list(st.members)
+    teeth = {b.id: b.teeth for b in st.train.bodies}
+    rates = [teeth[m.bodies[0]] * abs(st.speeds[ids.index(m.bodies[0])]) for m in st.train.meshes]
     return tuple(r / rates[0] for r in rates)
 
 
 def _loaded(st: TrainStructure) -> np.ndarray:
     """F per unit load factor (N on each u): the torques over the radii and the shafts'
-    assembly twists (module docstring); refused where the torques' power is not zero."""
+    assembly twists (module docstring); refused where the torques' power is not zero (to
+    1e-9 of their largest; what is left of it is taken out along the rigid rotation)."""
     train = st.train
-    ids = [b.id for b in train.bodies]
-    tau = np.array([train.torques.get(b.id, 0.0) / b.radius for b in train.bodies])
-    power = float(st.rigid @ tau)
-    scale = float(np.abs(st.rigid) @ np.abs(tau))
-    if scale > 0 and abs(power) > 1e-9 * scale:
-        speeds = [st.rigid[ids.index(i)] / train.bodies[ids.index(i)].radius for i in ids]
-        ratio = ", ".join(f"{i} {s / speeds[0]:+.6g}" for i, s in zip(ids, speeds, strict=True))
+    tau = np.array([train.torques.get(b.id, 0.0) for b in train.bodies])
+    power = sum(Fraction(t) * w for t, w in zip(tau, st.speeds, strict=True))
+    if abs(power) > 1e-9 * max(abs(t * float(w)) for t, w in zip(tau, st.speeds, strict=True)):
+        ratio = ", ".join(f"{b.id} {w}" for b, w in zip(train.bodies, st.speeds, strict=True))
         raise InputError(
             train.source,
             "train.torque",
-            "the torques do not balance at the train's speeds (relative speeds: "
-            f"{ratio}), so it would speed up; losses are not modelled: give torques "
-            "whose power adds up to zero",
+            f"the torques do not balance at the train's speeds (relative speeds: {ratio}), "
+            "so it would speed up; losses are not modelled: give torques whose power adds up "
+            "to zero",
         )
     k = np.asarray(st.stiffness)
     twist = np.array([0.0] * len(train.meshes) + [s.twist for s in train.shafts])
-    return tau + st.incidence.T @ (k * twist)
+    F = tau / np.asarray(st.radius) + st.incidence.T @ (k * twist)
+    m_phi = np.asarray(st.mass) * st.rigid
+    return F - (st.rigid @ F) / (st.rigid @ m_phi) * m_phi
 
 
 def derive_train_dynamics(st: TrainStructure) -> BodyDynamics:
@@ -194,18 +260,18 @@ def derive_train_dynamics(st: TrainStructure) -> BodyDynamics:
     multiples = mesh_multiples(st)
     waves = {}
     for j, (m, h) in enumerate(zip(train.meshes, multiples, strict=True)):
-        if m.variation and abs(h - round(h)) > 1e-6:
+        if m.variation and h.denominator != 1:
             raise InputError(
                 train.source,
                 f"train.mesh {m.id}",
-                f"its mesh frequency is {h:.6g} times the first mesh's, not a whole multiple; "
+                f"its mesh frequency is {h} times the first mesh's, not a whole multiple; "
                 "list first the mesh of the lowest frequency, or give this one no variation",
             )
         terms = []
         for l_, (a, b) in enumerate(m.variation, start=1):
             phi = 2 * math.pi * l_ * m.phase
             c, s = math.cos(phi), math.sin(phi)
-            terms.append((l_ * round(h), a * c - b * s, a * s + b * c))
+            terms.append((l_ * int(h), a * c - b * s, a * s + b * c))
         waves[j] = tuple(terms)
     k_ref, b_ref = train.meshes[0].stiffness, train.meshes[0].half_backlash
     meshes = range(len(train.meshes))
@@ -250,7 +316,7 @@ def derive_train_dynamics(st: TrainStructure) -> BodyDynamics:
         ),
         physical=(
             ("mesh_frequency_hz", "omega", "hz", "positive", "the first mesh's frequency in Hz"),
-            ("load_factor", "f", 1.0, "nonnegative", "the load factor, 1 the file's load"),
+            ("load_factor", "f", 1.0, "positive", "the load factor, 1 the file's load"),
             ("damping_ratio", "zeta", 1.0, "unit", "the damping ratio"),
         ),
         data={

@@ -19,7 +19,7 @@ train) is not a tree and keeps each body's rotation as a coordinate.  Its file h
     stiffness_N_per_m = 3.5e8             # mean, along the line of action
     half_backlash_um = 50
     variation = [[0.1, 0.0], [0.03, 0.0]] # optional: k(t) / k_m - 1, (cos, sin) per harmonic
-    phase = 0.0                           # optional: mesh periods after the first mesh
+    phase = 0.0                           # optional: in its own mesh periods
     [[train.shaft]]
     id = "pinion_shaft"
     bodies = ["pinion_test", "pinion_slave"]
@@ -45,6 +45,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..escape import is_target_name
 from .reader import InputError, Table, load_toml, nearest
 
 __all__ = ["Body", "Link", "Train", "TrainDynamics", "is_train", "load_train"]
@@ -138,9 +139,21 @@ def _variation(t: Table) -> tuple[tuple[float, float], ...]:
     return tuple((float(a), float(b)) for a, b in value)
 
 
+def _id(t: Table) -> str:
+    """A body's, mesh's or shaft's id: letters, digits, '-' and '_', starting with a letter
+    (it is printed, labels figures and names columns)."""
+    value = t.string("id")
+    if not is_target_name(value):
+        raise t.error(
+            "id",
+            f"{value!r} must start with a letter and use only letters, digits, '-' and '_'",
+        )
+    return value
+
+
 def _unique(tables: list[Table], seen: set) -> None:
     for t in tables:
-        name = t.string("id")
+        name = _id(t)
         if name in seen:
             raise t.error("id", f"{name!r} is used twice; give each body, mesh and shaft an id")
         seen.add(name)
@@ -161,7 +174,7 @@ def load_train(path: Path | str) -> Train:
     _unique(body_tables, seen)
     bodies = {}
     for t in body_tables:
-        bid = t.string("id")
+        bid = _id(t)
         teeth = t.integer("teeth", None, low=1) if t.has("teeth") else None
         bodies[bid] = Body(
             bid,
@@ -180,7 +193,7 @@ def load_train(path: Path | str) -> Train:
                 raise t.error("gears", f"gear {b!r} has no teeth; give its body a teeth count")
         meshes.append(
             Link(
-                t.string("id"),
+                _id(t),
                 "mesh",
                 pair,
                 t.number("stiffness_N_per_m", low=0.0, low_open=True),
@@ -197,7 +210,7 @@ def load_train(path: Path | str) -> Train:
     for t in shaft_tables:
         shafts.append(
             Link(
-                t.string("id"),
+                _id(t),
                 "shaft",
                 _pair(t, "bodies", bodies),
                 t.number("torsional_Nm_per_rad", low=0.0, low_open=True),
