@@ -361,22 +361,34 @@ def planetary_system(path: Path, **values) -> System:
     from gearsym.derive.emit.planetary_module import inputs_hash, planetary_module
     from gearsym.derive.input.train import is_train
 
+    # SymPy is imported only where the model is derived: a cached one is loaded without it
     if is_train(path):
-        from gearsym.derive.equations.train import derive_train, derive_train_dynamics
         from gearsym.derive.input.train import load_train
 
         train = load_train(path)
-        name, derive = train.name, lambda: derive_train_dynamics(derive_train(train))
-        command = f"gearsym.planetary.dynamics({name!r})"
+        name = train.name
+
+        def derive():
+            from gearsym.derive.equations.train import derive_train, derive_train_dynamics
+
+            return derive_train_dynamics(derive_train(train))
+
+        if train.dynamics is None:  # its one line before any derivation
+            derive()
     else:
-        from gearsym.derive.equations.planetary import derive_planetary
-        from gearsym.derive.equations.planetary_dynamics import derive_dynamics, needs_dynamics
-        from gearsym.derive.input.planetary import load_planetary
+        from gearsym.derive.input.planetary import load_planetary, needs_dynamics
 
         ps = load_planetary(path)
         needs_dynamics(ps)
-        name, derive = ps.name, lambda: derive_dynamics(derive_planetary(ps))
-        command = f"gearsym.planetary.dynamics({name!r})"
+        name = ps.name
+
+        def derive():
+            from gearsym.derive.equations.planetary import derive_planetary
+            from gearsym.derive.equations.planetary_dynamics import derive_dynamics
+
+            return derive_dynamics(derive_planetary(ps))
+
+    command = f"gearsym.planetary.dynamics({name!r})"
     where = cached_module(f"{name}_dynamics", inputs_hash(path))
     module = load_cached(where)
     if module is None:

@@ -17,11 +17,13 @@ from __future__ import annotations
 import hashlib
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .._version import __version__
-from ..equations.body_dynamics import BodyDynamics
 from ..escape import literal, text
-from .functions import Emitted
+
+if TYPE_CHECKING:  # SymPy only to derive: asking for a cached module's hash needs none
+    from ..equations.body_dynamics import BodyDynamics
 
 __all__ = ["FORMAT", "inputs_hash", "planetary_module"]
 
@@ -42,6 +44,8 @@ def _rows(matrix) -> str:
 
 def planetary_module(dyn: BodyDynamics, command: str) -> str:
     """Source text of the generated module of ``dyn``."""
+    from .functions import Emitted
+
     emitted = Emitted(dyn)
     coords = dyn.coordinates
     m = len(coords)

@@ -35,6 +35,7 @@ import math
 
 import numpy as np
 
+from ..input.planetary import needs_dynamics  # re-exported: the derivation's check
 from ..input.reader import InputError
 from .body_dynamics import Bodies, BodyDynamics, build, reduction
 from .planetary import PlanetaryStructure, planetary_meshes
@@ -73,27 +74,6 @@ def _variation(st: PlanetaryStructure) -> dict:
             terms.append((h, a * c - b * s, a * s + b * c))
         out[j] = tuple(terms)
     return out
-
-
-def needs_dynamics(ps) -> None:
-    """``InputError`` (one line) where the set's file cannot give the nonlinear model:
-    no ``[planetary.dynamics]`` table, or a turning carrier."""
-    if ps.dynamics is None:
-        raise InputError(
-            ps.source,
-            "planetary.dynamics",
-            "simulate, sweep, map, shoot, continue and frequency-response need the nonlinear "
-            "model, and it needs a [planetary.dynamics] table (sun_force_N, the half "
-            "backlashes, mesh_frequency_hz); add one (docs/user-guide.md, Planetary sets), or "
-            "run `gearsym modes` on the set",
-        )
-    if ps.carrier_speed_rpm:
-        raise InputError(
-            ps.source,
-            "planetary.carrier_speed_rpm",
-            "the nonlinear model is of the carrier's frame without its gyroscopic and "
-            "centripetal terms; leave the carrier speed out for it",
-        )
 
 
 def _load(st: PlanetaryStructure, phi) -> np.ndarray:

@@ -425,3 +425,15 @@ def test_a_loop_with_an_internal_mesh_torques_and_multiples_has_newtons_law(tmp_
         want = np.array([ours[phys.index(c)] for c in mod.COORDINATES])
         worst = max(worst, float(np.max(np.abs(theirs - want)) / np.max(np.abs(want))))
     assert worst < 1e-10
+
+
+def test_a_cached_trains_model_loads_without_sympy():
+    """Deriving needs SymPy; running a model already in the cache must not pay for it."""
+    planetary_system(RIG)  # derived into the cache, if it was not
+    code = (
+        "import sys; from gearsym.resolve import load; load('back-to-back-rig'); "
+        "print('sympy' in sys.modules)"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "False"
