@@ -20,7 +20,14 @@ saltation jump, but an integrator that steps over a kink loses its order.
 ``FlowMap(system, locate=True)`` (the default for piecewise models) therefore integrates
 the plain flow and the variational equations with SciPy's DOP853 through the one event
 loop (``integrate/events.py``), stopping and restarting at every crossing; the ``"ad"``
-route stays on CVODES, whose error control is all it has against the kinks.
+route stays on CVODES, whose error control is all it has against the kinks.  A model whose
+kinks are not on its coordinates (a planetary set's or a closed-loop train's meshes: the
+contract's ``switching_rows``, no surface to stop at) takes the compiled engine's DOP853
+instead over whole forcing periods, with its variational monodromy, as the orbit check
+does (``analysis/orbit_check.py``): the event loop would only have integrated it in
+Python.  Its dampers are linear, so ``trace J`` is constant and its integral is the
+duration times ``trace J`` at the start (checked at the end; NaN, no Liouville check,
+where they differ).
 
 ``StroboscopicMap(system, n)`` is the period map ``x -> phi_{nT}(x; t0)`` as an object of
 its own: fixed points are period-n orbits, its Jacobian is the monodromy matrix.
@@ -29,7 +36,7 @@ its own: fixed points are period-n orbits, its Jacobian is the monodromy matrix.
 from __future__ import annotations
 
 from collections import OrderedDict
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -41,6 +48,7 @@ from ..system import System
 __all__ = ["MONODROMY_METHODS", "FlowMap", "StroboscopicMap", "monodromy_agreement"]
 
 MONODROMY_METHODS = ("ad", "variational", "fd")
+_MOST_STEPS_A_PERIOD = 100_000  # of the compiled route (unlocated kinks); a few hundred is usual
 _CACHED_INTEGRATORS = 32  # durations kept per flow map (a continuation in omega makes many)
 
 
@@ -58,8 +66,61 @@ class FlowMap:
         if self.locate is None:
             self.locate = self.system.piecewise
 
+    def _compiled(self, x0, duration, t0, p, with_phi: bool):
+        """(end state, monodromy or None, int trace J) by the compiled engine where the
+        model's kinks are not located (module text); None where it does not apply (kinks
+        on switching surfaces, or not a whole number of forcing periods)."""
+        sys_ = self.system
+        if not sys_.piecewise or sys_.contract.switching_surfaces:
+            return None
+        if p is not None:
+            sys_ = replace(sys_, p=np.asarray(p, dtype=float))
+        periods = duration / sys_.period
+        m = int(round(periods))
+        if m < 1 or abs(periods - m) > 1e-9 * periods:
+            return None
+        from ..integrate.run import integrate
+        from ..integrate.spec import RunSpec
+
+        spec = RunSpec(
+            method="dop853",
+            rtol=self.rtol,
+            atol=self.atol,
+            time="phase",
+            t0=float(np.mod(sys_.omega * t0, 2.0 * np.pi)),
+            transient=0,
+            periods=m,
+            valid_range="ignore",
+            bound=1e6,
+            collect=("samples", "exponent", "monodromy") if with_phi else ("samples",),
+            lyapunov_periods=m if with_phi else 0,
+            # a mesh grazing its contact edge (an unlocated kink) can take millions of
+            # steps a period at these tolerances: such a flow is reported failed (its
+            # caller's corrector stops there) rather than run for minutes
+            max_steps=_MOST_STEPS_A_PERIOD * m,
+        )
+        x0 = np.asarray(x0, dtype=float)
+        res = integrate(sys_, x0, spec)
+        if res.status[0] != "ok":  # a failed integration, as CasADi's are: RuntimeError
+            why = res.status[0]
+            if why == "too many steps":
+                why += (
+                    f" (over {_MOST_STEPS_A_PERIOD:,} a period: a mesh grazing its contact "
+                    "edge, whose kink the integrator does not locate)"
+                )
+            raise RuntimeError(f"the flow stopped: {why}")
+        xf = np.asarray(res.x[0][-1], dtype=float)
+        a = float(np.trace(sys_.module.jacobian(t0, x0, sys_.p)))
+        b = float(np.trace(sys_.module.jacobian(t0 + duration, xf, sys_.p)))
+        q = a * duration if abs(a - b) <= 1e-12 * max(1.0, abs(a)) else float("nan")
+        return xf, (np.asarray(res.monodromy[0]) if with_phi else None), q
+
     def _located(self, x0, duration, t0, p, with_phi: bool):
-        """DOP853 on (x, Phi, int trace J), restarted at every switching surface."""
+        """DOP853 on (x, Phi, int trace J), restarted at every switching surface (the
+        compiled engine where the model's kinks are not located: :meth:`_compiled`)."""
+        done = self._compiled(x0, duration, t0, p, with_phi)
+        if done is not None:
+            return done
         sys_, n = self.system, self.system.n
         p = sys_.p if p is None else p
         k = n if with_phi else 0
