@@ -135,13 +135,19 @@ def mesh_response(
     ``l f_mesh = f_k``, in the range.  ``values``: the
     model's (``sun_force_N``, ``damping_ratio``, ...)."""
     from gearsym.derive.equations.planetary import derive_planetary
-    from gearsym.derive.input.planetary import load_planetary
+    from gearsym.derive.input.planetary import is_planetary, load_planetary
     from gearsym.derive.input.scene import resolve_target
     from gearsym.solver.analysis.modes import planetary_modes
 
     if not (0 < lo_hz < hi_hz and math.isfinite(hi_hz)) or int(num) < 2:
         raise ValueError(
             f"mesh frequencies {lo_hz:g} to {hi_hz:g} Hz ({num}): give 0 < LO < HI, NUM >= 2"
+        )
+    if not is_planetary(resolve_target(target)):
+        raise ValueError(
+            f"{target}: mesh_response steps a planetary set's mesh frequency (its sun and ring "
+            "meshes); for a gear train sweep mesh_frequency_hz (gearsym.sweep) and read each "
+            "run's meshes with gearsym.planetary.contact"
         )
     system = dynamics(target, **values)
     static = system.module.mesh_deflections(loaded_state(system))

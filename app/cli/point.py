@@ -134,7 +134,15 @@ def _cmd_simulate(args) -> int:
         from gearsym.solver import plots
 
         out = out_folder(args.out)
-        write_result(out, "point", result, args, initial_state=data["initial_state"])
+        write_result(
+            out,
+            "point",
+            result,
+            args,
+            initial_state=data["initial_state"],
+            meshes=data.get("meshes"),  # a planetary set's or a train's, as --json has them
+            shafts=data.get("shafts"),
+        )
         plots.save_figure(plots.point_figure(result, title=system.name), out / "point.png")
     tr = result.trajectory
     # exit status 3: the run ended invalid, divergent or failed (docs/user-guide.md)
@@ -325,7 +333,10 @@ def _cmd_sweep(args) -> int:
             shown = poincare_range(
                 system, args.units, args.param, result.values, result.poincare(c), c
             )
-            print(f"  {c} (Poincaré values, dynamic transmission error): {shown or 'none'}")
+            what = (  # a planetary set's or a train's coordinates are its bodies'
+                "displacement" if hasattr(system.module, "MESHES") else "dynamic transmission error"
+            )
+            print(f"  {c} (Poincaré values, {what}): {shown or 'none'}")
     motions = [result.motion(c) for c in system.coordinates]
     if all(m == motions[0] for m in motions):  # one verdict per attractor: said once
         print(f"  attractor: {runs_text(values, motions[0])}")

@@ -27,7 +27,7 @@ if TYPE_CHECKING:  # SymPy only to derive: asking for a cached module's hash nee
 
 __all__ = ["FORMAT", "inputs_hash", "planetary_module"]
 
-FORMAT = 5  # of this module's text: a new one derives the cached files again
+FORMAT = 6  # of this module's text: a new one derives the cached files again
 
 
 def inputs_hash(path) -> str:
@@ -137,6 +137,12 @@ def planetary_module(dyn: BodyDynamics, command: str) -> str:
         "    if unknown:",
         "        raise KeyError(f'unknown parameter(s) {unknown}; parameters: '",
         "                       f'{list(PARAMETERS)}; physical: {sorted(PHYSICAL)}')",
+        "    given = {}",
+        "    for k in values:",
+        "        name = PHYSICAL.get(k, k)",
+        "        if name in given:",
+        "            raise ValueError(f'{given[name]} and {k} set one quantity; give one of them')",
+        "        given[name] = k",
         "    p = list(DEFAULTS)",
         f"    scale = {{{scale}}}",
         "    words = {'positive': '> 0', 'unit': 'in [0, 1]', 'nonnegative': '>= 0'}",
