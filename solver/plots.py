@@ -336,10 +336,10 @@ def branch_figure(
                     label=f"period-{br.n} {'stable' if flag else 'unstable'} (continuation)",
                 )
             for b in br.bifurcations:
-                marker, colour = BIFURCATIONS[b.kind]
+                marker, colour = BIFURCATIONS[br.named(b)]
                 k = state_factors(system, units, br.parameter, [b.value], name)[0][0]
                 ax.plot(b.value, b.x0[index] * k, marker, color=colour, ms=7, mfc="none", mew=1.5)
-                ax.plot([], [], marker, color=colour, ms=7, mfc="none", mew=1.5, label=b.kind)
+                ax.plot([], [], marker, color=colour, ms=7, mfc="none", mew=1.5, label=br.named(b))
         unit = state_unit(system, units, name) or "half backlashes"
         ax.set_ylabel(f"{name} at τ = 0 mod nT\n({unit})")
         ax.grid(alpha=0.3)

@@ -377,9 +377,10 @@ def _cmd_continue(args) -> int:
             lam = b.value
             _, M, _ = smap.jacobian(b.x0, system.parameters_with(**{args.param: lam}))
             fig = plots.multipliers_figure(
-                np.linalg.eigvals(M), title=f"{b.kind} at {args.param} = {lam:.6g}"
+                np.linalg.eigvals(M), title=f"{br.named(b)} at {args.param} = {lam:.6g}"
             )
-            plots.save_figure(fig, out / f"multipliers_{k}_{b.kind}_{lam:.6g}.png")
+            kind = br.named(b).replace(" ", "-")
+            plots.save_figure(fig, out / f"multipliers_{k}_{kind}_{lam:.6g}.png")
     for br in branches:
         stable = sum(br.stable)
         print(f"period-{br.n} branch: {len(br.values)} points, {stable} stable; {br.message}")
@@ -388,7 +389,7 @@ def _cmd_continue(args) -> int:
         for b in br.bifurcations:
             at = parameter_span(system, args.units, args.param, [b.value]).partition(": ")[2]
             print(
-                f"  {b.kind:<16} {args.param} = {b.value:.8g}  multiplier "
+                f"  {br.named(b):<16} {args.param} = {b.value:.8g}  multiplier "
                 f"{b.multiplier.real:+.6f}{b.multiplier.imag:+.6f}i" + (f" ({at})" if at else "")
             )
     print(f"wrote {', '.join(p.name for p in written)} and branches.png in {out}")

@@ -191,8 +191,8 @@ def floquet_figure(branches, path: Path, title: str, caption: str) -> Path:
         for j in range(mods.shape[1]):
             ax.plot(lam, mods[:, j], "o", ms=3, mew=0, color=col, label=label)
         for b in br.bifurcations:
-            marker, mc = BIFURCATIONS.get(b.kind, ("x", "k"))
-            ax.axvline(float(b.value), color=mc, ls=":", lw=1.0, label=f"{b.kind} located")
+            marker, mc = BIFURCATIONS.get(br.named(b), ("x", "k"))
+            ax.axvline(float(b.value), color=mc, ls=":", lw=1.0, label=f"{br.named(b)} located")
     ax.axhline(1.0, color="0.4", lw=1, label="|μ| = 1 (unit circle)")
     ax.set_yscale("log")
     ax.set_xlabel("lambda")

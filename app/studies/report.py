@@ -126,7 +126,7 @@ def report(
     cont_lines = []
     for case, _, f1 in CASES:
         found = sorted(
-            {(b.kind, round(b.value, 6)) for br in branches[case] for b in br.bifurcations},
+            {(br.named(b), round(b.value, 6)) for br in branches[case] for b in br.bifurcations},
             key=lambda kv: kv[1],
         )
         covered, total, missed = stable_coverage(branches[case], poly.by_case[case])

@@ -15,7 +15,8 @@ accepted points the bifurcations are located on the arclength (Illinois false po
 
 * a **fold** where the tangent's parameter component changes sign;
 * a **period doubling** or **Neimark-Sacker** point (and a multiplier through +1 where
-  the branch does not turn: a branch point, reported as a fold) where a test function of
+  the branch does not turn: a branch point, recorded as a fold and named a branch point
+  by ``Branch.named`` in what is printed and drawn) where a test function of
   ``floquet.py`` changes sign: ``det(M - I)``, ``det(M + I)``, the product of
   ``|mu|^2 - 1`` over the complex pairs (whose number must not change).
 

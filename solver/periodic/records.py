@@ -30,7 +30,8 @@ class Bifurcation:
     Attributes
     ----------
     kind : str
-        ``"fold"`` (a multiplier through +1: the branch turns, or a branch point),
+        ``"fold"`` (a multiplier through +1: the branch turns, or a branch point, which
+        :meth:`Branch.named` tells apart),
         ``"period-doubling"`` (through -1) or ``"neimark-sacker"`` (a complex pair).
     value : float
         The parameter there (non-dimensional, as the model's parameter).
@@ -141,12 +142,21 @@ class Branch:
             f"{self.status})"
         )
 
+    def named(self, b: Bifurcation) -> str:
+        """``b``'s kind in words: a ``"fold"`` where the branch does not turn (the
+        tangent's parameter component keeps its sign across it) is a branch point, a
+        multiplier through +1 without a turn (a symmetry-breaking pitchfork, for one)."""
+        if b.kind != "fold" or not 1 <= b.index < len(self.points):
+            return b.kind
+        before, after = self.points[b.index - 1], self.points[b.index]
+        return b.kind if before.tangent_sign != after.tangent_sign else "branch point"
+
     def summary(self) -> str:
         """A few lines: the branch, its stability, each bifurcation, how it ended."""
         lines = [repr(self)[len("Branch(") : -1]]
         for b in self.bifurcations[:6]:
             lines.append(
-                f"  {b.kind} at {self.parameter} = {b.value:.8g}, multiplier "
+                f"  {self.named(b)} at {self.parameter} = {b.value:.8g}, multiplier "
                 f"{b.multiplier.real:+.6f}{b.multiplier.imag:+.6f}i"
             )
         if len(self.bifurcations) > 6:

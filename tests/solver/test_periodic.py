@@ -284,3 +284,23 @@ def test_the_engine_locates_folds_and_period_doublings_of_a_closed_form_map():
     # stability by the multiplier 2 - 3 x^2 at every point, unstable between the folds
     x = np.array([s[0] for s in branch.states])
     assert np.array_equal(branch.stable, np.abs(2 - 3 * x**2) < 1 - 1e-9)
+
+
+def test_a_multiplier_through_plus_one_without_a_turn_is_named_a_branch_point():
+    """The tangent's parameter component decides: it changes sign across a fold, keeps it
+    across a branch point (both are recorded with kind "fold")."""
+    from gearsym.solver.periodic.records import Bifurcation, Branch, BranchPoint
+
+    def point(v, sign):
+        return BranchPoint(v, np.zeros(2), None, None, None, sign)
+
+    pts = (point(0.0, 1), point(1.0, 1), point(2.0, -1), point(1.5, -1))
+    br = Branch("p", 1, pts)
+    turn = Bifurcation("fold", 2.1, np.zeros(2), 1.0, "p", index=2)
+    through = Bifurcation("fold", 0.5, np.zeros(2), 1.0, "p", index=1)
+    doubling = Bifurcation("period-doubling", 1.7, np.zeros(2), -1.0, "p", index=3)
+    assert [br.named(b) for b in (turn, through, doubling)] == [
+        "fold",
+        "branch point",
+        "period-doubling",
+    ]
