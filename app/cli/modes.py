@@ -118,9 +118,14 @@ def _cmd_modes(args) -> int:
         f"mesh frequency {result.mesh_frequency_hz:.1f} Hz at the scene's speed "
         f"({scene_rpm:.0f} rpm of gear {result.reference_driver}, the first mesh's driver)"
     )
-    print(f"  {'#':>2}  {'Hz':>10}  {'/ mesh':>7}  {'label':<13}  kinetic energy")
+    # a train's bodies only turn: where each mode strains (its meshes, its shafts) says more
+    strain = is_train(path)
+    what = "strain energy" if strain else "kinetic energy"
+    print(f"  {'#':>2}  {'Hz':>10}  {'/ mesh':>7}  {'label':<13}  {what}")
     for m in result.modes:
-        shares = ", ".join(f"{k} {v:.2f}" for k, v in m.kinetic_shares.items() if v >= 0.005)
+        energy = m.strain_shares if strain else m.kinetic_shares
+        top = sorted(energy.items(), key=lambda kv: -kv[1]) if strain else energy.items()
+        shares = ", ".join(f"{k} {v:.2f}" for k, v in top if v >= 0.005)
         print(
             f"  {m.index:2d}  {m.frequency_hz:10.1f}  {result.over_mesh(m):7.3f}  "
             f"{m.label:<13}  {shares}"

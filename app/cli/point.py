@@ -186,7 +186,7 @@ def _cmd_simulate(args) -> int:
             orders = ", ".join(f"{p['order']:.3g}" for p in row["peaks"])
             what = "displacement" if hasattr(system.module, "MESHES") else "dynamic TE"
             line = (
-                f"  {c}: {what} [{num(low, '.2f')}, {num(high, '.2f')}] µm  peaks at "
+                f"  {label}: {what} [{num(low, '.2f')}, {num(high, '.2f')}] µm  peaks at "
                 f"{peaks or 'n/a'} Hz (orders {orders or 'n/a'})"
             )
             if row.get("force_range"):
