@@ -56,7 +56,8 @@ def contact(tr) -> dict:
     """Each mesh's share of the samples of trajectory ``tr`` (a planetary set's nonlinear
     model, or a gear train's) with its teeth apart (``|u| <= 1``), in contact on the flank
     ``u > 1`` (``loaded_flank``: of a planetary set, where the sun's force is positive) and on
-    the flank ``u < -1`` (``back_flank``), its deflection's
+    the flank ``u < -1`` (``back_flank``), ``u`` its deflection with its transmission
+    error where it has one (a train's mesh), its deflection's
     extremes in its half backlashes, and its force's extremes over its mean stiffness
     times its half backlash (``(1 + v(tau)) g(u)``, the stiffness variation included); read
     from the samples (``samples_per_period`` of the run), so a contact loss shorter than a
@@ -66,7 +67,11 @@ def contact(tr) -> dict:
     tau = np.asarray(tr.t, dtype=float)
     out = {}
     for mesh, u in module.mesh_deflections(tr.x).items():
-        u = np.asarray(u, dtype=float)
+        # its transmission error (a train's mesh may have one) adds to its deflection
+        u = np.asarray(u, dtype=float) + sum(
+            c * np.cos(h * omega * tau) + s * np.sin(h * omega * tau)
+            for h, c, s in module.MESHES[mesh].get("error", ())
+        )
         v = sum(
             c * np.cos(h * omega * tau) + s * np.sin(h * omega * tau)
             for h, c, s in module.MESHES[mesh]["wave"]

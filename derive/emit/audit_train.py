@@ -80,7 +80,9 @@ def train_page(st: TrainStructure, command: str, source: str) -> str:
         "",
         "## Links\n",
         "Each link a spring along its deflection `δ = R q`, `K = Rᵀ diag(k) R`; a mesh's "
-        "force is the dead zone of its half backlash, its stiffness `k (1 + v(t))`.\n",
+        "force is the dead zone of its half backlash at `δ + e(t)`, its stiffness "
+        "`k (1 + v(t))`, `e` its transmission error (excess material, `Σ a_l cos(l ω_m t + "
+        "φ_l)` at its mesh frequency and phase).\n",
         "| link | kind | between | deflection | stiffness | half backlash / assembly twist "
         "| frequency over the first mesh's | phase (its mesh periods) |",
         "|---|---|---|---|---|---|---|---|",
@@ -91,6 +93,13 @@ def train_page(st: TrainStructure, command: str, source: str) -> str:
             kind = "internal mesh" if link.internal else "external mesh"
             stiff = f"{link.stiffness:.6g} N/m"
             gap = f"{link.half_backlash * 1e6:.6g} µm"
+            if link.error is not None and link.error.amplitudes:
+                gap += "; transmission error " + ", ".join(
+                    f"{a * 1e6:.6g} µm at {math.degrees(p):.6g}° (harmonic {h})"
+                    for h, (a, p) in enumerate(
+                        zip(link.error.amplitudes, link.error.phases, strict=True), start=1
+                    )
+                )
             extra = f"{multiples[j]} | {link.phase:.6g}"
         else:
             kind, stiff = "shaft", f"{link.stiffness:.6g} N m/rad"
@@ -140,7 +149,7 @@ def train_page(st: TrainStructure, command: str, source: str) -> str:
         )
     lines += [
         "## Not modelled\n",
-        "Transmission error; bearings and translations (the bodies only turn); the losses "
+        "Bearings and translations (the bodies only turn); the losses "
         "and the motor that supplies them; the shafts' own inertia (lump it with a body).\n",
     ]
     return "\n".join(line for line in lines if line is not None)

@@ -27,7 +27,7 @@ if TYPE_CHECKING:  # SymPy only to derive: asking for a cached module's hash nee
 
 __all__ = ["FORMAT", "inputs_hash", "planetary_module"]
 
-FORMAT = 6  # of this module's text: a new one derives the cached files again
+FORMAT = 7  # of this module's text: a new one derives the cached files again
 
 
 def inputs_hash(path) -> str:
@@ -78,7 +78,7 @@ def planetary_module(dyn: BodyDynamics, command: str) -> str:
     }
     k_ref = dyn.k_ref
     meshes = {
-        k: {key: v[key] for key in ("row", "half_backlash_m", "kind", "weight", "wave")}
+        k: {key: v[key] for key in ("row", "half_backlash_m", "kind", "weight", "wave", "error")}
         for k, v in dyn.meshes.items()
     }
     src = [

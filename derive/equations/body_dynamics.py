@@ -59,6 +59,9 @@ class Bodies:
     labels: dict  # mesh row index -> its kind's name in MESHES ("sun-planet", "mesh", ...)
     load: np.ndarray  # F / (k_ref b) per unit f on each q (phi_0^T F = 0)
     reference: int  # the mesh row whose k, m and b set the scales
+    # mesh row index -> ((h, c, s), ...): its transmission error in m, sum_l c_l cos(h_l
+    # omega tau) + s_l sin(h_l omega tau), added to its deflection (excess material)
+    errors: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -150,6 +153,12 @@ def build(b: Bodies, symbols=("omega", "f", "zeta")) -> dict:
     for j in range(len(k)):
         delta = sum(float(rows[j, i]) * y[i] for i in range(n_y) if rows[j, i] != 0.0)
         rate = sum(float(rows[j, i]) * dy[i] for i in range(n_y) if rows[j, i] != 0.0)
+        if kinds[j] == "mesh" and b.errors.get(j):
+            error = sum(  # in the reference half backlash, as delta
+                c_l / length * sp.cos(h * omega * tau) + s_l / length * sp.sin(h * omega * tau)
+                for h, c_l, s_l in b.errors[j]
+            )
+            delta, rate = delta + error, rate + sp.diff(error, tau)
         if kinds[j] == "mesh":
             u = delta / float(beta[j])
             g = sp.Piecewise((u - 1, u > 1), (u + 1, u < -1), (0, True))
@@ -177,6 +186,11 @@ def build(b: Bodies, symbols=("omega", "f", "zeta")) -> dict:
             "weight": float(kappa[j] * beta[j] ** 2),
             # v(tau) = sum_l c_l cos(h_l omega tau) + s_l sin(h_l omega tau): its variation
             "wave": tuple(b.waves.get(j, ())),
+            # e(tau) in its own half backlashes, added to its deflection (none: ())
+            "error": tuple(
+                (h, c_l / (beta[j] * length), s_l / (beta[j] * length))
+                for h, c_l, s_l in b.errors.get(j, ())
+            ),
             "kind": b.labels[j],
         }
         for j in range(len(k))

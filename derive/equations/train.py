@@ -34,6 +34,11 @@ themselves (``R phi_0 = 0``); the torques must too (their power ``sum tau_i thet
 no losses being modelled), else the train would speed up, and are refused (what is left of
 their power by rounding, at most 1e-9 of it, is taken out along the rigid rotation).
 
+**Transmission error** (``transmission_error``, as a tree's mesh states it): ``e_j(t) =
+sum_l a_l cos(l (h_j omega tau - 2 pi gamma_j) + phi_l)`` adds to the mesh's deflection
+(excess material), in its force and its damper, ``k (1 + v) b g((delta + e) / b) + c (delta'
++ e')``, as the tree models' ``x = C A theta + s e``.
+
 **Locked-in torque** of a loop of two pairs of equal ratio ``i`` joined by two shafts (a
 back-to-back rig), the meshes' teeth touching: going round the loop, the twists and the
 deflections referred to the first shaft add up to its assembly twist,
@@ -273,6 +278,24 @@ def derive_train_dynamics(st: TrainStructure) -> BodyDynamics:
             c, s = math.cos(phi), math.sin(phi)
             terms.append((l_ * int(h), a * c - b * s, a * s + b * c))
         waves[j] = tuple(terms)
+    errors = {}
+    for j, (m, h) in enumerate(zip(train.meshes, multiples, strict=True)):
+        te = m.error
+        if te is None or not te.amplitudes:
+            continue
+        if h.denominator != 1:
+            raise InputError(
+                train.source,
+                f"train.mesh {m.id}",
+                f"its mesh frequency is {h} times the first mesh's, not a whole multiple; "
+                "list first the mesh of the lowest frequency, or give this one no "
+                "transmission error",
+            )
+        terms = []
+        for l_, (a, phi) in enumerate(zip(te.amplitudes, te.phases, strict=True), start=1):
+            psi = 2 * math.pi * l_ * m.phase - phi  # a cos(l (h w t - 2 pi gamma) + phi)
+            terms.append((l_ * int(h), a * math.cos(psi), a * math.sin(psi)))
+        errors[j] = tuple(terms)
     k_ref, b_ref = train.meshes[0].stiffness, train.meshes[0].half_backlash
     meshes = range(len(train.meshes))
     bodies = Bodies(
@@ -288,6 +311,7 @@ def derive_train_dynamics(st: TrainStructure) -> BodyDynamics:
         labels={j: "internal" if train.meshes[j].internal else "external" for j in meshes},
         load=_loaded(st) / (k_ref * b_ref),
         reference=0,
+        errors=errors,
     )
     eq = build(bodies, ("omega", "f", "zeta"))
     T = eq["transform"]

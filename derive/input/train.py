@@ -20,6 +20,7 @@ train) is not a tree and keeps each body's rotation as a coordinate.  Its file h
     half_backlash_um = 50
     variation = [[0.1, 0.0], [0.03, 0.0]] # optional: k(t) / k_m - 1, (cos, sin) per harmonic
     phase = 0.0                           # optional: in its own mesh periods
+    transmission_error = { amplitude_um = [4.0], phase_deg = [0.0] }   # optional
     [[train.shaft]]
     id = "pinion_shaft"
     bodies = ["pinion_test", "pinion_slave"]
@@ -46,6 +47,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..escape import is_target_name
+from .meshes import _transmission_error
 from .reader import InputError, Table, load_toml, nearest
 
 __all__ = ["Body", "Link", "Train", "TrainDynamics", "is_train", "load_train"]
@@ -72,6 +74,7 @@ class Link:
     variation: tuple[tuple[float, float], ...] = ()  # (cos, sin) of each harmonic (a mesh)
     phase: float = 0.0  # mesh periods (a mesh)
     twist: float = 0.0  # rad, at assembly (a shaft)
+    error: object = None  # TransmissionError (a mesh): e(t) = sum_h a_h cos(h w t + phase_h)
 
 
 @dataclass(frozen=True)
@@ -201,6 +204,7 @@ def load_train(path: Path | str) -> Train:
                 half_backlash=t.number("half_backlash_um", low=0.0, low_open=True) * 1e-6,
                 variation=_variation(t),
                 phase=t.number("phase", 0.0, low=0.0, high=1.0, high_open=True),
+                error=_transmission_error(t.table("transmission_error", None)),
             )
         )
         t.finish()
