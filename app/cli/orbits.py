@@ -37,7 +37,7 @@ def register(sub) -> None:
         "The orbit's minimal period is checked: when a guess leads to an orbit of lower "
         "period, --tries more guesses settled from seeded random states are tried; when "
         "none has minimal period n, the lower-period orbit is reported as what it is "
-        "and the exit status is 1.",
+        "and the exit status is 3 (a run that did not find what was asked).",
     )
     sh.add_argument("scene", metavar="SCENE", help="a scene path or built-in name")
     sh.add_argument(
