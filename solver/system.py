@@ -70,9 +70,31 @@ class System:
         )
         return cls(module, module.parameters(**values), dict(values))
 
+    def _kept(self, values: dict) -> dict:
+        """This system's named values less those that ``values`` state again under another
+        name (``omega`` after ``speed_rpm``, ``mesh_frequency_hz`` after ``omega``): the
+        later value wins, as it does under one name."""
+        module = self.module
+        physical = getattr(module, "PHYSICAL", {})
+        aliases = getattr(module, "PHYSICAL_ALIASES", {})
+        replaces = getattr(module, "PHYSICAL_REPLACES", {})
+
+        def names(k: str) -> set:
+            out = {k, *aliases.get(k, ())}
+            to = physical.get(k)
+            if isinstance(to, str):  # a body model's physical name of a parameter
+                out.add(to)
+            for n in list(out):
+                out |= set(replaces.get(n, ()))
+            return out
+
+        new = set().union(*(names(k) for k in values)) if values else set()
+        return {k: v for k, v in self.values.items() if not names(k) & new}
+
     def with_values(self, **values) -> System:
-        """The same model with some named values changed (the rest kept)."""
-        merged = self.values | values
+        """The same model with some named values changed (the rest kept; a value stated
+        again under another name is replaced)."""
+        merged = self._kept(values) | values
         new = System(self.module, self.module.parameters(**merged), merged, self.contract)
         # Share the CasADi graphs: they depend on the model, not on the values.
         if "casadi" in self.__dict__:
@@ -81,7 +103,7 @@ class System:
 
     def parameters_with(self, **values) -> np.ndarray:
         """The parameter vector with some named values changed (no new System)."""
-        return self.module.parameters(**(self.values | values))
+        return self.module.parameters(**(self._kept(values) | values))
 
     # -- names -------------------------------------------------------------------------
     @property

@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from ..equations.train import TrainStructure, mesh_multiples
+from ..equations.train import TrainStructure, loaded_flanks, mesh_multiples
 from ..escape import markdown
 
 __all__ = ["train_index", "train_page"]
@@ -76,13 +76,15 @@ def train_page(st: TrainStructure, command: str, source: str) -> str:
             f"{st.mass[i]:.6g} | {speed} |"
         )
     multiples = mesh_multiples(st) if st.speeds is not None else ("—",) * len(tr.meshes)
+    flanks = loaded_flanks(st) if st.speeds is not None else (None,) * len(tr.meshes)
     lines += [
         "",
         "## Links\n",
         "Each link a spring along its deflection `δ = R q`, `K = Rᵀ diag(k) R`; a mesh's "
         "force is the dead zone of its half backlash at `δ + e(t)`, its stiffness "
-        "`k (1 + v(t))`, `e` its transmission error (excess material, `Σ a_l cos(l ω_m t + "
-        "φ_l)` at its mesh frequency and phase).\n",
+        "`k (1 + v(t))`, `e` its transmission error (excess material on the flank the file's "
+        "load presses, in the linear static solution: `Σ a_l cos(l ω_m t + φ_l)` at its "
+        "mesh frequency and phase, signed by that flank).\n",
         "| link | kind | between | deflection | stiffness | half backlash / assembly twist "
         "| frequency over the first mesh's | phase (its mesh periods) |",
         "|---|---|---|---|---|---|---|---|",
@@ -93,6 +95,8 @@ def train_page(st: TrainStructure, command: str, source: str) -> str:
             kind = "internal mesh" if link.internal else "external mesh"
             stiff = f"{link.stiffness:.6g} N/m"
             gap = f"{link.half_backlash * 1e6:.6g} µm"
+            if flanks[j] is not None:
+                gap += f", loaded on δ {'>' if flanks[j] > 0 else '<'} 0"
             if link.error is not None and link.error.amplitudes:
                 gap += "; transmission error " + ", ".join(
                     f"{a * 1e6:.6g} µm at {math.degrees(p):.6g}° (harmonic {h})"

@@ -35,9 +35,11 @@ no losses being modelled), else the train would speed up, and are refused (what 
 their power by rounding, at most 1e-9 of it, is taken out along the rigid rotation).
 
 **Transmission error** (``transmission_error``, as a tree's mesh states it): ``e_j(t) =
-sum_l a_l cos(l (h_j omega tau - 2 pi gamma_j) + phi_l)`` adds to the mesh's deflection
-(excess material), in its force and its damper, ``k (1 + v) b g((delta + e) / b) + c (delta'
-+ e')``, as the tree models' ``x = C A theta + s e``.
+sum_l a_l cos(l (h_j omega tau - 2 pi gamma_j) + phi_l)`` is excess material on the loaded
+flank, so it adds ``s_j e_j`` to the mesh's deflection, in its force and its damper, ``k (1 +
+v) b g((delta + s e) / b) + c (delta' + s e')``, as the tree models' ``x = C A theta + s e``:
+``s_j`` the sign of the mesh's deflection in the linear static solution at the file's load,
+every mesh's teeth touching (``loaded_flanks``; +1 where it carries none).
 
 **Locked-in torque** of a loop of two pairs of equal ratio ``i`` joined by two shafts (a
 back-to-back rig), the meshes' teeth touching: going round the loop, the twists and the
@@ -242,6 +244,16 @@ def _loaded(st: TrainStructure) -> np.ndarray:
     return F - (st.rigid @ F) / (st.rigid @ m_phi) * m_phi
 
 
+def loaded_flanks(st: TrainStructure) -> tuple[int, ...]:
+    """Each mesh's loaded flank at the file's load: the sign of its deflection in the
+    linear static solution with every mesh's teeth touching (+1 where it carries none)."""
+    K = st.incidence.T @ (np.asarray(st.stiffness)[:, None] * st.incidence)
+    q = np.linalg.lstsq(K, _loaded(st), rcond=None)[0]  # the load leaves phi_0 unforced
+    delta = st.incidence[: len(st.train.meshes)] @ q
+    small = 1e-12 * max(1e-300, float(np.max(np.abs(delta))))
+    return tuple(-1 if d < -small else 1 for d in delta)
+
+
 def derive_train_dynamics(st: TrainStructure) -> BodyDynamics:
     """The nonlinear model of a train (module docstring); ``InputError`` where it cannot be
     built (no ``[train.dynamics]``, a locked loop, unbalanced torques, a mesh turning at a
@@ -279,6 +291,7 @@ def derive_train_dynamics(st: TrainStructure) -> BodyDynamics:
             terms.append((l_ * int(h), a * c - b * s, a * s + b * c))
         waves[j] = tuple(terms)
     errors = {}
+    flank = loaded_flanks(st)
     for j, (m, h) in enumerate(zip(train.meshes, multiples, strict=True)):
         te = m.error
         if te is None or not te.amplitudes:
@@ -294,6 +307,7 @@ def derive_train_dynamics(st: TrainStructure) -> BodyDynamics:
         terms = []
         for l_, (a, phi) in enumerate(zip(te.amplitudes, te.phases, strict=True), start=1):
             psi = 2 * math.pi * l_ * m.phase - phi  # a cos(l (h w t - 2 pi gamma) + phi)
+            a *= flank[j]  # excess material presses the loaded flank
             terms.append((l_ * int(h), a * math.cos(psi), a * math.sin(psi)))
         errors[j] = tuple(terms)
     k_ref, b_ref = train.meshes[0].stiffness, train.meshes[0].half_backlash

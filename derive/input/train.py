@@ -47,7 +47,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..escape import is_target_name
-from .meshes import _transmission_error
 from .reader import InputError, Table, load_toml, nearest
 
 __all__ = ["Body", "Link", "Train", "TrainDynamics", "is_train", "load_train"]
@@ -142,6 +141,16 @@ def _variation(t: Table) -> tuple[tuple[float, float], ...]:
     return tuple((float(a), float(b)) for a, b in value)
 
 
+def _error(t: Table | None):
+    """A mesh's transmission error as a tree's mesh states it (``derive/input/meshes.py``,
+    imported here only when a mesh has one: loading a cached model stays light)."""
+    if t is None:
+        return None
+    from .meshes import _transmission_error
+
+    return _transmission_error(t)
+
+
 def _id(t: Table) -> str:
     """A body's, mesh's or shaft's id: letters, digits, '-' and '_', starting with a letter
     (it is printed, labels figures and names columns)."""
@@ -204,7 +213,7 @@ def load_train(path: Path | str) -> Train:
                 half_backlash=t.number("half_backlash_um", low=0.0, low_open=True) * 1e-6,
                 variation=_variation(t),
                 phase=t.number("phase", 0.0, low=0.0, high=1.0, high_open=True),
-                error=_transmission_error(t.table("transmission_error", None)),
+                error=_error(t.table("transmission_error", None)),
             )
         )
         t.finish()

@@ -503,7 +503,43 @@ def test_a_transmission_error_drives_the_linear_response_of_the_hand_assembly(tm
     r, k = rows["test"]
     c = 2 * zeta * np.sqrt(k / (r @ Minv @ r))
     W = 2 * np.pi * 900.0  # rad/s
-    E = 2e-6 * np.exp(1j * math.radians(30.0))
+    # excess material presses the loaded flank: the test mesh's is delta < 0 in the rig
+    flank = np.sign(system.module.mesh_deflections(x0)["test"])
+    assert flank == -1
+    E = flank * 2e-6 * np.exp(1j * math.radians(30.0))
     theta = np.linalg.solve(K - W**2 * M + 1j * W * C, -(k + 1j * W * c) * E * r)
     hand = r @ theta
     assert abs(ours - hand) < 1e-8 * abs(hand)  # measured 2.3e-11
+
+
+def test_one_transmission_error_on_both_pairs_keeps_the_rigs_mirror_symmetry(tmp_path):
+    """The slave pair is the test pair run half a mesh period later and loaded on the other
+    flank (the loop's one sense of counting): with the same transmission error on both,
+    excess material on each loaded flank, the slave mesh's deflection is the test mesh's
+    half a period on, negated (the stiffness variation kept)."""
+    te = "transmission_error = { amplitude_um = [5.0, 1.0], phase_deg = [0.0, 40.0] }\n"
+    text = TEXT.replace("half_backlash_um = 50\n", "half_backlash_um = 50\n" + te)
+    assert text.count("transmission_error") == 2
+    system = planetary_system(variant(tmp_path, "rig-te-both", text), mesh_frequency_hz=900.0)
+    x0 = system.module.static_state(system.p)
+    tr = simulate(system, x0, transient=300, periods=2, samples_per_period=64, rtol=1e-11)
+    assert tr.status == "ok"
+    u = system.module.mesh_deflections(tr.x)
+    test, slave = np.asarray(u["test"]), np.asarray(u["slave"])
+    assert np.ptp(test) > 0.05  # the error moves it
+    assert np.max(np.abs(test[:64] + slave[32:96])) < 1e-7
+
+
+def test_a_value_stated_again_under_another_name_replaces_the_first():
+    """with_values: the later value wins whatever its name (a continuation in omega of a
+    system loaded at a mesh frequency), for a train and for a tree model alike; in one
+    call both names are refused."""
+    from gearsym.resolve import load
+
+    rig = load("back-to-back-rig", mesh_frequency_hz=5000.0)
+    assert rig.with_values(omega=0.5).p[0] == 0.5
+    assert rig.parameters_with(omega=0.25)[0] == 0.25
+    tree = load("reference-light", speed_rpm=3000.0)
+    assert tree.with_values(omega=0.5).parameter("omega") == 0.5
+    with pytest.raises(ValueError, match="one quantity"):
+        load("back-to-back-rig", mesh_frequency_hz=5000.0, omega=0.5)
