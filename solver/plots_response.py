@@ -79,7 +79,7 @@ def frequency_response_figure(resp, physical: bool = False, title: str = ""):
                 )
                 shown.add(label)
             for e in curve.events:
-                marker, mc = BIFURCATIONS.get(e.kind, ("x", "k"))
+                marker, mc = BIFURCATIONS.get(e.name, ("x", "k"))
                 v = e.value
                 # the point before the event on the curve (a fold has two sides at
                 # nearly one parameter value: the nearest value would not do)
@@ -94,7 +94,7 @@ def frequency_response_figure(resp, physical: bool = False, title: str = ""):
                     color=mc,
                     ms=6,
                     mfc="none",
-                    label=f"{e.kind}" + (" (a sweep jumps here)" if e.kind == "fold" else ""),
+                    label=f"{e.name}" + (" (a sweep jumps here)" if e.name == "fold" else ""),
                 )
         ax.set_ylabel(f"half peak-to-peak of {c}" + (" (µm)" if physical else " (half backlashes)"))
         ax.grid(alpha=0.3)

@@ -305,7 +305,7 @@ def _cmd_response(args) -> int:
                 if "hill_vs_monodromy" in ev
                 else ""
             )
-            print(f"  {e.kind:<16} {name} = {e.value:.8g}{check}")
+            print(f"  {e.name:<16} {name} = {e.value:.8g}{check}")
         for note in c.details.get("notes", []):
             print(f"  note: {note}")
         if c.details.get("status") in ("boundary", "max-points"):

@@ -180,10 +180,10 @@ def response_section(rows) -> str:
     for r in rows:
         coords = r.resp.system.coordinates
         curve = r.resp.curves[0]
-        folds = ", ".join(f"{e.value:.4f}" for e in curve.events if e.kind == "fold")
-        other = [e for e in curve.events if e.kind != "fold"]
+        folds = ", ".join(f"{e.value:.4f}" for e in curve.events if e.name == "fold")
+        other = [e for e in curve.events if e.name != "fold"]
         if other:
-            folds += "; " + ", ".join(f"{e.kind} at {e.value:.4f}" for e in other)
+            folds += "; " + ", ".join(f"{e.name} at {e.value:.4f}" for e in other)
         sols = "; ".join(_fmt_solution(s, coords) for s in r.at_omega) or "none found"
         att = r.attractor
         if att is None:

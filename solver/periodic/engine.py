@@ -28,7 +28,7 @@ point is solved at the end exactly by the problem's :meth:`solve_at`), after
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Protocol
 
 import numpy as np
@@ -273,7 +273,8 @@ def _events(problem, step, s: Settings, index: int) -> list[Bifurcation]:
     folded = np.sign(t_new[-1]) != np.sign(t[-1])
     if folded:
         # the tangent alone decides a fold: no stability in the location
-        out.append(_locate(problem, z, t, ds, "fold", None, (t[-1], t_new[-1]), s, index))
+        b = _locate(problem, z, t, ds, "fold", None, (t[-1], t_new[-1]), s, index)
+        out.append(replace(b, turns=True))
     if tests is None or tests_new is None:
         return out
     for k, kind in enumerate(KINDS):
@@ -284,6 +285,8 @@ def _events(problem, step, s: Settings, index: int) -> list[Bifurcation]:
         if kind == "neimark-sacker" and tests_new[3] != tests[3]:
             continue  # complex pairs merged or split on the real axis: no crossing
         b = _locate(problem, z, t, ds, kind, k, (tests[k], tests_new[k]), s, index)
+        if kind == "fold":  # a multiplier through +1 where the branch does not turn
+            b = replace(b, turns=False)
         if kind != "neimark-sacker" or abs(abs(b.multiplier) - 1.0) < 1e-3:
             out.append(b)
     return out

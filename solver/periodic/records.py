@@ -56,12 +56,25 @@ class Bifurcation:
     parameter: str = ""
     index: int = -1
     evidence: Mapping = field(default_factory=dict)
+    turns: bool | None = None  # a "fold": whether the branch turns there (None: not known)
+
+    @property
+    def name(self) -> str:
+        """The kind in words: a ``"fold"`` where the branch does not turn is a branch
+        point, a multiplier through +1 without a turn (a symmetry-breaking pitchfork, for
+        one)."""
+        return "branch point" if self.kind == "fold" and self.turns is False else self.kind
 
     def to_dict(self) -> dict:
         """Kind, parameter name and value (also under the parameter's own name), index,
         multiplier (re, im), x0 and the evidence."""
-        out = {"kind": self.kind, "parameter": self.parameter, "value": float(self.value)}
-        if self.parameter and self.parameter not in ("kind", "index", "multiplier", "x0"):
+        out = {
+            "kind": self.kind,
+            "name": self.name,
+            "parameter": self.parameter,
+            "value": float(self.value),
+        }
+        if self.parameter and self.parameter not in ("kind", "name", "index", "multiplier", "x0"):
             out[self.parameter] = float(self.value)
         out |= {
             "index": int(self.index),
@@ -134,7 +147,7 @@ class Branch:
     def __repr__(self) -> str:
         v = self.values
         span = f"{v.min():.4g} to {v.max():.4g}" if v.size else "no points"
-        kinds = ", ".join(sorted({b.kind for b in self.bifurcations}))
+        kinds = ", ".join(sorted({self.named(b) for b in self.bifurcations}))
         return (
             f"Branch({self.model.get('model', '?')}: period-{self.n} in {self.parameter} "
             f"{span}, {v.size} points, {int(np.sum(self.stable))} stable, "
@@ -146,8 +159,8 @@ class Branch:
         """``b``'s kind in words: a ``"fold"`` where the branch does not turn (the
         tangent's parameter component keeps its sign across it) is a branch point, a
         multiplier through +1 without a turn (a symmetry-breaking pitchfork, for one)."""
-        if b.kind != "fold" or not 1 <= b.index < len(self.points):
-            return b.kind
+        if b.turns is not None or b.kind != "fold" or not 1 <= b.index < len(self.points):
+            return b.name
         before, after = self.points[b.index - 1], self.points[b.index]
         return b.kind if before.tangent_sign != after.tangent_sign else "branch point"
 

@@ -80,7 +80,7 @@ class FrequencyResponse:
                 f"{k} {np.nanmax(s['amplitude']):.4g}" if len(c.values) else k
                 for k, s in c.stats.items()
             )
-            events = ", ".join(f"{e.kind} at {e.value:.4g}" for e in c.events[:4])
+            events = ", ".join(f"{e.name} at {e.value:.4g}" for e in c.events[:4])
             more = f" (+{len(c.events) - 4})" if len(c.events) > 4 else ""
             lines.append(
                 f"  {c.method}: {len(c.values)} points, {int(np.sum(c.stable))} stable, "

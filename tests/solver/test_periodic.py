@@ -304,3 +304,14 @@ def test_a_multiplier_through_plus_one_without_a_turn_is_named_a_branch_point():
         "branch point",
         "period-doubling",
     ]
+
+
+def test_the_engine_records_whether_a_fold_turns():
+    """Bifurcation.turns, set where the engine locates it: named 'branch point' in every
+    output when False, and in the records (name beside kind)."""
+    from gearsym.solver.periodic.records import Bifurcation
+
+    b = Bifurcation("fold", 1.0, np.zeros(2), 1.0, "p", turns=False)
+    assert b.name == "branch point" and b.to_dict()["name"] == "branch point"
+    assert Bifurcation("fold", 1.0, np.zeros(2), 1.0, "p", turns=True).name == "fold"
+    assert Bifurcation("fold", 1.0, np.zeros(2), 1.0, "p").name == "fold"  # not known
