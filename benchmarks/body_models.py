@@ -73,12 +73,18 @@ def derive_times(repeats: int) -> dict:
 
 
 def sweep_times(repeats: int) -> dict:
-    full, csv = [], []
+    """The sweep's medians, and the sizes of its JSON and MAT files (MB); the model derived
+    and compiled into the cache first, untimed, so that no repeat pays for it."""
+    _timed(["simulate", SWEEP[1], "--transient", "1", "--periods", "1"])
+    full, csv, sizes = [], [], {}
     for _ in range(repeats):
         with tempfile.TemporaryDirectory() as tmp:
             full.append(_timed([*SWEEP, "--out", f"{tmp}/full"]))
             csv.append(_timed([*SWEEP, "--out", f"{tmp}/csv", "--format", "csv"]))
-    return {"full": statistics.median(full), "csv": statistics.median(csv)}
+            sizes = {
+                f: Path(tmp, "full", f"sweep.{f}").stat().st_size / 1e6 for f in ("json", "mat")
+            }
+    return {"full": statistics.median(full), "csv": statistics.median(csv), "mb": sizes}
 
 
 def per_state(repeats: int) -> list[dict]:
@@ -141,8 +147,10 @@ def page(derive: dict, sweep: dict, rows: list[dict], when: str, machine: str) -
         f"| the same, CSV only | {sweep['csv']:.1f} | — | |",
         "",
         "The difference of the two sweeps is what writing every point's full record costs "
-        "(its Poincaré points of all 34 states, spectra and evidence: 42 MB of JSON, 8 MB "
-        "of MAT, whose nested structures SciPy writes element by element).",
+        "(its Poincaré points of all 34 states, spectra and evidence: "
+        f"{sweep['mb'].get('json', float('nan')):.0f} MB of JSON, "
+        f"{sweep['mb'].get('mat', float('nan')):.0f} MB of MAT, whose nested structures "
+        "SciPy writes element by element).",
         "",
         "## Cost per state",
         "",

@@ -17,8 +17,15 @@ def test_the_page_judges_the_floors_and_lists_every_row():
             "nfev_per_point": 1e5,
         }
     ]
-    text = page({"a": 7.7, "b": 61.0}, {"full": 36.0, "csv": 20.0}, rows, "today", "here")
+    text = page(
+        {"a": 7.7, "b": 61.0},
+        {"full": 36.0, "csv": 20.0, "mb": {"json": 42.4, "mat": 8.2}},
+        rows,
+        "today",
+        "here",
+    )
     assert "`a` | 7.7 | 60 | met |" in text
     assert "`b` | 61.0 | 60 | not met |" in text
     assert "JSON + CSV + MAT | 36.0 | 20 | not met |" in text
     assert "| m | 2 | 4 | 10.0 | 5.00 | 100000 |" in text
+    assert "42 MB of JSON, 8 MB of MAT" in text
