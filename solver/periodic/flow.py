@@ -26,8 +26,9 @@ contract's ``switching_rows``, no surface to stop at) takes the compiled engine'
 instead over whole forcing periods, with its variational monodromy, as the orbit check
 does (``analysis/orbit_check.py``): the event loop would only have integrated it in
 Python.  Its dampers are linear, so ``trace J`` is constant and its integral is the
-duration times ``trace J`` at the start (checked at the end; NaN, no Liouville check,
-where they differ).
+duration times ``trace J`` at the start (checked at another state and time; NaN, no
+Liouville check, where they differ).  Only whole periods take this route: a multiple
+shooting segment shorter than a period still takes the event loop, correct but slow.
 
 ``StroboscopicMap(system, n)`` is the period map ``x -> phi_{nT}(x; t0)`` as an object of
 its own: fixed points are period-n orbits, its Jacobian is the monodromy matrix.
@@ -110,8 +111,10 @@ class FlowMap:
                 )
             raise RuntimeError(f"the flow stopped: {why}")
         xf = np.asarray(res.x[0][-1], dtype=float)
+        # trace J of linear dampers is free of the state and the time: checked at another
+        # state and time than the start's (the end's would be the start's on an orbit)
         a = float(np.trace(sys_.module.jacobian(t0, x0, sys_.p)))
-        b = float(np.trace(sys_.module.jacobian(t0 + duration, xf, sys_.p)))
+        b = float(np.trace(sys_.module.jacobian(t0 + 0.37 * duration, x0 + 0.1, sys_.p)))
         q = a * duration if abs(a - b) <= 1e-12 * max(1.0, abs(a)) else float("nan")
         return xf, (np.asarray(res.monodromy[0]) if with_phi else None), q
 
