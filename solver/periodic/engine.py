@@ -223,16 +223,18 @@ def continue_branch(
             ds = (end - z[-1]) / t[-1]
         try:
             z_new, steps, lin_new = correct(problem, z + ds * t, t, s.tol, s.max_iter)
-        except FAILURES:
+        except FAILURES as err:
             if end is not None:
                 status, message = land(end, z[:-1] + ds * t[:-1], _sign(t))
                 break
             ds /= 2
             if ds < s.ds_min:
                 status = "stalled"
+                # a failed integration says why (a grazing mesh's step budget, for one)
+                why = str(err).splitlines()[0] if isinstance(err, RuntimeError) else ""
                 message = (
                     f"the corrector failed with the smallest step ({s.ds_min:g}) at "
-                    f"{problem.parameter} = {z[-1]:.6g}"
+                    f"{problem.parameter} = {z[-1]:.6g}" + (f" ({why})" if why else "")
                 )
                 notes.append(message)
                 break
