@@ -93,7 +93,8 @@ def planetary_page(st: PlanetaryStructure, command: str, source: str) -> str:
         "`docs/analysis.md`).\n",
         _nonlinear(st),
         "**Not modelled yet** (issue 26): the rotating frame's terms in the parametric "
-        "analysis and in the nonlinear model; transmission error.\n",
+        "analysis and in the nonlinear model; a transmission error in the linear "
+        "analysis (the nonlinear model takes one from `[planetary.dynamics]`).\n",
         "## Kinematic graph\n",
         f"Bodies ({bodies}): carrier `c`, ring `r`, sun `s` and {n} planets, {spacing}, at "
         f"ψ = {angles} round the carrier. Each planet meshes with the sun (external) and "

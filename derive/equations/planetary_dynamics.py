@@ -25,13 +25,16 @@ backlash ``b``, time ``tau = omega_n t`` with ``omega_n = sqrt(k_sp / m_sp)`` of
 sun-planet mesh, forcing frequency ``omega``: the mesh frequency
 over ``omega_n``; ``f = F_s / (k_sp b)``.  The stiffness variation enters as
 ``v_j = sum_l a_l cos(l (omega tau - 2 pi gamma_j)) + b_l sin(l (omega tau - 2 pi gamma_j))``.
-No transmission error.  The carrier's rotating frame is not modelled here (a turning
-carrier's set is refused).
+A transmission error (``sun_planet_transmission_error``, ``ring_planet_transmission_error``)
+is excess material on the loaded flank (the sun's force makes every mesh's ``delta > 0``),
+delayed by each mesh's phase as its stiffness variation is (``_errors``).  The carrier's
+rotating frame is not modelled here (a turning carrier's set is refused).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -116,6 +119,37 @@ def scales(st: PlanetaryStructure) -> dict:
     }
 
 
+def _errors(st: PlanetaryStructure) -> dict:
+    """mesh row index -> ((l, c_l, s_l), ...): each mesh's transmission error in m (its
+    kind's harmonics, delayed by the mesh's phase as its stiffness is); excess material on
+    the loaded flank, which the sun's force makes ``delta > 0`` for every mesh."""
+    d = st.planetary.dynamics
+    if d.error_sun is None and d.error_ring is None:
+        return {}
+    if st.phases is None:
+        raise InputError(
+            st.planetary.source,
+            "planetary.dynamics",
+            "a transmission error is delayed by each mesh's phase, which needs sun_teeth "
+            "and ring_teeth in [planetary]; give them",
+        )
+    v = st.planetary.variation
+    offset = v.ring_sun_phase if v is not None else 0.0
+    out = {}
+    for j, (name, kind) in enumerate(zip(st.springs, st.kinds, strict=True)):
+        te = d.error_sun if name.startswith("s") else d.error_ring
+        if kind != "mesh" or te is None:
+            continue
+        sun, ring = st.phases[int(name[2:]) - 1]
+        gamma = sun if name.startswith("s") else (ring + offset) % 1.0
+        terms = []
+        for h, (a, phi) in enumerate(zip(te.amplitudes, te.phases, strict=True), start=1):
+            psi = 2 * math.pi * h * gamma - phi  # a cos(h (omega tau - 2 pi gamma) + phi)
+            terms.append((h, a * math.cos(psi), a * math.sin(psi)))
+        out[j] = tuple(terms)
+    return out
+
+
 def derive_dynamics(st: PlanetaryStructure) -> PlanetaryDynamics:
     """The nonlinear model of ``st`` (module docstring); ``InputError`` where it cannot
     be built (no ``[planetary.dynamics]``, a turning carrier, two rigid-body modes)."""
@@ -149,6 +183,7 @@ def derive_dynamics(st: PlanetaryStructure) -> PlanetaryDynamics:
         reference=ref,
     )
     scale = scales(st)
+    bodies = replace(bodies, errors=_errors(st))
     return BodyDynamics(
         structure=st,
         name=ps.name,

@@ -38,6 +38,9 @@ the carrier are equally spaced unless given.
     ring_planet_half_backlash_um = 50
     mesh_frequency_hz = 1000                      # the operating point (omega)
     damping_ratio = 0.03                          # every spring's, on its own mass
+    # optional, each kind of mesh's (needs sun_teeth and ring_teeth: the meshes' phases)
+    sun_planet_transmission_error = { amplitude_um = [2.0], phase_deg = [0.0] }
+    ring_planet_transmission_error = { amplitude_um = [2.0], phase_deg = [0.0] }
 
 The ``torsional`` model keeps each member's rotation only: translations are held and
 each planet's centre moves with the carrier (its bearing rigid), as in the purely
@@ -121,6 +124,9 @@ class Dynamics:
     backlash_ring: float
     mesh_frequency_hz: float
     damping_ratio: float
+    # each kind of mesh's transmission error (a tree mesh's TransmissionError), or None
+    error_sun: object = None
+    error_ring: object = None
 
 
 @dataclass(frozen=True)
@@ -218,8 +224,17 @@ def _dynamics(t: Table) -> Dynamics:
     b_r = t.number("ring_planet_half_backlash_um", low=0.0, low_open=True) * 1e-6
     f_m = t.number("mesh_frequency_hz", low=0.0, low_open=True)
     zeta = t.number("damping_ratio", 0.03, low=0.0, high=1.0)
+    errors = []
+    for key in ("sun_planet_transmission_error", "ring_planet_transmission_error"):
+        table = t.table(key, None)
+        if table is None:
+            errors.append(None)
+            continue
+        from .meshes import _transmission_error  # only where one is given: loading stays light
+
+        errors.append(_transmission_error(table))
     t.finish()
-    return Dynamics(force, b_s, b_r, f_m, zeta)
+    return Dynamics(force, b_s, b_r, f_m, zeta, *errors)
 
 
 def imbalance(angles_deg) -> float:

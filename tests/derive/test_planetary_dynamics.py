@@ -179,3 +179,45 @@ def test_a_maps_random_starts_lie_round_the_loaded_equilibrium(three):
     for k, c in enumerate(system.coordinates):
         assert box[c] == pytest.approx((x[k] - 1.0, x[k] + 1.0))
     assert box["du_s"] == (-1.0, 1.0)
+
+
+@pytest.mark.parametrize("sun_teeth, ring_teeth, in_phase", [(30, 90, True), (31, 89, False)])
+def test_a_transmission_error_in_phase_on_every_planet_moves_no_central_member_across(
+    sun_teeth, ring_teeth, in_phase, tmp_path
+):
+    """Parker and Lin (2004, "Mesh phasing relationships in planetary and epicyclic
+    gears"): an excitation of the sun meshes in phase on equally spaced planets (Z_s / N
+    whole) drives only the rotational modes, so no central member translates; phased
+    sequentially (Z_s / N not whole) it drives translational modes too. The error is
+    delayed by each mesh's phase, as its stiffness would be."""
+    from gearsym.derive.input.meshes import TransmissionError
+
+    te = TransmissionError((2e-6, 0.5e-6), (0.0, 0.7))
+    dyn = Dynamics(5000.0, 50e-6, 50e-6, 1500.0, 0.03, error_sun=te)
+    ps = replace(
+        example(3), dynamics=dyn, variation=None, sun_teeth=sun_teeth, ring_teeth=ring_teeth
+    )
+    _, system = _model(ps, tmp_path, f"te{sun_teeth}")
+    x0 = system.module.static_state(system.p)
+    tr = simulate(system, x0, transient=200, periods=2, samples_per_period=32, rtol=1e-11)
+    assert tr.status == "ok"
+    u = system.module.mesh_deflections(tr.x)
+    assert all(np.min(v) > 1 for v in u.values())  # in contact: the linear model
+    assert np.ptp(u["sp1"]) > 0.01  # the error moves the sun meshes
+    coords = list(system.module.COORDINATES)
+    across = [coords.index(f"{a}_{m}") for m in "crs" for a in "xy"]
+    travel = max(float(np.ptp(tr.x[i])) for i in across)
+    if in_phase:
+        assert travel < 1e-9
+    else:
+        assert travel > 1e-4
+
+
+def test_a_transmission_error_without_the_teeth_is_refused_in_one_line():
+    from gearsym.derive.input.meshes import TransmissionError
+
+    te = TransmissionError((2e-6,), (0.0,))
+    dyn = Dynamics(5000.0, 50e-6, 50e-6, 1500.0, 0.03, error_ring=te)
+    ps = replace(example(3), dynamics=dyn, variation=None, sun_teeth=None, ring_teeth=None)
+    with pytest.raises(InputError, match="needs sun_teeth and ring_teeth"):
+        derive_dynamics(derive_planetary(ps))
