@@ -37,12 +37,17 @@ def _segments(x, y, stable):
 def frequency_response_figure(resp, physical: bool = False, title: str = ""):
     """One panel per mesh coordinate of a :class:`~.sweep.frequency.FrequencyResponse`;
     returns the ``Figure`` (nothing saved).  ``physical``: mesh frequency in Hz and the
-    dynamic transmission error's amplitude in µm (only over the forcing frequency)."""
+    dynamic transmission error's amplitude in µm (over the forcing frequency, or over a
+    model's own mesh frequency in Hz: a planetary set's or a train's ``mesh_frequency_hz``)."""
     system = resp.system
     coords = system.coordinates
     scales = system.scales()
-    physical = physical and resp.parameter == system.contract.forcing_frequency
-    fx = scales["omega_n_rad_per_s"] / (2 * math.pi) if physical else 1.0
+    forcing = system.contract.forcing_frequency
+    # a model's own name for the forcing frequency in Hz (a planetary set's or a train's
+    # mesh_frequency_hz): the axis is Hz already, the amplitudes turn into µm as well
+    in_hz = getattr(system.module, "PHYSICAL", {}).get(resp.parameter) == forcing
+    physical = physical and (resp.parameter == forcing or in_hz)
+    fx = scales["omega_n_rad_per_s"] / (2 * math.pi) if physical and not in_hz else 1.0
     fig, axes = plt.subplots(
         len(coords), 1, figsize=(8, 3.2 * len(coords)), sharex=True, squeeze=False
     )

@@ -543,3 +543,25 @@ def test_a_value_stated_again_under_another_name_replaces_the_first():
     assert tree.with_values(omega=0.5).parameter("omega") == 0.5
     with pytest.raises(ValueError, match="one quantity"):
         load("back-to-back-rig", mesh_frequency_hz=5000.0, omega=0.5)
+
+
+def test_a_response_over_the_mesh_frequency_in_hz_is_drawn_in_micrometres():
+    """--units physical over a body model's mesh_frequency_hz (already Hz): the amplitudes
+    in µm (times the half backlash), the axis as given."""
+    import gearsym
+    from gearsym.solver.plots_response import frequency_response_figure
+
+    system = gearsym.planetary.dynamics("back-to-back-rig")
+    resp = gearsym.frequency_response(
+        system, "mesh_frequency_hz", 4000.0, 4400.0, points=3, methods=("shooting",)
+    )
+    fig = frequency_response_figure(resp, physical=True)
+    ax = fig.axes[0]
+    assert "(µm)" in ax.get_ylabel() and fig.axes[-1].get_xlabel() == "mesh frequency (Hz)"
+    line = next(ln for ln in ax.get_lines() if len(ln.get_xdata()) > 1)
+    curve = resp.curves[0]
+    c = system.coordinates[0]
+    assert np.allclose(line.get_xdata(), curve.values[: len(line.get_xdata())])
+    assert np.allclose(
+        line.get_ydata(), curve.stats[c]["amplitude"][: len(line.get_ydata())] * B * 1e6
+    )
