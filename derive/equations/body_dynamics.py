@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import sympy as sp
 
-__all__ = ["BodyDynamics", "Bodies", "build", "reduction"]
+__all__ = ["BodyDynamics", "Bodies", "build", "reduction", "structure_mapping"]
 
 
 @dataclass(frozen=True)
@@ -93,6 +93,23 @@ class BodyDynamics:
     # (user name, parameter, factor to it, rule "positive" | "unit" | "nonnegative", words)
     physical: tuple = ()
     data: dict = field(default_factory=dict)  # more data the module states (name -> value)
+
+
+def structure_mapping(st, motions) -> dict:
+    """The ``STRUCTURE`` mapping of a generated module (``solver.analysis.modes``) of a
+    linear model in body coordinates (a planetary set's or a train's: ``physical``,
+    ``mass``, ``springs``, ``kinds``, ``incidence``, ``stiffness``, ``members``), each
+    coordinate's ``motions``."""
+    return {
+        "physical": st.physical,
+        "mass": st.mass,
+        "coordinates": st.springs,
+        "kinds": st.kinds,
+        "incidence": tuple(tuple(float(v) for v in row) for row in st.incidence),
+        "stiffness": st.stiffness,
+        "members": st.members,
+        "motions": tuple(motions),
+    }
 
 
 def reduction(physical, mass, R, rigid: int):

@@ -92,6 +92,7 @@ import numpy as np
 import sympy as sp
 
 from ..input.planetary import CENTRAL, PlanetarySet
+from .body_dynamics import structure_mapping
 from .planetary_frame import at_speed
 
 __all__ = [
@@ -129,14 +130,7 @@ class PlanetaryStructure:
     def as_structure(self) -> dict:
         """The ``STRUCTURE`` mapping of a generated module (``solver.analysis.modes``)."""
         return {
-            "physical": self.physical,
-            "mass": self.mass,
-            "coordinates": self.springs,
-            "kinds": self.kinds,
-            "incidence": tuple(tuple(float(v) for v in row) for row in self.incidence),
-            "stiffness": self.stiffness,
-            "members": self.members,
-            "motions": self.motions,
+            **structure_mapping(self, self.motions),
             **(
                 {
                     "carrier_speed_rad_s": self.carrier_speed_rad_s,

@@ -61,7 +61,7 @@ import numpy as np
 
 from ..input.reader import InputError
 from ..input.train import Train
-from .body_dynamics import Bodies, BodyDynamics, build
+from .body_dynamics import Bodies, BodyDynamics, build, structure_mapping
 
 __all__ = ["TrainStructure", "derive_train", "derive_train_dynamics", "mesh_multiples"]
 
@@ -84,24 +84,16 @@ class TrainStructure:
     def as_structure(self, omega_n: float | None = None) -> dict:
         """The ``STRUCTURE`` mapping of a generated module (``solver.analysis.modes``)."""
         first = self.train.meshes[0]
-        out = {
-            "physical": self.physical,
-            "mass": self.mass,
-            "coordinates": self.springs,
-            "kinds": self.kinds,
-            "incidence": tuple(tuple(float(v) for v in row) for row in self.incidence),
-            "stiffness": self.stiffness,
-            "members": self.members,
-            "motions": ("rotation",) * len(self.physical),
+        out = structure_mapping(self, ("rotation",) * len(self.physical)) | {
             "reference_teeth": self.train.bodies[self.members.index(first.bodies[0])].teeth,
             "reference_driver": first.bodies[0],
         }
         return out | ({"omega_n": omega_n} if omega_n is not None else {})
 
 
-def _groups(train: Train) -> list[list[str]]:
-    """The bodies in groups that the links (``meshes`` and ``shafts``) join."""
-    parent = {b.id: b.id for b in train.bodies}
+def _groups(ids, links) -> list[list[str]]:
+    """The bodies ``ids`` in groups that ``links`` (meshes, shafts) join."""
+    parent = {i: i for i in ids}
 
     def root(x: str) -> str:
         while parent[x] != x:
@@ -109,11 +101,11 @@ def _groups(train: Train) -> list[list[str]]:
             x = parent[x]
         return x
 
-    for link in (*train.meshes, *train.shafts):
+    for link in links:
         parent[root(link.bodies[0])] = root(link.bodies[1])
     groups: dict = {}
-    for b in train.bodies:
-        groups.setdefault(root(b.id), []).append(b.id)
+    for i in ids:
+        groups.setdefault(root(i), []).append(i)
     return list(groups.values())
 
 
@@ -160,9 +152,8 @@ def _radii(train: Train) -> tuple[float, ...]:
                 f"({a.teeth}, {b.teeth}) and base radii ({a.radius * 1e3:g}, "
                 f"{b.radius * 1e3:g} mm) disagree; a mesh's gears share a base pitch",
             )
-    meshed = Train(train.name, "", "", train.bodies, train.meshes, (), {}, None)
     pitch = {}
-    for group in _groups(meshed):
+    for group in _groups(list(body), train.meshes):  # the gears that mesh together
         gears = [body[g] for g in group if body[g].teeth is not None]
         p = sum(g.radius / g.teeth for g in gears) / len(gears) if gears else None
         pitch.update(dict.fromkeys(group, p))
@@ -172,7 +163,7 @@ def _radii(train: Train) -> tuple[float, ...]:
 
 def derive_train(train: Train) -> TrainStructure:
     """The linear model of ``train`` (module docstring)."""
-    groups = _groups(train)
+    groups = _groups([b.id for b in train.bodies], (*train.meshes, *train.shafts))
     if len(groups) > 1:
         raise InputError(
             train.source,

@@ -76,6 +76,7 @@ __all__ = [
     "is_planetary",
     "load_planetary",
     "needs_dynamics",
+    "topology_file",
 ]
 
 DOFS = ("torsional", "lateral-torsional")
@@ -256,15 +257,21 @@ def bearing_limit_rpm(planet: Member) -> float:
     return math.sqrt(planet.bearing / planet.mass) * 30.0 / math.pi
 
 
-def load_planetary(path: Path | str) -> PlanetarySet:
-    """Read and check a planetary set's topology file (module docstring)."""
-    path = Path(path)
-    source = str(path)
-    top = Table(load_toml(path), source)
+def topology_file(path: Path | str) -> tuple[Table, str, str]:
+    """A topology file's top table, with its ``[topology]`` name and description read and
+    checked (a planetary set's and a gear train's files begin alike)."""
+    top = Table(load_toml(Path(path)), str(path))
     head = top.table("topology")
     name = head.target_name("name")
     description = head.string("description", "")
     head.finish()
+    return top, name, description
+
+
+def load_planetary(path: Path | str) -> PlanetarySet:
+    """Read and check a planetary set's topology file (module docstring)."""
+    source = str(path)
+    top, name, description = topology_file(path)
     p = top.table("planetary")
     dofs = p.string("degrees_of_freedom", "lateral-torsional")
     if dofs not in DOFS:

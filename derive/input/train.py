@@ -47,6 +47,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..escape import is_target_name
+from .planetary import topology_file
 from .reader import InputError, Table, load_toml, nearest
 
 __all__ = ["Body", "Link", "Train", "TrainDynamics", "is_train", "load_train"]
@@ -173,13 +174,8 @@ def _unique(tables: list[Table], seen: set) -> None:
 
 def load_train(path: Path | str) -> Train:
     """Read and check a gear train's file (module docstring)."""
-    path = Path(path)
     source = str(path)
-    top = Table(load_toml(path), source)
-    head = top.table("topology")
-    name = head.target_name("name")
-    description = head.string("description", "")
-    head.finish()
+    top, name, description = topology_file(path)
     tr = top.table("train")
     body_tables = tr.tables("body")
     seen: set = set()
