@@ -181,13 +181,18 @@ def _cmd_simulate(args) -> int:
         peaks = ", ".join(f"{p['frequency']:.4g}" for p in row["peaks"])
         body = bodies.get(c)  # a gear train's coordinate is a body's rotation
         label = f"{c} ({body})" if body else c
-        line = f"  {label}: range [{num(low)}, {num(high)}]  peaks at {peaks or 'n/a'}"
+        # no peak where the run went: the coordinate is constant to rounding
+        none = (
+            "no peaks (constant to rounding)" if result.trajectory.status == "ok" else "peaks n/a"
+        )
+        line = f"  {label}: range [{num(low)}, {num(high)}]  " + (
+            f"peaks at {peaks}" if peaks else none
+        )
         if units.physical:
             orders = ", ".join(f"{p['order']:.3g}" for p in row["peaks"])
             what = "displacement" if hasattr(system.module, "MESHES") else "dynamic TE"
-            line = (
-                f"  {label}: {what} [{num(low, '.2f')}, {num(high, '.2f')}] µm  peaks at "
-                f"{peaks or 'n/a'} Hz (orders {orders or 'n/a'})"
+            line = f"  {label}: {what} [{num(low, '.2f')}, {num(high, '.2f')}] µm  " + (
+                f"peaks at {peaks} Hz (orders {orders})" if peaks else none
             )
             if row.get("force_range"):
                 fl, fh = row["force_range"]

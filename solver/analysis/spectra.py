@@ -33,6 +33,7 @@ class Spectrum:
     window: str
     samples: int
     duration: float
+    level: float = 0.0  # the signal's largest magnitude (its rounding sets a floor)
 
     @property
     def resolution(self) -> float:
@@ -45,13 +46,16 @@ class Spectrum:
         return np.arange(self.amplitude.size) * self.resolution
 
     def peaks(self, count: int = 5, floor: float = 1e-3) -> list[dict]:
-        """Largest local maxima above ``floor`` times the highest one."""
+        """Largest local maxima above ``floor`` times the highest one and above
+        :data:`ROUNDING` times the signal's size (``level``): a signal constant to rounding
+        (a body at rest, a loop carrying only its locked-in load) has no peaks, where the
+        relative floor alone called its rounding noise peaks."""
         a = self.amplitude
-        if a.size < 3 or not np.any(a > 0):
+        if a.size < 3 or not np.any(a > ROUNDING * self.level):
             return []
         inner = (a[1:-1] >= a[:-2]) & (a[1:-1] >= a[2:])
         idx = np.nonzero(inner)[0] + 1
-        idx = idx[a[idx] >= floor * a.max()]
+        idx = idx[(a[idx] >= floor * a.max()) & (a[idx] > ROUNDING * self.level)]
         idx = idx[np.argsort(a[idx])[::-1][:count]]
         return [
             {
@@ -103,10 +107,14 @@ def spectrum(tr: Trajectory, state: str) -> Spectrum:
         w_sum = n / 2.0  # the periodic Hann window's sum
     amp = np.abs(np.fft.rfft(z))
     amp *= 2.0 / w_sum
-    return Spectrum(amp, tr.system.omega, "hann", n, n * dt)
+    return Spectrum(amp, tr.system.omega, "hann", n, n * dt, float(np.max(np.abs(y))))
 
 
 _CACHED = 1 << 20
+# an amplitude below this share of the signal's size is rounding, not motion: far above
+# double precision's (1e-16) and below what any run of the package resolves (rtol >= 1e-12
+# of the state, whose spectral lines are then at most ~1e-12 of it in error)
+ROUNDING = 1e-10
 
 
 def extremes(tr: Trajectory) -> dict:

@@ -188,3 +188,29 @@ def test_spectrum_reads_the_closed_form_amplitude(linear_system):
     sp = spectrum(tr, "u")
     k = int(np.argmin(np.abs(sp.frequency - linear_system.omega)))
     assert sp.amplitude[k] == pytest.approx(a_exact, rel=1e-4)
+
+
+def test_a_signal_constant_to_rounding_has_no_spectral_peaks():
+    """A coordinate at rest (a loop carrying only its locked-in load) is constant up to
+    rounding: its spectrum holds noise of about 1e-16 of it, which the relative floor
+    alone reported as peaks; an oscillation of 1e-6 of the same mean keeps its peak at
+    its own frequency (the signal is built here, so the reference is the input)."""
+    from gearsym.solver.analysis.spectra import Spectrum, _hann
+
+    n, omega = 1024, 0.5
+    t = np.arange(n) * (2 * np.pi / omega) / 32  # 32 samples a period, 32 periods
+    rng = np.random.default_rng(0)
+
+    def of(y):
+        w, w_sum = _hann(n)
+        amp = np.abs(np.fft.rfft((y - y.mean()) * w)) * 2.0 / w_sum
+        return Spectrum(amp, omega, "hann", n, n * t[1], float(np.max(np.abs(y))))
+
+    rest = 2.7569 + 4e-16 * rng.standard_normal(n)
+    assert of(rest).peaks() == []
+    moving = 2.7569 + 1e-6 * np.cos(omega * t)
+    (peak,) = of(moving).peaks()
+    assert peak["per_omega"] == pytest.approx(1.0)
+    assert peak["amplitude"] == pytest.approx(1e-6, rel=1e-6)
+    # without the signal's size (level 0) the old relative floor is all there is
+    assert of(rest).__class__(of(rest).amplitude, omega, "hann", n, n * t[1]).peaks() != []
