@@ -79,6 +79,7 @@ CONTACT = {"forward": "#1b7837", "separated": "#878787", "backward": "#762a83"}
 BIFURCATIONS = {
     "fold": ("s", "#e41a1c"),
     "branch point": ("^", "#ff7f00"),  # a multiplier through +1 where the branch does not turn
+    "non-smooth fold": ("s", "#a6761d"),  # the branch turns with no multiplier at +1
     "period-doubling": ("D", "#984ea3"),
     "neimark-sacker": ("o", "#4daf4a"),
 }

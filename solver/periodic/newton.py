@@ -11,6 +11,10 @@ import numpy as np
 
 __all__ = ["NewtonError", "NewtonResult", "newton"]
 
+# what an evaluation at a trial point may raise when the point is out of reach: a failed
+# integration (RuntimeError), a singular system, a refused value, an overflow
+_TRIAL_FAILURES = (RuntimeError, ValueError, ArithmeticError, np.linalg.LinAlgError)
+
 
 class NewtonError(RuntimeError):
     """Newton's method did not converge; ``history`` holds the residual norms reached."""
@@ -53,15 +57,16 @@ def newton(
     max_iter : int
         Steps allowed.
     damped : bool
-        Halve the step until the residual's max-norm decreases (down to 1/10^4).
+        Halve the step until the residual's max-norm decreases (down to 1/10^4); a
+        trial whose evaluation fails (a flow that stops) counts as no decrease.
     singular : str
         What a singular Jacobian means, for the error message.
 
     Raises
     ------
     NewtonError
-        No convergence, a non-finite residual, a singular Jacobian or (damped) no
-        decrease along the Newton direction.
+        No convergence, a non-finite residual, a singular Jacobian, (damped) no
+        decrease along the Newton direction, or (undamped) a failed evaluation at a step.
     """
     z = np.asarray(z0, dtype=float).copy()
     F, J, extra = fun(z)
@@ -77,18 +82,32 @@ def newton(
             step = np.linalg.solve(J, -F)
         except np.linalg.LinAlgError:
             raise NewtonError(singular, history) from None
-        lam = 1.0
+        lam, failed = 1.0, None
         while True:
             trial = z + lam * step
-            Ft, Jt, et = fun(trial)
-            nt = float(np.max(np.abs(Ft)))
+            try:
+                Ft, Jt, et = fun(trial)
+            except NewtonError:
+                raise
+            except _TRIAL_FAILURES as err:
+                # a trial the flow cannot reach (an integration that stops, a state the
+                # model refuses) is no decrease: a shorter step is tried, as for a larger
+                # residual, instead of ending the whole solve there
+                if not damped:
+                    raise NewtonError(
+                        f"the Newton step's evaluation failed: {err}", history
+                    ) from None
+                failed, nt = str(err), float("inf")
+            else:
+                failed, nt = None, float(np.max(np.abs(Ft)))
             if not damped or nt < norm:
                 break
             lam /= 2
             if lam < 1e-4:
+                why = f" (the shortest step's evaluation failed: {failed})" if failed else ""
                 raise NewtonError(
                     f"Newton's line search found no decrease of the residual "
-                    f"({norm:.3g}) after {steps} iterations",
+                    f"({norm:.3g}) after {steps} iterations{why}",
                     history,
                 )
         z, F, J, extra, norm = trial, Ft, Jt, et, nt

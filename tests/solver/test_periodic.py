@@ -97,8 +97,27 @@ def test_fold_of_a_hardening_duffing_oscillator_against_brute_force():
         ).x_final
     lo, hi = _fold_sweep(system, upper - 0.05, upper + 0.05, 0.005, state)
     assert lo - 0.005 <= upper <= hi + 1e-9, (upper, lo, hi)
-    multiplier = [b.multiplier for b in branch.bifurcations if b.value == upper][0]
-    assert abs(multiplier - 1.0) < 1e-3
+    (fold,) = [b for b in branch.bifurcations if b.value == upper]
+    assert abs(fold.multiplier - 1.0) < 1e-3
+    # a smooth fold: the branch turns and a multiplier sits at +1, so it keeps its name
+    assert fold.turns and fold.name == "fold"
+
+
+def test_a_turn_without_a_multiplier_at_one_is_a_non_smooth_fold():
+    """The rig's load continuation turns at load_factor = 0.11437 where an orbit grazes
+    a mesh's contact edge; its multipliers there (nearest +1: -0.029 + 0.037i) jump
+    instead of passing +1, so the smooth fold's evidence is missing (a hand-made record
+    with those numbers; the smooth fold of the Duffing test above keeps its name)."""
+    from gearsym.solver.periodic.records import Bifurcation
+
+    def fold(mu, turns):
+        return Bifurcation("fold", 0.11437, np.zeros(2), mu, "load_factor", 3, {}, turns)
+
+    assert fold(complex(-0.028723, 0.036943), True).name == "non-smooth fold"
+    assert fold(complex(-0.028723, 0.036943), True).to_dict()["name"] == "non-smooth fold"
+    assert fold(1.0 + 1e-4, True).name == "fold"
+    assert fold(1.0 + 1e-4, False).name == "branch point"
+    assert fold(None, True).name == "fold"  # no stability: nothing to tell it by
 
 
 def _period_two(system, state):
