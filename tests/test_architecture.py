@@ -111,6 +111,7 @@ def test_the_formatter_is_switched_off_at_most_twenty_times():
 SOLVER_ORDER = {
     "__init__": 9,
     "_json": 0,
+    "_matfile": 0,
     "_memory": 0,
     "_warnings": 0,
     "cache": 0,

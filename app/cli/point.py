@@ -182,9 +182,7 @@ def _cmd_simulate(args) -> int:
         body = bodies.get(c)  # a gear train's coordinate is a body's rotation
         label = f"{c} ({body})" if body else c
         # no peak where the run went: the coordinate is constant to rounding
-        none = (
-            "no peaks (constant to rounding)" if result.trajectory.status == "ok" else "peaks n/a"
-        )
+        none = "no peaks (constant to rounding)" if tr.status == "ok" else "peaks n/a"
         line = f"  {label}: range [{num(low)}, {num(high)}]  " + (
             f"peaks at {peaks}" if peaks else none
         )
