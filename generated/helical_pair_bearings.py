@@ -774,6 +774,125 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
 }
 """
 
+# The Jacobian's nonzero entries in C: the monodromy's (x, W)' = (F, J W) in one
+# run (solver/integrate/native/monodromy.c).
+C_JACOBIAN = r"""
+/* the Jacobian's nonzero entries, row-major, for the compiled monodromy */
+#define GS_NJ 45
+static const int GS_JROW[45] = {0, 1, 2, 3, 4, 5, 6, 7, 7, 7, 7, 7, 7, 7, 7, 7, 7, 7, 7, 7, 7, 8, 8, 8, 8, 9, 9, 9, 9, 10, 10, 10, 10, 11, 11, 11, 11, 12, 12, 12, 12, 13, 13, 13, 13};
+static const int GS_JCOL[45] = {7, 8, 9, 10, 11, 12, 13, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 0, 1, 7, 8, 0, 2, 7, 9, 0, 3, 7, 10, 0, 4, 7, 11, 0, 5, 7, 12, 0, 6, 7, 13};
+
+static inline void gs_jac(double tau, const double *x, const double *p, double *J)
+{
+    const double m_u = x[0];
+    const double m_omega = p[0];
+    const double m_xi_u_u = p[2];
+    const double m_xi_u_xp = p[3];
+    const double m_xi_u_yp = p[4];
+    const double m_xi_u_zp = p[5];
+    const double m_xi_u_xg = p[6];
+    const double m_xi_u_yg = p[7];
+    const double m_xi_u_zg = p[8];
+    const double m_xi_xp_u = p[9];
+    const double m_xi_xp_xp = p[10];
+    const double m_xi_yp_u = p[11];
+    const double m_xi_yp_yp = p[12];
+    const double m_xi_zp_u = p[13];
+    const double m_xi_zp_zp = p[14];
+    const double m_xi_xg_u = p[15];
+    const double m_xi_xg_xg = p[16];
+    const double m_xi_yg_u = p[17];
+    const double m_xi_yg_yg = p[18];
+    const double m_xi_zg_u = p[19];
+    const double m_xi_zg_zg = p[20];
+    const double m_kappa_u_u = p[21];
+    const double m_kappa_u_xp = p[22];
+    const double m_kappa_u_yp = p[23];
+    const double m_kappa_u_zp = p[24];
+    const double m_kappa_u_xg = p[25];
+    const double m_kappa_u_yg = p[26];
+    const double m_kappa_u_zg = p[27];
+    const double m_kappa_xp_u = p[28];
+    const double m_kappa_xp_xp = p[29];
+    const double m_kappa_yp_u = p[30];
+    const double m_kappa_yp_yp = p[31];
+    const double m_kappa_zp_u = p[32];
+    const double m_kappa_zp_zp = p[33];
+    const double m_kappa_xg_u = p[34];
+    const double m_kappa_xg_xg = p[35];
+    const double m_kappa_yg_u = p[36];
+    const double m_kappa_yg_yg = p[37];
+    const double m_kappa_zg_u = p[38];
+    const double m_kappa_zg_zg = p[39];
+    const double m_kc_u_1 = p[40];
+    const double m_ks_u_1 = p[41];
+    const double m_kc_u_2 = p[42];
+    const double m_ks_u_2 = p[43];
+    const double m_kc_u_3 = p[44];
+    const double m_ks_u_3 = p[45];
+    const double m_g1 = p[48];
+    const double m_g3 = p[49];
+    const double m_g5 = p[50];
+    const double m_g7 = p[51];
+    const double j_0 = ((m_u)*(m_u));
+    const double j_1 = m_g5 + m_g7*j_0;
+    const double j_2 = m_g3 + j_0*j_1;
+    const double j_3 = m_omega*tau;
+    const double j_4 = 2*j_3;
+    const double j_5 = 3*j_3;
+    const double j_6 = m_kc_u_1*cos(j_3) + m_kc_u_2*cos(j_4) + m_kc_u_3*cos(j_5) + m_ks_u_1*sin(j_3) + m_ks_u_2*sin(j_4) + m_ks_u_3*sin(j_5) + 1;
+    const double j_7 = j_6*(m_g1 + j_0*j_2);
+    const double j_8 = 2*m_u;
+    const double j_9 = j_6*m_u*(j_0*(2*m_g7*((m_u)*(m_u)*(m_u)) + j_1*j_8) + j_2*j_8);
+    J[0] = 1;
+    J[1] = 1;
+    J[2] = 1;
+    J[3] = 1;
+    J[4] = 1;
+    J[5] = 1;
+    J[6] = 1;
+    J[7] = -j_7*m_kappa_u_u - j_9*m_kappa_u_u;
+    J[8] = -m_kappa_u_xp;
+    J[9] = -m_kappa_u_yp;
+    J[10] = -m_kappa_u_zp;
+    J[11] = -m_kappa_u_xg;
+    J[12] = -m_kappa_u_yg;
+    J[13] = -m_kappa_u_zg;
+    J[14] = -2*m_xi_u_u;
+    J[15] = -2*m_xi_u_xp;
+    J[16] = -2*m_xi_u_yp;
+    J[17] = -2*m_xi_u_zp;
+    J[18] = -2*m_xi_u_xg;
+    J[19] = -2*m_xi_u_yg;
+    J[20] = -2*m_xi_u_zg;
+    J[21] = -j_7*m_kappa_xp_u - j_9*m_kappa_xp_u;
+    J[22] = -m_kappa_xp_xp;
+    J[23] = -2*m_xi_xp_u;
+    J[24] = -2*m_xi_xp_xp;
+    J[25] = -j_7*m_kappa_yp_u - j_9*m_kappa_yp_u;
+    J[26] = -m_kappa_yp_yp;
+    J[27] = -2*m_xi_yp_u;
+    J[28] = -2*m_xi_yp_yp;
+    J[29] = -j_7*m_kappa_zp_u - j_9*m_kappa_zp_u;
+    J[30] = -m_kappa_zp_zp;
+    J[31] = -2*m_xi_zp_u;
+    J[32] = -2*m_xi_zp_zp;
+    J[33] = -j_7*m_kappa_xg_u - j_9*m_kappa_xg_u;
+    J[34] = -m_kappa_xg_xg;
+    J[35] = -2*m_xi_xg_u;
+    J[36] = -2*m_xi_xg_xg;
+    J[37] = -j_7*m_kappa_yg_u - j_9*m_kappa_yg_u;
+    J[38] = -m_kappa_yg_yg;
+    J[39] = -2*m_xi_yg_u;
+    J[40] = -2*m_xi_yg_yg;
+    J[41] = -j_7*m_kappa_zg_u - j_9*m_kappa_zg_u;
+    J[42] = -m_kappa_zg_zg;
+    J[43] = -2*m_xi_zg_u;
+    J[44] = -2*m_xi_zg_zg;
+    (void)tau; (void)x; (void)p; (void)J;
+}
+"""
+
 
 def rhs(tau, x, p):
     """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); result (n,) or (n, N)."""

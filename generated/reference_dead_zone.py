@@ -527,6 +527,62 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
 }
 """
 
+# The Jacobian's nonzero entries in C: the monodromy's (x, W)' = (F, J W) in one
+# run (solver/integrate/native/monodromy.c).
+C_JACOBIAN = r"""
+/* the Jacobian's nonzero entries, row-major, for the compiled monodromy */
+#define GS_NJ 10
+static const int GS_JROW[10] = {0, 1, 2, 2, 2, 2, 3, 3, 3, 3};
+static const int GS_JCOL[10] = {2, 3, 0, 1, 2, 3, 0, 1, 2, 3};
+
+static inline void gs_jac(double tau, const double *x, const double *p, double *J)
+{
+    const double m_u = x[0];
+    const double m_v = x[1];
+    const double m_omega = p[0];
+    const double m_xi_u_u = p[3];
+    const double m_xi_u_v = p[4];
+    const double m_xi_v_u = p[5];
+    const double m_xi_v_v = p[6];
+    const double m_kappa_u_u = p[7];
+    const double m_kappa_u_v = p[8];
+    const double m_kappa_v_u = p[9];
+    const double m_kappa_v_v = p[10];
+    const double m_kc_u_1 = p[11];
+    const double m_ks_u_1 = p[12];
+    const double m_kc_u_2 = p[13];
+    const double m_ks_u_2 = p[14];
+    const double m_kc_u_3 = p[15];
+    const double m_ks_u_3 = p[16];
+    const double m_kc_v_1 = p[17];
+    const double m_ks_v_1 = p[18];
+    const double m_kc_v_2 = p[19];
+    const double m_ks_v_2 = p[20];
+    const double m_kc_v_3 = p[21];
+    const double m_ks_v_3 = p[22];
+    const double m_phi_v = p[23];
+    const double j_0 = m_omega*tau;
+    const double j_1 = 2*j_0;
+    const double j_2 = 3*j_0;
+    const double j_3 = (m_kc_u_1*cos(j_0) + m_kc_u_2*cos(j_1) + m_kc_u_3*cos(j_2) + m_ks_u_1*sin(j_0) + m_ks_u_2*sin(j_1) + m_ks_u_3*sin(j_2) + 1)*((m_u > 1 || m_u < -1) ? (1) : (0));
+    const double j_4 = j_0 - m_phi_v;
+    const double j_5 = j_1 - 2*m_phi_v;
+    const double j_6 = j_2 - 3*m_phi_v;
+    const double j_7 = (m_kc_v_1*cos(j_4) + m_kc_v_2*cos(j_5) + m_kc_v_3*cos(j_6) + m_ks_v_1*sin(j_4) + m_ks_v_2*sin(j_5) + m_ks_v_3*sin(j_6) + 1)*((m_v > 1 || m_v < -1) ? (1) : (0));
+    J[0] = 1;
+    J[1] = 1;
+    J[2] = -j_3*m_kappa_u_u;
+    J[3] = -j_7*m_kappa_u_v;
+    J[4] = -2*m_xi_u_u;
+    J[5] = -2*m_xi_u_v;
+    J[6] = -j_3*m_kappa_v_u;
+    J[7] = -j_7*m_kappa_v_v;
+    J[8] = -2*m_xi_v_u;
+    J[9] = -2*m_xi_v_v;
+    (void)tau; (void)x; (void)p; (void)J;
+}
+"""
+
 
 def rhs(tau, x, p):
     """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); result (n,) or (n, N)."""

@@ -574,6 +574,79 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
 }
 """
 
+# The Jacobian's nonzero entries in C: the monodromy's (x, W)' = (F, J W) in one
+# run (solver/integrate/native/monodromy.c).
+C_JACOBIAN = r"""
+/* the Jacobian's nonzero entries, row-major, for the compiled monodromy */
+#define GS_NJ 10
+static const int GS_JROW[10] = {0, 1, 2, 2, 2, 2, 3, 3, 3, 3};
+static const int GS_JCOL[10] = {2, 3, 0, 1, 2, 3, 0, 1, 2, 3};
+
+static inline void gs_jac(double tau, const double *x, const double *p, double *J)
+{
+    const double m_u = x[0];
+    const double m_v = x[1];
+    const double m_omega = p[0];
+    const double m_xi_u_u = p[3];
+    const double m_xi_u_v = p[4];
+    const double m_xi_v_u = p[5];
+    const double m_xi_v_v = p[6];
+    const double m_kappa_u_u = p[7];
+    const double m_kappa_u_v = p[8];
+    const double m_kappa_v_u = p[9];
+    const double m_kappa_v_v = p[10];
+    const double m_kc_u_1 = p[11];
+    const double m_ks_u_1 = p[12];
+    const double m_kc_u_2 = p[13];
+    const double m_ks_u_2 = p[14];
+    const double m_kc_u_3 = p[15];
+    const double m_ks_u_3 = p[16];
+    const double m_kc_v_1 = p[17];
+    const double m_ks_v_1 = p[18];
+    const double m_kc_v_2 = p[19];
+    const double m_ks_v_2 = p[20];
+    const double m_kc_v_3 = p[21];
+    const double m_ks_v_3 = p[22];
+    const double m_phi_v = p[23];
+    const double m_g1 = p[28];
+    const double m_g3 = p[29];
+    const double m_g5 = p[30];
+    const double m_g7 = p[31];
+    const double j_0 = ((m_u)*(m_u));
+    const double j_1 = m_g5 + m_g7*j_0;
+    const double j_2 = m_g3 + j_0*j_1;
+    const double j_3 = m_omega*tau;
+    const double j_4 = 2*j_3;
+    const double j_5 = 3*j_3;
+    const double j_6 = m_kc_u_1*cos(j_3) + m_kc_u_2*cos(j_4) + m_kc_u_3*cos(j_5) + m_ks_u_1*sin(j_3) + m_ks_u_2*sin(j_4) + m_ks_u_3*sin(j_5) + 1;
+    const double j_7 = j_6*(m_g1 + j_0*j_2);
+    const double j_8 = 2*m_u;
+    const double j_9 = 2*m_g7;
+    const double j_10 = j_6*m_u*(j_0*(j_1*j_8 + j_9*((m_u)*(m_u)*(m_u))) + j_2*j_8);
+    const double j_11 = ((m_v)*(m_v));
+    const double j_12 = m_g5 + m_g7*j_11;
+    const double j_13 = m_g3 + j_11*j_12;
+    const double j_14 = j_3 - m_phi_v;
+    const double j_15 = j_4 - 2*m_phi_v;
+    const double j_16 = j_5 - 3*m_phi_v;
+    const double j_17 = m_kc_v_1*cos(j_14) + m_kc_v_2*cos(j_15) + m_kc_v_3*cos(j_16) + m_ks_v_1*sin(j_14) + m_ks_v_2*sin(j_15) + m_ks_v_3*sin(j_16) + 1;
+    const double j_18 = j_17*(m_g1 + j_11*j_13);
+    const double j_19 = 2*m_v;
+    const double j_20 = j_17*m_v*(j_11*(j_12*j_19 + j_9*((m_v)*(m_v)*(m_v))) + j_13*j_19);
+    J[0] = 1;
+    J[1] = 1;
+    J[2] = -j_10*m_kappa_u_u - j_7*m_kappa_u_u;
+    J[3] = -j_18*m_kappa_u_v - j_20*m_kappa_u_v;
+    J[4] = -2*m_xi_u_u;
+    J[5] = -2*m_xi_u_v;
+    J[6] = -j_10*m_kappa_v_u - j_7*m_kappa_v_u;
+    J[7] = -j_18*m_kappa_v_v - j_20*m_kappa_v_v;
+    J[8] = -2*m_xi_v_u;
+    J[9] = -2*m_xi_v_v;
+    (void)tau; (void)x; (void)p; (void)J;
+}
+"""
+
 
 def rhs(tau, x, p):
     """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); result (n,) or (n, N)."""

@@ -273,6 +273,34 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
 }
 """
 
+# The Jacobian's nonzero entries in C: the monodromy's (x, W)' = (F, J W) in one
+# run (solver/integrate/native/monodromy.c).
+C_JACOBIAN = r"""
+/* the Jacobian's nonzero entries, row-major, for the compiled monodromy */
+#define GS_NJ 8
+static const int GS_JROW[8] = {0, 1, 2, 2, 2, 3, 3, 3};
+static const int GS_JCOL[8] = {2, 3, 0, 1, 2, 0, 1, 3};
+
+static inline void gs_jac(double tau, const double *x, const double *p, double *J)
+{
+    const double m_xi_u_u = p[3];
+    const double m_xi_v_v = p[4];
+    const double m_kappa_u_u = p[5];
+    const double m_kappa_u_v = p[6];
+    const double m_kappa_v_u = p[7];
+    const double m_kappa_v_v = p[8];
+    J[0] = 1;
+    J[1] = 1;
+    J[2] = -m_kappa_u_u;
+    J[3] = -m_kappa_u_v;
+    J[4] = -2*m_xi_u_u;
+    J[5] = -m_kappa_v_u;
+    J[6] = -m_kappa_v_v;
+    J[7] = -2*m_xi_v_v;
+    (void)tau; (void)x; (void)p; (void)J;
+}
+"""
+
 
 def rhs(tau, x, p):
     """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); result (n,) or (n, N)."""

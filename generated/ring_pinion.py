@@ -356,6 +356,45 @@ static void gs_rhs_batch(double tau, int n, const double *restrict X, const doub
 }
 """
 
+# The Jacobian's nonzero entries in C: the monodromy's (x, W)' = (F, J W) in one
+# run (solver/integrate/native/monodromy.c).
+C_JACOBIAN = r"""
+/* the Jacobian's nonzero entries, row-major, for the compiled monodromy */
+#define GS_NJ 3
+static const int GS_JROW[3] = {0, 1, 1};
+static const int GS_JCOL[3] = {1, 0, 1};
+
+static inline void gs_jac(double tau, const double *x, const double *p, double *J)
+{
+    const double m_u = x[0];
+    const double m_omega = p[0];
+    const double m_xi_u_u = p[2];
+    const double m_kappa_u_u = p[3];
+    const double m_kc_u_1 = p[4];
+    const double m_ks_u_1 = p[5];
+    const double m_kc_u_2 = p[6];
+    const double m_ks_u_2 = p[7];
+    const double m_kc_u_3 = p[8];
+    const double m_ks_u_3 = p[9];
+    const double m_g1 = p[12];
+    const double m_g3 = p[13];
+    const double m_g5 = p[14];
+    const double m_g7 = p[15];
+    const double j_0 = ((m_u)*(m_u));
+    const double j_1 = m_g5 + m_g7*j_0;
+    const double j_2 = m_g3 + j_0*j_1;
+    const double j_3 = m_omega*tau;
+    const double j_4 = 2*j_3;
+    const double j_5 = 3*j_3;
+    const double j_6 = m_kappa_u_u*(m_kc_u_1*cos(j_3) + m_kc_u_2*cos(j_4) + m_kc_u_3*cos(j_5) + m_ks_u_1*sin(j_3) + m_ks_u_2*sin(j_4) + m_ks_u_3*sin(j_5) + 1);
+    const double j_7 = 2*m_u;
+    J[0] = 1;
+    J[1] = -j_6*m_u*(j_0*(2*m_g7*((m_u)*(m_u)*(m_u)) + j_1*j_7) + j_2*j_7) - j_6*(m_g1 + j_0*j_2);
+    J[2] = -2*m_xi_u_u;
+    (void)tau; (void)x; (void)p; (void)J;
+}
+"""
+
 
 def rhs(tau, x, p):
     """dX/dtau.  x: (n,) or (n, N); p: (P,) or (P, N); result (n,) or (n, N)."""

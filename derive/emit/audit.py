@@ -360,7 +360,9 @@ def index_page(models: list[Model], command: str) -> str:
         "$x_i = c$, the valid range); `rhs(tau, x, p)`, `jacobian(tau, x, p)`, "
         "`parameters(**values)`, `casadi_functions()`, `STRUCTURE` (the physical mass "
         "matrix, $R$ and the springs, for `gearsym modes`), and the C right-hand side `C_SOURCE` "
-        "(with its variational form `C_SOURCE_VARIATIONAL`). A solver reads `CONTRACT`, "
+        "(with its variational form `C_SOURCE_VARIATIONAL`, and `C_JACOBIAN`, the "
+        "Jacobian's nonzero entries, from which the monodromy runs as one matrix). A "
+        "solver reads `CONTRACT`, "
         "never the source or a naming pattern.\n",
         "## Targets\n",
         "| target | source | states | parameters | operations (rhs / rhs + Jacobian) | page |",

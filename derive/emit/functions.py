@@ -1,5 +1,5 @@
 """The functions every generated module defines, written once for each kind of model: the
-C source (plain and with the variational equations), NumPy ``rhs`` and ``jacobian`` with
+C source (plain, with the variational equations, the Jacobian), NumPy ``rhs`` and ``jacobian`` with
 their ``_broadcast`` helper, and ``casadi_functions``.  A model here is anything with
 ``state_symbols``, ``parameter_symbols``, ``parameters``, ``rhs`` and a row-major
 ``jacobian`` (a tree's ``Model``, a planetary set's ``PlanetaryDynamics``)."""
@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from ..escape import code_names
 from .c import c_source
+from .c_jacobian import jacobian_source
 from .printer import CodePrinter, function_body
 
 __all__ = ["Emitted"]
@@ -33,7 +34,8 @@ class Emitted:
 
     def c_lines(self) -> list[str]:
         plain, variational = c_source(self.model), c_source(self.model, variational=True)
-        for c_text in (plain, variational):  # it goes into r"""...""": nothing may end it
+        jacobian = jacobian_source(self.model)
+        for c_text in (plain, variational, jacobian):  # in r"""...""": nothing may end it
             if '"""' in c_text or c_text.rstrip("\n").endswith("\\"):
                 raise ValueError("the C source cannot be held in a raw triple-quoted string")
         return [
@@ -45,6 +47,12 @@ class Emitted:
             "# The same with the variational equations (x, w)' = (F, J w), for Lyapunov exponents.",
             'C_SOURCE_VARIATIONAL = r"""',
             variational.rstrip("\n"),
+            '"""',
+            "",
+            "# The Jacobian's nonzero entries in C: the monodromy's (x, W)' = (F, J W) in one",
+            "# run (solver/integrate/native/monodromy.c).",
+            'C_JACOBIAN = r"""',
+            jacobian.rstrip("\n"),
             '"""',
             "",
             "",

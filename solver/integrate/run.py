@@ -230,6 +230,16 @@ def _monodromy(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec, backend: st
     (which fails the point, its monodromy NaN)."""
     N, n = X0.shape
     inner = spec.with_(collect=tuple(c for c in spec.collect if c != "monodromy"))
+    if backend != "numpy":
+        from .native.build import NativeUnavailable, monodromy_library
+
+        if monodromy_library(module):
+            try:
+                return _matrix_monodromy(module, P, X0, inner)
+            except NativeUnavailable as err:  # the copies below, said once
+                from .native.fallback import fallback_warning
+
+                fallback_warning(err, "the monodromy's tangents as copies of the state instead")
     tangent0 = np.tile(np.eye(n), (N, 1))
     P, X0 = np.repeat(P, n, axis=0), np.repeat(X0, n, axis=0)
     res = _engine(module, P, X0, inner, backend, tangent0)
@@ -260,6 +270,29 @@ def _monodromy(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec, backend: st
         monodromy=M,
         tangent=None,
     )
+
+
+def _matrix_monodromy(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec) -> RunResult:
+    """Each point run once with the matrix of tangents from the identity (the monodromy
+    library, ``native/monodromy.c``): the monodromy is the matrix's end times its growth;
+    a failed point's is NaN.  A piecewise force law's points take their own steps, as
+    in :func:`_compiled`."""
+    from .native.engine import run_compiled
+
+    N, n = X0.shape
+    # the identity scaled to unit norm: the engine rescales the tangent block at the start
+    # too, without counting that growth
+    W0 = np.tile(np.eye(n).ravel() / np.sqrt(n), (N, 1))
+    piecewise = Contract.of(module).piecewise
+    res = run_compiled(
+        module, P, X0, spec.with_(group=1) if piecewise else spec, W0, monodromy=True
+    )
+    growth = np.sqrt(n) * np.exp(res.tangent[:, n * n :])[:, :, None]
+    M = res.tangent[:, : n * n].reshape(N, n, n) * growth
+    for i in range(N):
+        if res.status[i] != "ok":
+            M[i] = np.nan
+    return replace(res, monodromy=M, tangent=None)
 
 
 def _compiled(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec, tangent0=None) -> RunResult:

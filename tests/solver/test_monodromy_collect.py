@@ -111,3 +111,36 @@ def test_the_orbit_check_names_its_route_when_it_fails_too():
     smooth = check_orbit(System.load("reference_light"), x, 1, max_iter=0)
     assert not smooth.converged and "variational" in smooth.describe()["method"]
     assert "multiplier_error_note" not in smooth.describe()
+
+
+@pytest.mark.parametrize(
+    "name,values",
+    [
+        ("reference-light", {"lambda": 0.4}),
+        ("lin-parker-1999-3-backlash", {"mesh_frequency_hz": 2000.0}),
+        ("back-to-back-rig", {}),
+    ],
+)
+def test_the_matrix_of_tangents_gives_the_monodromy_of_the_tangents_one_by_one(
+    name, values, monkeypatch
+):
+    """The monodromy library (F and the Jacobian's nonzero entries once a stage, J W over
+    them: derive/emit/c_jacobian.py, native/monodromy.c) against the route it replaces,
+    one copy of the state per tangent through the variational library (J w generated
+    apart, from C_SOURCE_VARIATIONAL): the same matrix to rounding, also for the dead
+    zones of the planetary set and the rig."""
+    from gearsym.resolve import load
+    from gearsym.solver.integrate.native import build
+
+    system = load(name).with_values(**values)
+    assert build.monodromy_library(system.module)
+    start = RunSpec(method="dop853", rtol=1e-8, atol=1e-10, transient=200, periods=1)
+    x = integrate(system, np.full(system.n, 0.01), start).x[0, -1]
+    matrix = integrate(system, x, _spec(1))
+    monkeypatch.setattr(build, "monodromy_library", lambda module: False)
+    copies = integrate(system, x, _spec(1))
+    scale = np.abs(copies.monodromy).max()
+    np.testing.assert_allclose(matrix.monodromy, copies.monodromy, rtol=0, atol=1e-10 * scale)
+    np.testing.assert_allclose(matrix.x, copies.x, rtol=0, atol=1e-12)
+    # one run of n + n^2 states, where the copies made n runs of 2n
+    assert matrix.nfev[0] < copies.nfev[0] / 4

@@ -93,11 +93,14 @@ def _period(contract: Contract, P: np.ndarray, spec: RunSpec) -> tuple[float, in
     return 2.0 * np.pi / float(omega[0]), iw
 
 
-def run_compiled(module, P, X0, spec: RunSpec, tangent0=None) -> RunResult:
+def run_compiled(module, P, X0, spec: RunSpec, tangent0=None, monodromy=False) -> RunResult:
     """Integrate every row ``P[i]`` (N, n_p) from ``X0[i]`` (N, n) of ``module`` as
     ``spec`` says, in the compiled engine.  ``tangent0`` (N, n), with the exponent
     collected from the run's start: each point's tangent start (default one unit vector
     drawn from ``spec.seed`` for all), and the result's ``tangent`` gives its end.
+    ``monodromy``: the library with the matrix of tangents (``build.monodromy_library``),
+    ``tangent0`` (N, n * n) each point's matrix, row-major, and ``tangent`` its end (the
+    matrix scaled to unit norm, then its log growth).
 
     Returns a :class:`~..spec.RunResult` (``backend="native"``; ``exits`` in tau, None
     with ``valid_range="ignore"``).  Raises ``ValueError`` on inputs the spec cannot run,
@@ -111,17 +114,19 @@ def run_compiled(module, P, X0, spec: RunSpec, tangent0=None) -> RunResult:
     N, n = X0.shape
     collect = set(spec.collect)
     tangent = "exponent" in collect
-    if tangent0 is not None:
+    m = n * n if monodromy else n  # the tangent block's length
+    if tangent0 is not None or monodromy:
         tangent0 = np.ascontiguousarray(tangent0, dtype=float)
         if (
             not tangent
-            or tangent0.shape != (N, n)
+            or tangent0.shape != (N, m)
             or spec.lyapunov_periods != (spec.transient + spec.periods)
         ):
             raise ValueError(
-                f"tangent0 must be ({N}, {n}), with the exponent collected from the start"
+                f"tangent0 must be ({N}, {m}), with the exponent collected from the start"
             )
-    lib, facts = library(module, variational=tangent, shared=shared_parameters(P))
+    kind = "monodromy" if monodromy else tangent
+    lib, facts = library(module, variational=kind, shared=shared_parameters(P))
     K, L = spec.n_samples, spec.lyapunov_periods
     check = spec.valid_range != "ignore"
     bounds = np.full(n, np.inf)
@@ -136,7 +141,7 @@ def run_compiled(module, P, X0, spec: RunSpec, tangent0=None) -> RunResult:
         "xmin": np.empty((N, n)) if "extremes" in collect else None,
         "xmax": np.empty((N, n)) if "extremes" in collect else None,
         "exponent": np.empty((N, L)) if tangent else None,
-        "tangent": np.empty((N, n + 1)) if tangent0 is not None else None,
+        "tangent": np.empty((N, m + 1)) if tangent0 is not None else None,
         "nfev": np.zeros(N, dtype=np.int64),
         "nsteps": np.zeros(N, dtype=np.int64),
         "status": np.zeros(N, dtype=np.int32),
@@ -147,12 +152,12 @@ def run_compiled(module, P, X0, spec: RunSpec, tangent0=None) -> RunResult:
         "P": N * P.shape[1],
         "X0": N * n,
         "bounds": n,
-        "tangent0": n if tangent0 is None else N * n,
+        "tangent0": n if tangent0 is None else N * m,
         "x": N * K * n,
         "xmin": N * n,
         "xmax": N * n,
         "exponent": N * L,
-        "tangent": N * (n + 1),
+        "tangent": N * (m + 1),
         "nfev": N,
         "nsteps": N,
         "status": N,

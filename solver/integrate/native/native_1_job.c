@@ -112,7 +112,9 @@ static const gs_tableau GS_TABLEAUX[3] = {
 };
 #define GS_KROWS 16 /* DOP853: 12 stages, the FSAL stage and 3 of the dense output */
 
-#ifdef GS_VARIATIONAL
+#if defined(GS_MONODROMY_N) /* the state and the matrix W (monodromy.c) */
+#define GS_NSTATE GS_MONODROMY_N
+#elif defined(GS_VARIATIONAL)
 #define GS_NSTATE (GS_NX / 2)
 #else
 #define GS_NSTATE GS_NX
