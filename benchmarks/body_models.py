@@ -91,8 +91,8 @@ def sweep_times(repeats: int) -> dict:
 def point_split(repeats: int) -> dict:
     """Where one sweep point's compute goes, on one core, at 12 mesh frequencies of the
     sweep's range: the 300 + 100-period run (rtol 1e-8) against the shooting check of its
-    end state (Newton, variational monodromy at rtol 1e-12: n copies of the state, each
-    with a tangent); seconds summed over the frequencies, medians of the repeats."""
+    end state (Newton, the monodromy at rtol 1e-12: the state and its matrix of tangents
+    in one run); seconds summed over the frequencies, medians of the repeats."""
     from gearsym.resolve import load
     from gearsym.solver.analysis.orbit_check import check_orbit
     from gearsym.solver.integrate.run import integrate
@@ -183,9 +183,8 @@ def page(derive: dict, sweep: dict, split: dict, rows: list[dict], when, machine
         "",
         "What a point computes, on one core at 12 mesh frequencies of the sweep's range: the "
         f"300 + 100-period run {split['run']:.2f} s, the shooting check of its end state "
-        f"{split['check']:.2f} s (its variational monodromy at rtol 1e-12 integrates one "
-        "copy of the 34 states, each with a tangent, per state: 68 times the run's work a "
-        "step over one period). Half the sweep's compute is that check.",
+        f"{split['check']:.2f} s (its monodromy at rtol 1e-12 over one period: one run of "
+        "the 34 states and their 34 x 34 matrix of tangents, native/monodromy.c).",
         "",
         "## Cost per state",
         "",

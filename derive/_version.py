@@ -8,7 +8,8 @@ __version__ = "0.1.0"
 # stiffness-sign check in parameters() (issue 14); 3: that check done once per harmonics;
 # 4: STRUCTURE (the physical matrices for the modal analysis) and models on bearings;
 # 5: PHYSICAL and the physical quantities evaluated in parameters() (issue 25); 6: the C
-# text no longer names the model (models with the same equations share a library).
+# text no longer names the model (models with the same equations share a library); 7:
+# C_JACOBIAN, the Jacobian's nonzero entries in C (the monodromy in one run).
 # ``gearsym derive --check`` names a generated file whose text changed while its inputs
 # hash did not (derive/build.py), the sign that this number was not bumped.
-EMITTED_FORMAT = 6
+EMITTED_FORMAT = 7

@@ -99,7 +99,7 @@ def frequency_response_figure(resp, physical: bool = False, title: str = ""):
                     color=mc,
                     ms=6,
                     mfc="none",
-                    label=f"{e.name}" + (" (a sweep jumps here)" if e.name == "fold" else ""),
+                    label=f"{e.name}" + (" (a sweep jumps here)" if e.jump else ""),
                 )
         ax.set_ylabel(f"half peak-to-peak of {c}" + (" (µm)" if physical else " (half backlashes)"))
         ax.grid(alpha=0.3)

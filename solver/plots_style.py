@@ -79,7 +79,10 @@ CONTACT = {"forward": "#1b7837", "separated": "#878787", "backward": "#762a83"}
 BIFURCATIONS = {
     "fold": ("s", "#e41a1c"),
     "branch point": ("^", "#ff7f00"),  # a multiplier through +1 where the branch does not turn
-    "non-smooth fold": ("s", "#a6761d"),  # the branch turns with no multiplier at +1
+    # no multiplier at the critical value there: the orbit grazes a contact edge
+    "non-smooth fold": ("s", "#a6761d"),
+    "non-smooth branch point": ("^", "#a6761d"),
+    "non-smooth period-doubling": ("D", "#a6761d"),
     "period-doubling": ("D", "#984ea3"),
     "neimark-sacker": ("o", "#4daf4a"),
 }

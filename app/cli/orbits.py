@@ -392,5 +392,7 @@ def _cmd_continue(args) -> int:
                 f"  {br.named(b):<16} {args.param} = {b.value:.8g}  multiplier "
                 f"{b.multiplier.real:+.6f}{b.multiplier.imag:+.6f}i" + (f" ({at})" if at else "")
             )
+            if "location" in b.evidence:
+                print(f"    {b.evidence['location']}")
     print(f"wrote {', '.join(p.name for p in written)} and branches.png in {out}")
     return 0

@@ -233,7 +233,7 @@ def response_figure(responses: dict, path: Path, title: str, caption: str, mark:
                     label=f"λ = {lam}, {'stable' if stable else 'unstable'}",
                 )
             for e in curve.events:
-                if e.name == "fold":
+                if e.jump:
                     i = min(max(e.index - 1, 0), len(x) - 1)
                     ax.plot(
                         e.value,

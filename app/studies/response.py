@@ -180,8 +180,12 @@ def response_section(rows) -> str:
     for r in rows:
         coords = r.resp.system.coordinates
         curve = r.resp.curves[0]
-        folds = ", ".join(f"{e.value:.4f}" for e in curve.events if e.name == "fold")
-        other = [e for e in curve.events if e.name != "fold"]
+        folds = ", ".join(
+            f"{e.value:.4f}" + ("" if e.name == "fold" else f" ({e.name})")
+            for e in curve.events
+            if e.jump
+        )
+        other = [e for e in curve.events if not e.jump]
         if other:
             folds += "; " + ", ".join(f"{e.name} at {e.value:.4f}" for e in other)
         sols = "; ".join(_fmt_solution(s, coords) for s in r.at_omega) or "none found"

@@ -180,9 +180,9 @@ def check_orbit(
         periods=n,
         valid_range="ignore",
         bound=1e6,
-        # the library with the variational equations (the monodromy's tangents; the
-        # differences' runs do not use it): the one a map's runs and the continued
-        # windows build, so a model is compiled once
+        # the monodromy by the state and its matrix of tangents in one run (run.py); the
+        # differences' runs take the library with one tangent, as a map's runs and the
+        # continued windows do
         collect=("samples", "exponent", "monodromy"),
         lyapunov_periods=n,
     )

@@ -111,9 +111,10 @@ def spectrum(tr: Trajectory, state: str) -> Spectrum:
 
 
 _CACHED = 1 << 20
-# an amplitude below this share of the signal's size is rounding, not motion: far above
-# double precision's (1e-16) and below what any run of the package resolves (rtol >= 1e-12
-# of the state, whose spectral lines are then at most ~1e-12 of it in error)
+# an amplitude below this share of the signal's size is taken for rounding, not motion:
+# far above double precision's (1e-16) and below the accuracy of the runs that make
+# spectra (rtol 1e-8 by default); a run at rtol 1e-12 resolves lines of 1e-11 of the
+# signal, which this leaves out
 ROUNDING = 1e-10
 
 

@@ -97,15 +97,18 @@ def decide_backend(
     ``shared``: the parameters equal across the batch the run takes (``library``'s), so
     that the library checked is the one the run uses (the library for any batch, built
     only to be checked, cost about a second of compiling per model and was never run)."""
-    from .native.build import NativeUnavailable, library
+    from .native.build import NativeUnavailable, library, monodromy_library
     from .native.fallback import fallback_warning
 
     if backend not in BACKENDS:
         raise ValueError(f"backend {backend!r} is unknown; backends: {', '.join(BACKENDS)}")
     if backend == "numpy":
         return backend
+    kind = "exponent" in spec.collect
+    if "monodromy" in spec.collect and monodromy_library(module):
+        kind = "monodromy"  # (else a library compiled only to be checked)
     try:
-        library(module, variational="exponent" in spec.collect, shared=shared)
+        library(module, variational=kind, shared=shared)
     except NativeUnavailable as err:
         if backend == "native":
             raise
@@ -222,12 +225,14 @@ def _engine(module, P, X0, spec: RunSpec, backend: str, tangent0=None) -> RunRes
 
 
 def _monodromy(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec, backend: str) -> RunResult:
-    """Each point run once per state, the tangent starting from that unit vector (the
-    copies of a point side by side, so that a lock-step group mostly holds them together;
-    copies in other groups differ by the steps only, about 1e-12): the
-    monodromy's column k is the tangent's end times its growth.  The point's samples,
-    extremes and exponent are those of its first copy, or of its first copy that failed
-    (which fails the point, its monodromy NaN)."""
+    """The monodromy of each point: by the monodromy library (:func:`_matrix_monodromy`,
+    one run of the state and the matrix of tangents) where the model has its Jacobian in
+    C and the engine is compiled; else each point run once per state, the tangent
+    starting from that unit vector (the copies of a point side by side, so that a
+    lock-step group mostly holds them together; copies in other groups differ by the
+    steps only, about 1e-12): the monodromy's column k is the tangent's end times its
+    growth.  The point's samples, extremes and exponent are then those of its first
+    copy, or of its first copy that failed (which fails the point, its monodromy NaN)."""
     N, n = X0.shape
     inner = spec.with_(collect=tuple(c for c in spec.collect if c != "monodromy"))
     if backend != "numpy":
@@ -292,7 +297,8 @@ def _matrix_monodromy(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec) -> R
     for i in range(N):
         if res.status[i] != "ok":
             M[i] = np.nan
-    return replace(res, monodromy=M, tangent=None)
+    # the growth of the whole matrix is no exponent's estimate: none is given
+    return replace(res, monodromy=M, tangent=None, exponent=None)
 
 
 def _compiled(module, P: np.ndarray, X0: np.ndarray, spec: RunSpec, tangent0=None) -> RunResult:

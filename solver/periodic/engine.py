@@ -304,15 +304,20 @@ def _locate(problem, z0, t0, ds, kind, k, ends, s: Settings, index) -> Bifurcati
     to the step when that is longer than 1) or the test is below 1e-12."""
     a, b = 0.0, ds
     f_a, f_b = float(ends[0]), float(ends[1])
-    z_mid, lin, side = z0, None, 0
+    z_mid, lin, side, failed = z0, None, 0, None
     for _ in range(40):
         mid = b - f_b * (b - a) / (f_b - f_a) if f_b != f_a else 0.5 * (a + b)
         if not min(a, b) < mid < max(a, b):
             mid = 0.5 * (a + b)
         try:
             z_try, _, lin_try = correct(problem, z0 + mid * t0, t0, s.tol, s.locate_iter)
-        except FAILURES:
-            break  # keep the bracket reached so far
+        except FAILURES as err:  # keep the bracket reached so far, and say so
+            why = str(err).splitlines()[0] if str(err) else type(err).__name__
+            failed = (
+                f"not located: the corrector failed inside the bracket [{a:.3g}, {b:.3g}] "
+                f"of arclength ({why}); the point is its last solved end"
+            )
+            break
         z_mid, lin = z_try, lin_try
         if k is None:
             f = tangent(lin.Gu, lin.Glam, t0)[-1]
@@ -340,6 +345,9 @@ def _locate(problem, z0, t0, ds, kind, k, ends, s: Settings, index) -> Bifurcati
             crit = complex(mu[np.argmin(np.abs(np.abs(mu) - 1.0))])
         else:
             crit = complex(mu[np.argmin(np.abs(mu - target))])
+    evidence = problem.evidence(z_mid)
+    if failed:
+        evidence = {**evidence, "location": failed}
     return Bifurcation(
         kind,
         float(z_mid[-1]),
@@ -347,7 +355,7 @@ def _locate(problem, z0, t0, ds, kind, k, ends, s: Settings, index) -> Bifurcati
         crit,
         problem.parameter,
         index,
-        problem.evidence(z_mid),
+        evidence,
     )
 
 

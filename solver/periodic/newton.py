@@ -90,14 +90,17 @@ def newton(
             except NewtonError:
                 raise
             except _TRIAL_FAILURES as err:
+                if type(err).__name__ == "NativeUnavailable":
+                    raise  # no compiler, or a library that did not build: not the trial's
                 # a trial the flow cannot reach (an integration that stops, a state the
                 # model refuses) is no decrease: a shorter step is tried, as for a larger
                 # residual, instead of ending the whole solve there
+                first = str(err).splitlines()[0] if str(err) else type(err).__name__
                 if not damped:
                     raise NewtonError(
-                        f"the Newton step's evaluation failed: {err}", history
-                    ) from None
-                failed, nt = str(err), float("inf")
+                        f"the Newton step's evaluation failed: {first}", history
+                    ) from err
+                failed, nt = first, float("inf")
             else:
                 failed, nt = None, float(np.max(np.abs(Ft)))
             if not damped or nt < norm:

@@ -12,7 +12,7 @@ discretisation that reads them (mean, half peak-to-peak, RMS, the top harmonics'
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -23,9 +23,9 @@ def _complex(z) -> dict | None:
     return None if z is None else {"re": float(z.real), "im": float(z.imag)}
 
 
-# A turning point located to the continuation's tolerance has a multiplier within about
-# the square root of that distance of +1 at a smooth fold (1e-4 on the shipped models'
-# folds); one farther than this from +1 is no smooth fold
+# A bifurcation located to the continuation's tolerance has its critical multiplier
+# within about the square root of that distance of +1 or -1 when smooth (1e-4 on the
+# shipped models' folds); one farther than this from it is no smooth one
 NON_SMOOTH = 0.05
 
 
@@ -49,10 +49,11 @@ class Bifurcation:
         The parameter's name.
     index : int
         The index of the first branch point past it.
-    evidence : Mapping[str, float]
+    evidence : Mapping[str, float or str]
         What else shows it (harmonic balance: ``hill_vs_monodromy``, the largest distance
         of Hill's multipliers from a time integration's monodromy, and
-        ``max_monodromy_multiplier``).
+        ``max_monodromy_multiplier``; ``location``: why it was not located, the corrector
+        having failed inside the step).
     """
 
     kind: str
@@ -68,18 +69,27 @@ class Bifurcation:
     def name(self) -> str:
         """The kind in words: a ``"fold"`` where the branch does not turn is a branch
         point, a multiplier through +1 without a turn (a symmetry-breaking pitchfork, for
-        one); a turn with no multiplier near +1 is a non-smooth fold (the branch turns
-        where an orbit grazes a contact edge: its multipliers jump there instead of
-        passing through +1, di Bernardo et al. 2008, "Piecewise-smooth Dynamical Systems",
-        so the smooth fold's evidence is missing and it is not called one)."""
-        if self.kind != "fold":
-            return self.kind
-        if self.turns is False:
-            return "branch point"
-        if self.turns and self.multiplier is not None:
-            if abs(self.multiplier - 1.0) > NON_SMOOTH:
-                return "non-smooth fold"
-        return self.kind
+        one).  Where the located multiplier is not at the kind's critical value (+1, -1)
+        the name says "non-smooth": the branch turns, or its test changes sign, where an
+        orbit grazes a contact edge and its multipliers jump there instead of passing the
+        critical value (di Bernardo et al. 2008, "Piecewise-smooth Dynamical Systems"), so
+        the smooth bifurcation's evidence is missing and it is not called one.  A point
+        whose location failed (``evidence["location"]``) is not judged so: its multiplier
+        was read a step away."""
+        kind = self.kind
+        if kind == "fold" and self.turns is False:
+            kind = "branch point"
+        target = {"fold": 1.0, "branch point": 1.0, "period-doubling": -1.0}.get(kind)
+        located = "location" not in self.evidence
+        if target is not None and self.multiplier is not None and located:
+            if abs(self.multiplier - target) > NON_SMOOTH:
+                return f"non-smooth {kind}"
+        return kind
+
+    @property
+    def jump(self) -> bool:
+        """Whether a slow sweep jumps here: the branch turns (a fold, smooth or not)."""
+        return self.kind == "fold" and self.turns is not False
 
     def to_dict(self) -> dict:
         """Kind, parameter name and value (also under the parameter's own name), index,
@@ -97,7 +107,7 @@ class Bifurcation:
             "multiplier": _complex(self.multiplier),
             "x0": [float(v) for v in self.x0],
         }
-        return out | {k: float(v) for k, v in self.evidence.items()}
+        return out | {k: v if isinstance(v, str) else float(v) for k, v in self.evidence.items()}
 
     describe = to_dict
 
@@ -178,7 +188,7 @@ class Branch:
         if b.turns is not None or b.kind != "fold" or not 1 <= b.index < len(self.points):
             return b.name
         before, after = self.points[b.index - 1], self.points[b.index]
-        return b.kind if before.tangent_sign != after.tangent_sign else "branch point"
+        return replace(b, turns=before.tangent_sign != after.tangent_sign).name
 
     def summary(self) -> str:
         """A few lines: the branch, its stability, each bifurcation, how it ended."""

@@ -30,4 +30,4 @@ def test_the_page_judges_the_floors_and_lists_every_row():
     assert "JSON + CSV + MAT | 36.0 | 20 | not met |" in text
     assert "| m | 2 | 4 | 10.0 | 5.00 | 100000 |" in text
     assert "42 MB of JSON, 8 MB of MAT" in text
-    assert "run 0.57 s, the shooting check of its end state 0.59 s" in text
+    assert "run 0.57 s, the shooting check of its end state 0.59 s (its monodromy" in text

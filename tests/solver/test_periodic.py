@@ -1,5 +1,7 @@
 """Shooting, Floquet multipliers and continuation against closed forms and brute force."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from gearsym.solver.integrate import simulate
@@ -118,6 +120,20 @@ def test_a_turn_without_a_multiplier_at_one_is_a_non_smooth_fold():
     assert fold(1.0 + 1e-4, True).name == "fold"
     assert fold(1.0 + 1e-4, False).name == "branch point"
     assert fold(None, True).name == "fold"  # no stability: nothing to tell it by
+    # the rig's same grazing where the branch does not turn (continued from 1.0)
+    assert fold(complex(-0.028723, 0.036943), False).name == "non-smooth branch point"
+    # a sweep jumps at a turn, smooth or not, not at a branch point
+    assert fold(complex(-0.028723, 0.036943), True).jump
+    assert not fold(1.0, False).jump
+    # a period doubling's multiplier at -1, or not
+    pd = Bifurcation("period-doubling", 0.2, np.zeros(2), complex(-0.9999, 0), "f", 3, {})
+    assert pd.name == "period-doubling"
+    assert replace(pd, multiplier=complex(0.004231, 0)).name == "non-smooth period-doubling"
+    # a point whose location failed is not judged by a multiplier read a step away
+    lost = fold(complex(1.2005, 0), True)
+    assert lost.name == "non-smooth fold"
+    lost = replace(lost, evidence={"location": "not located: the corrector failed"})
+    assert lost.name == "fold" and lost.to_dict()["location"].startswith("not located")
 
 
 def _period_two(system, state):
@@ -334,3 +350,29 @@ def test_the_engine_records_whether_a_fold_turns():
     assert b.name == "branch point" and b.to_dict()["name"] == "branch point"
     assert Bifurcation("fold", 1.0, np.zeros(2), 1.0, "p", turns=True).name == "fold"
     assert Bifurcation("fold", 1.0, np.zeros(2), 1.0, "p").name == "fold"  # not known
+
+
+def test_a_fold_whose_location_fails_says_so_and_is_not_called_non_smooth(monkeypatch):
+    """The Duffing fold of the test above with every correction inside its location
+    failing (as a flow that stops would): the point kept is the bracket's end, a step
+    from the fold, its multiplier far from +1; the record says it was not located and
+    keeps the name fold (a reviewer's case)."""
+    import inspect
+
+    from gearsym.solver.periodic import engine
+
+    system = System.load(DUFFING, k=0.1, B=0.5, a=1.0, c=1.0, omega=1.0)
+    run = simulate(system, np.zeros(2), method="cvodes", transient=300, periods=1)
+    real = engine.correct
+
+    def failing(problem, z_pred, t, tol, max_iter):
+        if inspect.stack()[1].function == "_locate":
+            raise RuntimeError("the flow stopped: too many steps\nsecond line")
+        return real(problem, z_pred, t, tol, max_iter)
+
+    monkeypatch.setattr(engine, "correct", failing)
+    branch = continue_orbit(system, "omega", 1.0, 2.5, run.poincare[:, 0], ds=0.05, ds_max=0.1)
+    folds = [b for b in branch.bifurcations if b.kind == "fold"]
+    assert folds and all(b.name == "fold" for b in folds)
+    assert all(b.evidence["location"].startswith("not located") for b in folds)
+    assert "second line" not in folds[0].evidence["location"]

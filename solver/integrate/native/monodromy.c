@@ -35,7 +35,7 @@ static inline void gs_rhs(double tau, const double *x, const double *p, const do
 static void gs_rhs_batch(double tau, int n, const double *restrict X, const double *restrict P,
                          const double *restrict Q, double *restrict DX)
 {
-    double x[GS_NX], dx[GS_NX], p[GS_NP], q[GS_NQ];
+    double x[GS_NX], dx[GS_NX], p[GS_NP], q[GS_NQ > 0 ? GS_NQ : 1];
     for (int j = 0; j < n; ++j) {
         for (int i = 0; i < GS_NX; ++i) x[i] = X[(long)i * n + j];
         for (int i = 0; i < GS_NP; ++i) p[i] = P[(long)i * n + j];
