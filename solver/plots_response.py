@@ -15,13 +15,27 @@ import numpy as np  # noqa: E402
 
 from .plots_style import BIFURCATIONS, SWEEPS, legend_below  # noqa: E402
 
-__all__ = ["METHODS", "frequency_response_figure", "mesh_response_figure"]
+__all__ = ["METHODS", "event_point", "frequency_response_figure", "mesh_response_figure"]
 
 METHODS = {"hb": "#1b9e77", "shooting": "#7570b3"}  # one colour per method, every figure
 _NAMES = {"hb": "harmonic balance", "shooting": "shooting", "integration": "integration"}
 # the up and down sweeps of time integration: the sweeps' palette, triangles pointing
 # the way the sweep went
 _SWEPT = {"up": ("forward", "^"), "down": ("backward", "v")}
+
+
+def event_point(values, e) -> int:
+    """The curve point an event is drawn at: of the two points it lies between, the one
+    nearer its parameter value (a fold has two sides at nearly one value, so the nearest
+    value over the whole curve would not do; the point before it alone sat a grid step
+    along the curve from a sharp fold, off its turn)."""
+    values = np.asarray(values, dtype=float)
+    if e.index < 0:
+        return int(np.argmin(np.abs(values - e.value)))
+    around = [k for k in (e.index - 1, e.index) if 0 <= k < len(values)]
+    if not around:
+        return len(values) - 1
+    return min(around, key=lambda k: abs(values[k] - e.value))
 
 
 def _segments(x, y, stable):
@@ -86,12 +100,7 @@ def frequency_response_figure(resp, physical: bool = False, title: str = ""):
             for e in curve.events:
                 marker, mc = BIFURCATIONS.get(e.name, ("x", "k"))
                 v = e.value
-                # the point before the event on the curve (a fold has two sides at
-                # nearly one parameter value: the nearest value would not do)
-                if e.index >= 0:
-                    k = min(max(e.index - 1, 0), len(x) - 1)
-                else:
-                    k = int(np.argmin(np.abs(curve.values - v)))
+                k = event_point(curve.values, e)
                 ax.plot(
                     v * fx,
                     y[k],

@@ -209,7 +209,7 @@ def response_figure(responses: dict, path: Path, title: str, caption: str, mark:
     forcing frequency, one colour per load ratio (:data:`LOAD_RATIOS`), stable solid and
     unstable dashed, folds marked in each panel, the study's operating frequency
     ``mark`` as a vertical line; one legend below the panels."""
-    from gearsym.solver.plots_response import _segments
+    from gearsym.solver.plots_response import _segments, event_point
 
     plt = _plt()
     first = next(iter(responses.values()))
@@ -234,7 +234,7 @@ def response_figure(responses: dict, path: Path, title: str, caption: str, mark:
                 )
             for e in curve.events:
                 if e.jump:
-                    i = min(max(e.index - 1, 0), len(x) - 1)
+                    i = event_point(curve.values, e)
                     ax.plot(
                         e.value,
                         y[i],

@@ -151,3 +151,22 @@ def test_maps_show_runs_that_left_the_valid_range(duffing):
     assert len(hatched) == 1
     assert "left the valid range" in lyap.axes[0].get_legend().get_texts()[0].get_text()
     assert "dominant attractor" in cap_motion and "dominant" not in cap_count
+
+
+def test_a_fold_is_drawn_at_the_turn_not_a_grid_step_along_the_curve():
+    """A branch resampled on a grid keeps its turning point (0.458 here) between grid
+    points a step away in the parameter, far along the curve at a sharp fold: the marker
+    goes to whichever of its two neighbours is nearer the fold's value (the turn), where
+    the point before it alone put the marker off the curve (reproduce's light-load
+    response, lambda 0.1)."""
+    from types import SimpleNamespace
+
+    from gearsym.solver.plots_response import event_point
+
+    values = [0.4506, 0.4582, 0.4583, 0.4506]  # up to the turn (kept), then back down
+    fold = SimpleNamespace(index=2, value=0.45831)
+    assert event_point(values, fold) == 2
+    fold = SimpleNamespace(index=3, value=0.45829)
+    assert event_point(values, fold) == 2
+    # no index: the nearest value over the curve
+    assert event_point(values, SimpleNamespace(index=-1, value=0.4507)) in (0, 3)
