@@ -36,7 +36,7 @@ import numpy as np
 from ._bounds import Interval
 from .floquet import KINDS, Floquet
 from .newton import newton
-from .records import Bifurcation, Branch, BranchPoint
+from .records import CRITICAL, Bifurcation, Branch, BranchPoint
 
 __all__ = [
     "FAILURES",
@@ -340,7 +340,7 @@ def _locate(problem, z0, t0, ds, kind, k, ends, s: Settings, index) -> Bifurcati
     mu = problem.multipliers(z_mid, lin)
     crit = None
     if mu is not None:
-        target = {"fold": 1.0, "period-doubling": -1.0}.get(kind)
+        target = CRITICAL.get(kind)
         if target is None:
             crit = complex(mu[np.argmin(np.abs(np.abs(mu) - 1.0))])
         else:

@@ -40,14 +40,13 @@ import numpy as np
 from .engine import FAILURES
 from .floquet import KINDS, bifurcation_tests
 from .flow import FlowMap, StroboscopicMap
-from .records import Bifurcation, Branch
+from .records import CRITICAL, Bifurcation, Branch
 
 __all__ = ["MAX_WIDEN", "RTOL", "WINDOW", "Screening", "located_monodromy", "screen"]
 
 WINDOW = 0.01  # widest bracket: this share of max(1, |parameter|) on each side
 MAX_WIDEN = 6  # branch points added on each side at most
 RTOL = 1e-9  # the located integration's (multipliers to about 1e-8: docs/deadzone-multipliers.md)
-_TARGET = {"fold": 1.0, "period-doubling": -1.0}
 
 
 @dataclass(frozen=True)
@@ -124,8 +123,8 @@ def _kinds_changed(a, b) -> list[str]:
 
 def _critical(mu, kind: str) -> complex:
     """The multiplier of ``mu`` nearest to where ``kind`` crosses the unit circle."""
-    if kind in _TARGET:
-        return complex(mu[np.argmin(np.abs(mu - _TARGET[kind]))])
+    if kind in CRITICAL:
+        return complex(mu[np.argmin(np.abs(mu - CRITICAL[kind]))])
     pairs = mu[np.abs(mu.imag) > 1e-9]
     pool = pairs if pairs.size else mu
     return complex(pool[np.argmin(np.abs(np.abs(pool) - 1.0))])
@@ -134,7 +133,7 @@ def _critical(mu, kind: str) -> complex:
 def _distance(mu, kind: str) -> float:
     """How far ``kind``'s critical multiplier is from where it crosses."""
     c = _critical(mu, kind)
-    return abs(c - _TARGET[kind]) if kind in _TARGET else abs(abs(c) - 1.0)
+    return abs(c - CRITICAL[kind]) if kind in CRITICAL else abs(abs(c) - 1.0)
 
 
 def screen(
@@ -253,4 +252,4 @@ def _merge(found, dropped: list) -> list[Bifurcation]:
 def _off(b: Bifurcation) -> float:
     """How far the recorded critical multiplier of ``b`` is from its crossing."""
     mu = complex(b.multiplier)
-    return abs(mu - _TARGET[b.kind]) if b.kind in _TARGET else abs(abs(mu) - 1.0)
+    return abs(mu - CRITICAL[b.kind]) if b.kind in CRITICAL else abs(abs(mu) - 1.0)

@@ -27,6 +27,9 @@ def _complex(z) -> dict | None:
 # within about the square root of that distance of +1 or -1 when smooth (1e-4 on the
 # shipped models' folds); one farther than this from it is no smooth one
 NON_SMOOTH = 0.05
+# the multiplier each kind of bifurcation crosses the unit circle at (a Neimark-Sacker
+# pair anywhere on it)
+CRITICAL = {"fold": 1.0, "branch point": 1.0, "period-doubling": -1.0}
 
 
 @dataclass(frozen=True)
@@ -79,7 +82,7 @@ class Bifurcation:
         kind = self.kind
         if kind == "fold" and self.turns is False:
             kind = "branch point"
-        target = {"fold": 1.0, "branch point": 1.0, "period-doubling": -1.0}.get(kind)
+        target = CRITICAL.get(kind)
         located = "location" not in self.evidence
         if target is not None and self.multiplier is not None and located:
             if abs(self.multiplier - target) > NON_SMOOTH:
