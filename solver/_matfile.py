@@ -26,6 +26,7 @@ data element per variable, each compressed (``miCOMPRESSED``, zlib) around an
 from __future__ import annotations
 
 import functools
+import math
 import struct
 import time
 import zlib
@@ -54,13 +55,21 @@ def _element(kind: int, data: bytes) -> bytes:
 def _matrix(cls: int, dims, name: bytes, body: list) -> list:
     """An miMATRIX element in parts: its tag, array flags, dimensions, name and ``body``
     (parts already padded)."""
-    head = [
-        _element(_UINT32, struct.pack("<II", cls, 0)),
-        _element(_INT32, struct.pack(f"<{len(dims)}i", *dims)),
-        _element(_INT8, name),
-    ]
-    size = sum(map(len, head)) + sum(map(len, body))
-    return [struct.pack("<II", _MATRIX, size), *head, *body]
+    head = _head(cls, tuple(dims), name)
+    return [struct.pack("<II", _MATRIX, len(head) + sum(map(len, body))), head, *body]
+
+
+@functools.lru_cache(maxsize=4096)
+def _head(cls: int, dims: tuple, name: bytes) -> bytes:
+    """An miMATRIX element's array flags, dimensions and name (a result repeats a few of
+    them many times: a nameless 1 x 1 struct per point, state and peak)."""
+    return b"".join(
+        (
+            _element(_UINT32, struct.pack("<II", cls, 0)),
+            _element(_INT32, struct.pack(f"<{len(dims)}i", *dims)),
+            _element(_INT8, name),
+        )
+    )
 
 
 def _dims(shape: tuple) -> tuple:
@@ -87,9 +96,14 @@ def _text(s: str, name: bytes) -> list:
     return _matrix(_CHAR, (1, len(s)), name, [_element(_UTF8, s.encode("utf-8"))])
 
 
-# a nameless 1 x 1 double (the commonest element of a result) up to its 8 bytes of data
-_SCALAR = b"".join(_matrix(_DOUBLE_CLASS, (1, 1), b"", [struct.pack("<II", _DOUBLE, 8)]))
-_SCALAR = struct.pack("<II", _MATRIX, len(_SCALAR) - 8 + 8) + _SCALAR[8:]
+# a nameless 1 x 1 double or int64 (the commonest elements of a result) up to their 8
+# bytes of data
+def _scalar(cls: int, kind: int) -> bytes:
+    whole = b"".join(_matrix(cls, (1, 1), b"", [struct.pack("<II", kind, 8)]))
+    return struct.pack("<II", _MATRIX, len(whole)) + whole[8:]
+
+
+_SCALAR, _INT_SCALAR = _scalar(_DOUBLE_CLASS, _DOUBLE), _scalar(_INT64_CLASS, _INT64)
 
 
 _NUMBERS = frozenset((float, int, bool, type(None)))  # a number in JSON form, or null
@@ -102,10 +116,15 @@ def _numbers(items: list) -> bool:
 
 
 def _floats(items: list) -> np.ndarray:
-    """A list of numbers and nulls as doubles, null as NaN."""
+    """A list of numbers and nulls as doubles, null and infinities as NaN (as their JSON
+    form, null, would be)."""
     if None in items:
-        return np.array([np.nan if v is None else v for v in items], dtype=float)
-    return np.array(items, dtype=float)
+        a = np.array([np.nan if v is None else v for v in items], dtype=float)
+    else:
+        a = np.array(items, dtype=float)
+    if not np.isfinite(a).all():
+        a[~np.isfinite(a)] = np.nan
+    return a
 
 
 def _parts(obj, name: bytes = b"") -> list:
@@ -118,24 +137,40 @@ def _parts(obj, name: bytes = b"") -> list:
         return _numeric(np.asarray(obj, dtype=float), name)
     if isinstance(obj, dict):
         return _struct(obj, name, _parts)
+    if type(obj) in _PLAIN:  # its own JSON form but for a non-finite float (NaN either way)
+        return _clean(obj, name)
+    if type(obj) is list and obj and set(map(type, obj)) <= _PLAIN:
+        return _clean(obj, name)  # the same: null and non-finite floats both NaN
+    if type(obj) in (list, tuple) and any(type(v) is dict for v in obj):
+        # a cell array whatever else it holds (a struct is no number): each element by
+        # these rules, not the whole list (a sweep's points) converted first
+        return _matrix(_CELL, (1, len(obj)), name, [p for v in obj for p in _parts(v)])
     return _clean(clean(obj), name)
+
+
+# types whose values _clean writes as their JSON form would be written
+_PLAIN = frozenset((float, int, bool, str, type(None)))
 
 
 def _clean(obj, name: bytes = b"") -> list:
     """:func:`_parts` of data already in its JSON form."""
-    if obj is None or isinstance(obj, float):
+    kind = type(obj)
+    if kind is float or obj is None:
+        value = obj if obj is not None and math.isfinite(obj) else np.nan
         if not name:
-            return [_SCALAR + struct.pack("<d", np.nan if obj is None else obj)]
-        return _numeric(np.array(np.nan if obj is None else obj), name)
-    if isinstance(obj, str):
+            return [_SCALAR + struct.pack("<d", value)]
+        return _numeric(np.array(value), name)
+    if kind is str:
         return _text(obj, name)
-    if isinstance(obj, bool):
+    if kind is bool:
         return _clean(float(obj), name)
-    if isinstance(obj, int):
+    if kind is int:
         if -(2**63) <= obj < 2**63:
+            if not name:
+                return [_INT_SCALAR + struct.pack("<q", obj)]
             return _numeric(np.array(obj, dtype=np.int64), name)
         return _numeric(np.array(float(obj)), name)  # past int64: a double
-    if isinstance(obj, dict):
+    if kind is dict:
         return _struct(obj, name, _clean)
     if obj and _numbers(obj):
         return _numeric(_floats(obj), name)

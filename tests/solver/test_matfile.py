@@ -123,6 +123,14 @@ def test_every_rule_of_the_conversion_gives_scipys_file():
         "one null": [None],
         "a-b": 1,  # and "a_b": one field name, the later value (as savemat's dict)
         "a_b": [{"x-y": 1, "x_y": 2}],
+        # the writer's short cuts: plain lists and scalars not put through their JSON
+        # form, lists holding records written element by element
+        "plain non-finite": [1.0, float("inf"), float("-inf"), float("nan"), None],
+        "plain inf": float("-inf"),
+        "plain mixed": [1, True, "s", None, float("inf")],
+        "numpy in a list": [np.float64(2.0), 1.0],
+        "records among others": [{"a": np.float64(1.0), "b": [1.0, None]}, 2.0, "x", [1.0]],
+        "records in a tuple": ({"q": (1, 2)}, {"r": float("nan")}),
     }
     table = {"x": np.array([1.0, 2.0]), "s": _cells(["a", ""])}
     _same_as_scipy({"result": document, "table": table})
