@@ -107,3 +107,27 @@ def test_the_stores_of_older_sources_are_removed_beyond_the_newest(tmp_path, mon
     assert store.root == root / memo.source_hash()[:16]
     kept = sorted(d.name for d in root.iterdir())
     assert kept == sorted([store.root.name] + [f"old{k}" for k in range(5 - memo.KEEP + 1, 5)])
+
+
+def test_the_key_tells_apart_what_differs_and_ignores_a_dicts_order(tmp_path):
+    """Rows of one plain type are keyed in one go (a reproduce's tasks carry thousands of
+    them): still a float from an int, a list from a tuple, a text from a number, -0.0 from
+    0.0 and NaN from a number; a dict's insertion order does not change its key."""
+    forms = [
+        [1.0, 2.0],
+        [1, 2],
+        (1.0, 2.0),
+        ["1.0", "2.0"],
+        [1.0, 2.0, 3.0],
+        [-0.0, 2.0],
+        [0.0, 2.0],
+        [float("nan"), 2.0],
+        [1.0, 2],  # mixed: element by element
+        [True, 2],
+    ]
+    keys = [canonical(f, tmp_path) for f in forms]
+    assert len(set(keys)) == len(forms)
+    a = {"x": [1.0], "y": {"p": 1, "q": (2.0,)}}
+    b = {"y": {"q": (2.0,), "p": 1}, "x": [1.0]}
+    assert canonical(a, tmp_path) == canonical(b, tmp_path)
+    assert canonical(a, tmp_path) != canonical({**a, "x": [1.5]}, tmp_path)

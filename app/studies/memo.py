@@ -91,6 +91,9 @@ class Unkeyed(TypeError):
     """An argument the key cannot be made of."""
 
 
+_PLAIN = frozenset((float, int, str))  # exact types: repr tells their values apart
+
+
 def canonical(x, out: Path):
     """``x`` as nested tuples of plain values (see the module's docstring)."""
     from gearsym.solver.system import System
@@ -113,10 +116,16 @@ def canonical(x, out: Path):
         data = hashlib.sha256(np.ascontiguousarray(x).tobytes()).hexdigest()
         return ("array", str(x.dtype), x.shape, data)
     if isinstance(x, (list, tuple)):
+        kinds = set(map(type, x))
+        if len(kinds) == 1 and kinds <= _PLAIN:  # a row of numbers or texts in one go
+            return (type(x).__name__, next(iter(kinds)).__name__, repr(tuple(x)))
         return (type(x).__name__, tuple(canonical(v, out) for v in x))
     if isinstance(x, dict):
         items = [(canonical(k, out), canonical(v, out)) for k, v in x.items()]
-        return ("dict", tuple(sorted(items, key=repr)))
+        # ordered by the keys alone: distinct keys have distinct canonical forms, and the
+        # repr of every value's whole subtree at every level of a nested record made the
+        # keys of a reproduce's tasks cost seconds of the main process's time
+        return ("dict", tuple(sorted(items, key=_first_repr)))
     if isinstance(x, (set, frozenset)):
         return ("set", tuple(sorted((canonical(v, out) for v in x), key=repr)))
     if dataclasses.is_dataclass(x) and not isinstance(x, type):
@@ -125,6 +134,10 @@ def canonical(x, out: Path):
     if callable(x) and hasattr(x, "__qualname__"):
         return ("function", x.__module__, x.__qualname__)
     raise Unkeyed(type(x).__qualname__)
+
+
+def _first_repr(pair: tuple) -> str:
+    return repr(pair[0])
 
 
 def _moved(x, old: Path, new: Path):
