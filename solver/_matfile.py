@@ -137,24 +137,57 @@ def _parts(obj, name: bytes = b"") -> list:
         return _numeric(np.asarray(obj, dtype=float), name)
     if isinstance(obj, dict):
         return _struct(obj, name, _parts)
-    if type(obj) in _PLAIN:  # its own JSON form but for a non-finite float (NaN either way)
+    return _json(obj, name)
+
+
+# exact types whose values are their own JSON form (a non-finite float aside, which
+# _clean writes as NaN, as it writes the null that is its JSON form)
+_PLAIN = frozenset((float, int, bool, str, type(None)))
+_RECORDS = _PLAIN | {dict}
+
+
+def _json(obj, name: bytes = b"") -> list:
+    """``_clean(clean(obj), name)`` in one walk: records (dicts, lists of them and of
+    plain values) are not converted to their JSON form first and walked again, which took
+    half the time of a 400-point sweep's file; anything else (NumPy values, arrays and
+    nested lists inside them) is converted as ``clean`` converts it."""
+    kind = type(obj)
+    if kind in _PLAIN:
         return _clean(obj, name)
-    if type(obj) is list and obj and set(map(type, obj)) <= _PLAIN:
-        return _clean(obj, name)  # the same: null and non-finite floats both NaN
-    if type(obj) in (list, tuple) and any(type(v) is dict for v in obj):
-        # a cell array whatever else it holds (a struct is no number): each element by
-        # these rules, not the whole list (a sweep's points) converted first
-        return _matrix(_CELL, (1, len(obj)), name, [p for v in obj for p in _parts(v)])
+    if kind is dict:
+        return _struct({str(k): v for k, v in obj.items()}, name, _json)
+    if kind is list or kind is tuple:
+        kinds = set(map(type, obj))
+        if kinds <= _PLAIN:
+            return _clean(list(obj), name)
+        if dict in kinds and kinds <= _RECORDS:  # no number nor matrix: a cell array
+            return _matrix(_CELL, (1, len(obj)), name, [p for v in obj for p in _json(v)])
     return _clean(clean(obj), name)
 
 
-# types whose values _clean writes as their JSON form would be written
-_PLAIN = frozenset((float, int, bool, str, type(None)))
+def _base(obj):
+    """A subclass's value as its base type (an enum's value), as the JSON form keeps
+    them and :func:`_clean` writes them."""
+    if isinstance(obj, float):
+        return float(obj)
+    if isinstance(obj, str):
+        return "" + obj
+    if isinstance(obj, int):
+        return int(obj)
+    if isinstance(obj, dict):
+        return dict(obj)
+    return list(obj)
+
+
+_EXACT = _PLAIN | {dict, list}
 
 
 def _clean(obj, name: bytes = b"") -> list:
     """:func:`_parts` of data already in its JSON form."""
     kind = type(obj)
+    if kind not in _EXACT:
+        obj = _base(obj)
+        kind = type(obj)
     if kind is float or obj is None:
         value = obj if obj is not None and math.isfinite(obj) else np.nan
         if not name:
@@ -187,7 +220,8 @@ def _clean(obj, name: bytes = b"") -> list:
 def _struct(fields: dict, name: bytes, each) -> list:
     """A 1 x 1 struct of ``fields`` (names cleaned as ``export`` cleans them), each value
     written by ``each``."""
-    keys = tuple(fields)
+    # as text: the caches below would take 1, 1.0 and True for one key
+    keys = tuple(map(str, fields))
     if _collide(keys):  # two keys one field name: the later value, as a dict keeps it
         fields = {_field(k): v for k, v in fields.items()}
         keys = tuple(fields)

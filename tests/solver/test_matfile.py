@@ -131,6 +131,11 @@ def test_every_rule_of_the_conversion_gives_scipys_file():
         "numpy in a list": [np.float64(2.0), 1.0],
         "records among others": [{"a": np.float64(1.0), "b": [1.0, None]}, 2.0, "x", [1.0]],
         "records in a tuple": ({"q": (1, 2)}, {"r": float("nan")}),
+        # arrays inside a list are in their JSON form (inf as null), records or not
+        "arrays in records": [
+            {"x": np.array([1.0, np.inf]), "e": np.array([]), "z": np.array(3)},
+            {"m": np.zeros((2, 2)), "k": [np.int64(2), 1.5]},
+        ],
     }
     table = {"x": np.array([1.0, 2.0]), "s": _cells(["a", ""])}
     _same_as_scipy({"result": document, "table": table})
