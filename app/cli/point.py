@@ -377,6 +377,7 @@ def verdict_lines(v) -> list[str]:
             f"      shooting check: period-{o['minimal_period']} orbit, residual "
             f"{o['residual']:.1e}, largest multiplier {o['largest_multiplier']:.4f}"
             + ("; the run was still converging to it" if ev.get("converging") else "")
+            + (f"; neutral, {ev['neutral']}" if "neutral" in ev else "")
         )
     if "transient_chaos" in ev:
         lines.append("      " + ev["transient_chaos"]["text"])

@@ -89,6 +89,18 @@ class OrbitCheck:
         more than the multipliers' error."""
         return self.converged and self.minimal_period == self.n and self.largest < 1 - _MU_ERROR
 
+    @property
+    def neutral(self) -> bool:
+        """Converged, of minimal period n, every multiplier inside the unit circle by more
+        than their error but one or more at +1 within it: the orbit is one of a family
+        (a free motion, such as bodies turning inside their backlash with every mesh
+        apart), which neither attracts nor repels along it."""
+        if not (self.converged and self.minimal_period == self.n) or self.multipliers is None:
+            return False
+        mu = np.asarray(self.multipliers)
+        on = np.abs(mu - 1.0) <= _MU_ERROR
+        return bool(on.any() and np.all(np.abs(mu[~on]) < 1 - _MU_ERROR))
+
     def exponent(self, period: float) -> float:
         """The largest Lyapunov exponent of the orbit, ``log max|mu| / (n T)``, per tau."""
         return float(np.log(self.largest) / (self.n * period))
@@ -106,6 +118,7 @@ class OrbitCheck:
             "largest_multiplier": None if self.multipliers is None else self.largest,
             "multiplier_error": _MU_ERROR,
             "attracting": self.attracting,
+            **({"neutral": True} if self.neutral else {}),
             "method": self.method,
             **({"why": self.why} if self.why else {}),
             **(

@@ -60,7 +60,9 @@ def _periodic(system: System, w: Window, x_end, t_end, tol: float) -> OrbitCheck
         if check.converged and m is not None and m < n and m not in tried:
             check = check_orbit(system, check.x, m, t0=t_end)
             tried.add(m)
-        if check.attracting:
+        # a neutral orbit (one of a family) only where the run's points already repeat
+        # on it: the run is on the family and stays there
+        if check.attracting or (check.neutral and n == strict and check.n == n):
             return check
     return None
 
@@ -185,6 +187,12 @@ def _settled_periodic(system, w, x_end, t_end, orbit, judged, periods_run, tol) 
         "spread": spread(system, w.points),
         "windows": judged,
     }
+    if not orbit.attracting:
+        evidence["neutral"] = (
+            "the orbit is one of a family: a multiplier is +1 within its error (a free "
+            "motion, such as bodies turning inside their backlash with every mesh apart), "
+            "the others inside the unit circle; the run's points repeat on it"
+        )
     chaotic = [j for j in judged if j["label"] == "chaotic"]
     if chaotic:
         evidence["transient_chaos"] = {

@@ -33,7 +33,7 @@ class Spectrum:
     window: str
     samples: int
     duration: float
-    level: float = 0.0  # the signal's largest magnitude (its rounding sets a floor)
+    level: float = 0.0  # the signal's size, at least 1 (its rounding sets a floor)
 
     @property
     def resolution(self) -> float:
@@ -107,7 +107,11 @@ def spectrum(tr: Trajectory, state: str) -> Spectrum:
         w_sum = n / 2.0  # the periodic Hann window's sum
     amp = np.abs(np.fft.rfft(z))
     amp *= 2.0 / w_sum
-    return Spectrum(amp, tr.system.omega, "hann", n, n * dt, float(np.max(np.abs(y))))
+    # the signal's size, never below the states' unit (half backlashes, O(1)): a
+    # coordinate at rest near zero (a free body inside its backlash) is noise of the
+    # integrator's absolute tolerance, not lines
+    level = max(float(np.max(np.abs(y))), 1.0)
+    return Spectrum(amp, tr.system.omega, "hann", n, n * dt, level)
 
 
 _CACHED = 1 << 20

@@ -1,0 +1,48 @@
+"""A set at rest inside its backlash: a period-1 verdict that says it is neutral.
+
+The back-to-back rig at a twentieth of its locked-in load keeps every mesh inside its
+backlash (the shafts' twist does not close the gaps): nothing couples the two halves of
+the loop, and each turns freely inside its gap.  Every state is constant; the shooting
+check converges to the rest state with one Floquet multiplier exactly 1 (the free
+relative rotation: a family of equilibria) and the others inside the unit circle.  The
+verdict was "undetermined" after 3,000 periods, with a 0-1 test and a section dimension
+read off rounding noise of 1e-11, and spectral "peaks" of a coordinate at 1e-13.
+
+References: the multiplier 1 of a family of orbits (a free motion) is exact, independent
+of the integrator; the others follow from the run here.  The rest state's constancy is
+the run's own output.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from gearsym.derive.input.scene import resolve_target
+from gearsym.resolve import planetary_system
+from gearsym.solver.analysis.orbit_check import OrbitCheck
+from gearsym.solver.analysis.point import analyse_point
+
+
+def test_a_loop_at_rest_inside_its_backlash_is_period_1_neutral_with_no_peaks():
+    rig = planetary_system(resolve_target("back-to-back-rig")).with_values(load_factor=0.05)
+    res = analyse_point(rig)
+    v = res.verdict
+    assert v.motion == "period-1"
+    assert v.periods_run == 400  # no windows: the check settles it at once
+    assert "neutral" in v.evidence and "family" in v.evidence["neutral"]
+    mu = np.array([complex(*m) for m in v.evidence["orbit"]["multipliers"]])
+    assert np.min(np.abs(mu - 1.0)) < 1e-9  # the free rotation, exact
+    assert np.sort(np.abs(mu))[-2] < 0.5  # everything else decays
+    for name, sp in res.spectra.items():
+        assert sp.peaks() == [], name  # constant to rounding, one coordinate near 0
+
+
+def _check(mu) -> OrbitCheck:
+    return OrbitCheck(1, True, np.zeros(2), 0.0, 1, 1, np.asarray(mu, complex), 0.0)
+
+
+def test_neutral_needs_every_other_multiplier_inside():
+    assert _check([1.0, 0.5]).neutral and not _check([1.0, 0.5]).attracting
+    assert not _check([1.0, 1.2]).neutral  # another multiplier outside: unstable
+    assert not _check([1.0 + 1e-4, 0.5]).neutral  # not +1 within the error: a fold's near
+    assert not _check([-1.0, 0.5]).neutral  # -1 is a flip, not a free motion
+    assert not _check([0.5, 0.2]).neutral and _check([0.5, 0.2]).attracting
