@@ -54,17 +54,18 @@ def loaded_state(system):
 
 def contact(tr) -> dict:
     """Each mesh's share of the samples of trajectory ``tr`` (a planetary set's nonlinear
-    model, or a gear train's) with its teeth apart (``|u| <= 1``), in contact on the flank
-    ``u > 1`` (``loaded_flank``: of a planetary set, where the sun's force is positive) and on
-    the flank ``u < -1`` (``back_flank``), ``u`` its deflection with its transmission
-    error where it has one (a train's mesh), its deflection's
-    extremes in its half backlashes, and its force's extremes over its mean stiffness
-    times its half backlash (``(1 + v(tau)) g(u)``, the stiffness variation included); read
-    from the samples (``samples_per_period`` of the run), so a contact loss shorter than a
-    sample can be missed."""
+    model, or a gear train's) with its teeth apart (``|u| <= 1``), in contact on its loaded
+    flank (``loaded_flank``; ``loaded_side``: the sign of ``u`` there, :func:`loaded_sides`)
+    and on its back flank (``back_flank``), ``u`` its deflection with its transmission
+    error where it has one (a train's mesh); its deflection's extremes in its half
+    backlashes, and its force's extremes over its mean stiffness times its half backlash
+    (``(1 + v(tau)) g(u)``, the stiffness variation included); read from the samples
+    (``samples_per_period`` of the run), so a contact loss shorter than a sample can be
+    missed."""
     module = tr.system.module
     omega = tr.system.p[list(module.PARAMETERS).index("omega")]
     tau = np.asarray(tr.t, dtype=float)
+    sides = loaded_sides(tr.system)
     out = {}
     for mesh, u in module.mesh_deflections(tr.x).items():
         # its transmission error (a train's mesh may have one) adds to its deflection
@@ -79,14 +80,35 @@ def contact(tr) -> dict:
         force = (1.0 + v) * np.where(u > 1.0, u - 1.0, np.where(u < -1.0, u + 1.0, 0.0))
         out[mesh] = {
             "apart": float(np.mean(np.abs(u) <= 1.0)),
-            "loaded_flank": float(np.mean(u > 1.0)),
-            "back_flank": float(np.mean(u < -1.0)),
+            "loaded_side": sides[mesh],
+            "loaded_flank": float(np.mean(sides[mesh] * u > 1.0)),
+            "back_flank": float(np.mean(sides[mesh] * u < -1.0)),
             "min": float(u.min()),
             "max": float(u.max()),
             "force_min": float(force.min()),
             "force_max": float(force.max()),
             "samples": int(u.size),
         }
+    return out
+
+
+def loaded_sides(system) -> dict:
+    """Each mesh's loaded flank as the sign of its deflection ``u`` there (+1: ``u > 1``):
+    the sign in the linear static solution at the model's load, every mesh's teeth
+    touching (``K ybar = f load``, the module's ``STATIC``), +1 where the mesh carries
+    none.  A planetary set's sun force loads every mesh on ``u > 1``; a gear train's
+    meshes can be loaded on either (the back-to-back rig's test pair on ``u < -1``), as the
+    derivation's ``loaded_flanks`` finds them for its transmission errors."""
+    module = system.module
+    static = module.STATIC
+    # the load parameter follows omega in both kinds of model (f of a train, f_s of a set)
+    y = np.linalg.lstsq(
+        np.asarray(static["stiffness"]), system.p[1] * np.asarray(static["load"]), rcond=None
+    )[0]
+    out = {}
+    for mesh, d in module.MESHES.items():
+        u = float(np.dot(d["row"], y))
+        out[mesh] = -1 if u < -1e-9 * max(1.0, float(np.max(np.abs(y)))) else 1
     return out
 
 

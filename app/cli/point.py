@@ -19,6 +19,7 @@ from ._common import (
 from ._output import format_option, units_option, write_result
 from ._start import resolve_start, start_options
 from ._system import system_of
+from ._verdict import verdict_lines
 
 __all__ = ["register"]
 
@@ -217,10 +218,12 @@ def _cmd_simulate(args) -> int:
                 )
             )
     for mesh, row in data.get("meshes", {}).items():
+        side = "u > 1" if row.get("loaded_side", 1) > 0 else "u < -1"
         print(
             f"  mesh {mesh}: deflection [{row['min']:.4f}, {row['max']:.4f}] half backlashes; "
-            f"teeth apart {row['apart']:.2f}, on the flank u > 1 {row['loaded_flank']:.2f}, "
-            f"u < -1 {row['back_flank']:.2f} of {row['samples']} samples"
+            f"teeth apart {row['apart']:.2f}, on the loaded flank ({side}) "
+            f"{row['loaded_flank']:.2f}, the back flank {row['back_flank']:.2f} of "
+            f"{row['samples']} samples"
         )
     for shaft, row in data.get("shafts", {}).items():
         a, b = row["bodies"]
@@ -363,38 +366,3 @@ def _cmd_sweep(args) -> int:
             + " (exit status 3)"
         )
     return 3 if failed else 0
-
-
-def verdict_lines(v) -> list[str]:
-    """The attractor's verdict and the evidence it rests on, as the CLI prints it."""
-    if v is None:
-        return []
-    ev = v.evidence
-    lines = [f"  attractor: {v.motion} (verdict after {v.periods_run} periods)"]
-    if "orbit" in ev:
-        o = ev["orbit"]
-        lines.append(
-            f"      shooting check: period-{o['minimal_period']} orbit, residual "
-            f"{o['residual']:.1e}, largest multiplier {o['largest_multiplier']:.4f}"
-            + ("; the run was still converging to it" if ev.get("converging") else "")
-            + (f"; neutral, {ev['neutral']}" if "neutral" in ev else "")
-        )
-    if "transient_chaos" in ev:
-        lines.append("      " + ev["transient_chaos"]["text"])
-    for w in (ev.get("windows") or [])[-2:]:
-        parts = [f"periods {w['window'][0]}-{w['window'][1]}: {w['label']}"]
-        if "exponent" in w:
-            e = w["exponent"]
-            lo, hi = e["interval"]
-            parts.append(f"exponent {e['exponent']:.5f} per tau in [{lo:.5f}, {hi:.5f}]")
-        if "zero_one" in w:
-            parts.append(f"0-1 test K = {w['zero_one']['K']:.2f}")
-        if "interval" in w.get("two_trajectory", {}):
-            lo, hi = w["two_trajectory"]["interval"]
-            parts.append(f"two-trajectory exponent in [{lo:.5f}, {hi:.5f}]")
-        if "rotation_number" in w:
-            parts.append(f"rotation number {w['rotation_number']:.5f}")
-        lines.append("      " + ", ".join(parts))
-    if "why" in ev:
-        lines.append(f"      why undetermined: {ev['why']}")
-    return lines

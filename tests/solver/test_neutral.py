@@ -46,3 +46,27 @@ def test_neutral_needs_every_other_multiplier_inside():
     assert not _check([1.0 + 1e-4, 0.5]).neutral  # not +1 within the error: a fold's near
     assert not _check([-1.0, 0.5]).neutral  # -1 is a flip, not a free motion
     assert not _check([0.5, 0.2]).neutral and _check([0.5, 0.2]).attracting
+
+
+def test_each_meshs_loaded_flank_is_the_derivations():
+    """The contact shares name each mesh's loaded flank by its side: the rig's test pair
+    is loaded on u < -1, its slave pair on u > 1 (the derivation's ``loaded_flanks``,
+    from the loop's static solution in body rotations, against the side read off the
+    model's reduced static solution); at the rig's own load both run on it all the time.
+    A planetary set's sun force loads every mesh on u > 1."""
+    from gearsym.derive.equations.train import derive_train, loaded_flanks
+    from gearsym.derive.input.train import load_train
+    from gearsym.planetary_dynamics import contact, loaded_sides
+    from gearsym.solver.integrate import simulate
+
+    path = resolve_target("back-to-back-rig")
+    rig = planetary_system(path)
+    st = derive_train(load_train(path))
+    want = dict(zip((m.id for m in st.train.meshes), loaded_flanks(st), strict=True))
+    assert want == {"test": -1, "slave": 1}
+    assert loaded_sides(rig) == want
+    shares = contact(simulate(rig, rig.module.static_state(rig.p), transient=20, periods=20))
+    for mesh in want:
+        assert (shares[mesh]["loaded_flank"], shares[mesh]["back_flank"]) == (1.0, 0.0)
+    lp = planetary_system(resolve_target("lin-parker-1999-3-backlash"))
+    assert set(loaded_sides(lp).values()) == {1}
