@@ -62,17 +62,14 @@ def contact(tr) -> dict:
     (``(1 + v(tau)) g(u)``, the stiffness variation included); read from the samples
     (``samples_per_period`` of the run), so a contact loss shorter than a sample can be
     missed."""
+    from gearsym.solver.analysis.meshing import body_mesh_deflections, loaded_sides
+
     module = tr.system.module
     omega = tr.system.p[list(module.PARAMETERS).index("omega")]
     tau = np.asarray(tr.t, dtype=float)
     sides = loaded_sides(tr.system)
     out = {}
-    for mesh, u in module.mesh_deflections(tr.x).items():
-        # its transmission error (a train's mesh may have one) adds to its deflection
-        u = np.asarray(u, dtype=float) + sum(
-            c * np.cos(h * omega * tau) + s * np.sin(h * omega * tau)
-            for h, c, s in module.MESHES[mesh].get("error", ())
-        )
+    for mesh, u in body_mesh_deflections(tr).items():
         v = sum(
             c * np.cos(h * omega * tau) + s * np.sin(h * omega * tau)
             for h, c, s in module.MESHES[mesh]["wave"]
@@ -89,26 +86,6 @@ def contact(tr) -> dict:
             "force_max": float(force.max()),
             "samples": int(u.size),
         }
-    return out
-
-
-def loaded_sides(system) -> dict:
-    """Each mesh's loaded flank as the sign of its deflection ``u`` there (+1: ``u > 1``):
-    the sign in the linear static solution at the model's load, every mesh's teeth
-    touching (``K ybar = f load``, the module's ``STATIC``), +1 where the mesh carries
-    none.  A planetary set's sun force loads every mesh on ``u > 1``; a gear train's
-    meshes can be loaded on either (the back-to-back rig's test pair on ``u < -1``), as the
-    derivation's ``loaded_flanks`` finds them for its transmission errors."""
-    module = system.module
-    static = module.STATIC
-    # the load parameter follows omega in both kinds of model (f of a train, f_s of a set)
-    y = np.linalg.lstsq(
-        np.asarray(static["stiffness"]), system.p[1] * np.asarray(static["load"]), rcond=None
-    )[0]
-    out = {}
-    for mesh, d in module.MESHES.items():
-        u = float(np.dot(d["row"], y))
-        out[mesh] = -1 if u < -1e-9 * max(1.0, float(np.max(np.abs(y)))) else 1
     return out
 
 

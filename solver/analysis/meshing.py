@@ -18,7 +18,15 @@ import numpy as np
 
 from ..integrate import Trajectory
 
-__all__ = ["GAP_LOADED_REGIMES", "REGIMES", "contract_regimes", "meshing_regime", "meshing_states"]
+__all__ = [
+    "GAP_LOADED_REGIMES",
+    "REGIMES",
+    "body_mesh_deflections",
+    "contract_regimes",
+    "loaded_sides",
+    "meshing_regime",
+    "meshing_states",
+]
 
 # Kahraman and Singh's regimes (a force that vanishes between its edges: a dead zone) and
 # their counterparts for a force that only crosses zero there (nothing separates, nothing
@@ -95,6 +103,8 @@ def meshing_states(tr: Trajectory) -> dict:
         dead zone would spend separated.  Coordinates without a force sign in the
         contract are left out.
     """
+    if hasattr(tr.system.module, "mesh_deflections"):  # a model in body coordinates
+        return _body_meshing(tr)
     out = {}
     c = tr.system.contract
     for coord in tr.system.coordinates:
@@ -128,3 +138,55 @@ def _loaded_in(sign, lower: float, upper: float) -> bool:
         s != 0 and a < upper and b > lower
         for s, a, b in zip(sign.signs, bounds[:-1], bounds[1:], strict=True)
     )
+
+
+def loaded_sides(system) -> dict:
+    """Each mesh's loaded flank of a model in body coordinates, as the sign of its
+    deflection ``u`` there (+1: ``u > 1``): the sign in the linear static solution at the
+    model's load, every mesh's teeth touching (``K ybar = f load``, the module's
+    ``STATIC``), +1 where the mesh carries none.  A planetary set's sun force loads every
+    mesh on ``u > 1``; a gear train's meshes can be loaded on either (the back-to-back
+    rig's test pair on ``u < -1``), as the derivation's ``loaded_flanks`` finds them."""
+    module = system.module
+    static = module.STATIC
+    # the load parameter follows omega in both kinds of model (f of a train, f_s of a set)
+    y = np.linalg.lstsq(
+        np.asarray(static["stiffness"]), system.p[1] * np.asarray(static["load"]), rcond=None
+    )[0]
+    out = {}
+    for mesh, d in module.MESHES.items():
+        u = float(np.dot(d["row"], y))
+        out[mesh] = -1 if u < -1e-9 * max(1.0, float(np.max(np.abs(y)))) else 1
+    return out
+
+
+def body_mesh_deflections(tr: Trajectory) -> dict:
+    """Each mesh's deflection in its half backlashes over trajectory ``tr`` of a model in
+    body coordinates, its transmission error included where it has one (a train's mesh):
+    ``{mesh: (K,)}``, what its force law reads."""
+    module = tr.system.module
+    omega = tr.system.p[list(module.PARAMETERS).index("omega")]
+    tau = np.asarray(tr.t, dtype=float)
+    out = {}
+    for mesh, u in module.mesh_deflections(tr.x).items():
+        out[mesh] = np.asarray(u, dtype=float) + sum(
+            c * np.cos(h * omega * tau) + s * np.sin(h * omega * tau)
+            for h, c, s in module.MESHES[mesh].get("error", ())
+        )
+    return out
+
+
+def _body_meshing(tr: Trajectory) -> dict:
+    sides = loaded_sides(tr.system)
+    out = {}
+    for mesh, u in body_mesh_deflections(tr).items():
+        u = sides[mesh] * u[np.isfinite(u)]
+        if not u.size:
+            out[mesh] = dict.fromkeys(("forward", "separated", "backward"), None)
+            continue
+        out[mesh] = {
+            "forward": float(np.mean(u > 1.0)),
+            "separated": float(np.mean(np.abs(u) <= 1.0)),
+            "backward": float(np.mean(u < -1.0)),
+        }
+    return out

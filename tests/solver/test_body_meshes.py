@@ -1,4 +1,5 @@
-"""A set at rest inside its backlash: a period-1 verdict that says it is neutral.
+"""Models in body coordinates: a set at rest inside its backlash (a period-1 verdict that
+says it is neutral), each mesh's loaded flank and its contact shares in sweep records.
 
 The back-to-back rig at a twentieth of its locked-in load keeps every mesh inside its
 backlash (the shafts' twist does not close the gaps): nothing couples the two halves of
@@ -16,6 +17,7 @@ the run's own output.
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from gearsym.derive.input.scene import resolve_target
 from gearsym.resolve import planetary_system
 from gearsym.solver.analysis.orbit_check import OrbitCheck
@@ -56,7 +58,8 @@ def test_each_meshs_loaded_flank_is_the_derivations():
     A planetary set's sun force loads every mesh on u > 1."""
     from gearsym.derive.equations.train import derive_train, loaded_flanks
     from gearsym.derive.input.train import load_train
-    from gearsym.planetary_dynamics import contact, loaded_sides
+    from gearsym.planetary_dynamics import contact
+    from gearsym.solver.analysis.meshing import loaded_sides
     from gearsym.solver.integrate import simulate
 
     path = resolve_target("back-to-back-rig")
@@ -70,3 +73,31 @@ def test_each_meshs_loaded_flank_is_the_derivations():
         assert (shares[mesh]["loaded_flank"], shares[mesh]["back_flank"]) == (1.0, 0.0)
     lp = planetary_system(resolve_target("lin-parker-1999-3-backlash"))
     assert set(loaded_sides(lp).values()) == {1}
+
+
+def test_a_body_models_sweep_record_carries_each_meshs_contact_shares():
+    """A sweep point of the three-planet set with backlash (its records are what sweeps
+    write) holds every mesh's shares, forward on its loaded flank, apart and backward,
+    the same as ``contact`` reads off the same run (the rig's back-to-back loop: its test
+    pair forward on u < -1); at 3,500 Hz a ring-planet mesh loses contact part of the
+    time (a share between 0 and 1, the three shares summing to 1)."""
+    from gearsym.planetary_dynamics import contact
+
+    lp = planetary_system(resolve_target("lin-parker-1999-3-backlash"))
+    for system in (
+        lp.with_values(mesh_frequency_hz=3500.0),
+        planetary_system(resolve_target("back-to-back-rig")),
+    ):
+        res = analyse_point(system, system.module.static_state(system.p))
+        shares = res.record().meshing_states
+        read = contact(res.trajectory)
+        assert set(shares) == set(system.module.MESHES) == set(read)
+        for mesh, s in shares.items():
+            assert s["forward"] + s["separated"] + s["backward"] == pytest.approx(1.0)
+            assert (s["forward"], s["separated"], s["backward"]) == (
+                read[mesh]["loaded_flank"],
+                read[mesh]["apart"],
+                read[mesh]["back_flank"],
+            )
+        if system.name.startswith("lin-parker"):
+            assert 0.0 < max(s["separated"] for s in shares.values()) < 1.0
