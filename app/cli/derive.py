@@ -188,7 +188,12 @@ def _cmd_derive(args) -> int:
         for path in written:
             print(f"wrote {path}")
     elif written:
-        print(f"wrote {len(written)} files under {where}")
+        names = ", ".join(
+            str(Path(w).relative_to(where)) if Path(w).is_relative_to(where) else str(w)
+            for w in written[:6]
+        )
+        more = f" and {len(written) - 6} more" if len(written) > 6 else ""
+        print(f"wrote {names}{more} under {where}")
     return 0
 
 

@@ -313,7 +313,7 @@ def _cmd_sweep(args) -> int:
     from gearsym.solver.units import in_units, parameter_span, poincare_range
 
     physical = args.units == "physical"
-    path, *_ = write_result(
+    paths = write_result(
         out, "sweep", in_units(result, system, args.units) if physical else result, args
     )
     if figure:
@@ -329,9 +329,8 @@ def _cmd_sweep(args) -> int:
             ),
             out / "bifurcation.png",
         )
-        print(f"wrote {path} and {fig}")
-    else:
-        print(f"wrote {path}")
+        paths.append(fig)
+    print(f"wrote {', '.join(p.name for p in paths)} in {out}")
     if physical:
         span = parameter_span(system, args.units, args.param, result.values)
         print(f"  {span or system.name + ': no speed to give in rpm'}")
