@@ -78,6 +78,7 @@ def contact(tr) -> dict:
         out[mesh] = {
             "apart": float(np.mean(np.abs(u) <= 1.0)),
             "loaded_side": sides[mesh],
+            "half_backlash_um": 1e6 * float(module.MESHES[mesh]["half_backlash_m"]),
             "loaded_flank": float(np.mean(sides[mesh] * u > 1.0)),
             "back_flank": float(np.mean(sides[mesh] * u < -1.0)),
             "min": float(u.min()),

@@ -95,8 +95,10 @@ class Units:
     def operating_point(self) -> str:
         """The speed and mesh frequency in words (physical), else omega."""
         s = self.scales
-        if not self.physical or "speed_rpm" not in s:
+        if not self.physical:
             return f"omega = {self.omega:.6g}"
+        if "speed_rpm" not in s:  # a model in body coordinates states no speed
+            return f"mesh frequency {self.frequency(self.omega):.6g} Hz (omega = {self.omega:.6g})"
         return (
             f"{s['speed_rpm']:.6g} rpm of gear '{s.get('speed_gear', '?')}', mesh frequency "
             f"{s['mesh_frequency_hz']:.6g} Hz (omega = {self.omega:.6g})"

@@ -219,8 +219,10 @@ def _cmd_simulate(args) -> int:
             )
     for mesh, row in data.get("meshes", {}).items():
         side = "u > 1" if row.get("loaded_side", 1) > 0 else "u < -1"
+        b = row.get("half_backlash_um")
+        um = f" ({row['min'] * b:.2f} to {row['max'] * b:.2f} µm)" if units.physical and b else ""
         print(
-            f"  mesh {mesh}: deflection [{row['min']:.4f}, {row['max']:.4f}] half backlashes; "
+            f"  mesh {mesh}: deflection [{row['min']:.4f}, {row['max']:.4f}] half backlashes{um}; "
             f"teeth apart {row['apart']:.2f}, on the loaded flank ({side}) "
             f"{row['loaded_flank']:.2f}, the back flank {row['back_flank']:.2f} of "
             f"{row['samples']} samples"

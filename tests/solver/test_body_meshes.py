@@ -101,3 +101,24 @@ def test_a_body_models_sweep_record_carries_each_meshs_contact_shares():
             )
         if system.name.startswith("lin-parker"):
             assert 0.0 < max(s["separated"] for s in shares.values()) < 1.0
+
+
+def test_a_body_model_in_physical_units_states_its_mesh_frequency_and_micrometres():
+    """``--units physical`` of a planetary set: its operating point as the mesh frequency
+    its file states (it has no speed of a gear), each mesh's half backlash in µm beside
+    its shares (the file's values, read here with tomllib)."""
+    import tomllib
+
+    from gearsym.planetary_dynamics import contact
+    from gearsym.solver.integrate import simulate
+    from gearsym.solver.units import Units
+
+    path = resolve_target("lin-parker-1999-3-backlash")
+    d = tomllib.loads(path.read_text(encoding="utf-8"))["planetary"]["dynamics"]
+    lp = planetary_system(path)
+    said = Units.of(lp).operating_point()
+    assert said.startswith(f"mesh frequency {d['mesh_frequency_hz']:.6g} Hz (omega = ")
+    rows = contact(simulate(lp, lp.module.static_state(lp.p), transient=2, periods=2))
+    for mesh, row in rows.items():
+        key = "sun_planet" if mesh.startswith("s") else "ring_planet"
+        assert row["half_backlash_um"] == pytest.approx(d[f"{key}_half_backlash_um"])
