@@ -139,10 +139,12 @@ def _cmd_derive(args) -> int:
             return 1
         from gearsym.derive.build import shipped_planetary, shipped_trains
 
+        trains = len(shipped_trains())
         print(
             "generated/ and docs/ match a fresh regeneration of "
             f"{len(shipped_targets())} shipped targets, {len(shipped_planetary())} "
-            f"planetary sets and {len(shipped_trains())} gear trains with closed loops"
+            f"planetary sets and {trains} gear train{'s' if trains != 1 else ''} with closed "
+            "loops"
         )
         return 0
 

@@ -56,8 +56,9 @@ def train_page(st: TrainStructure, command: str, source: str) -> str:
         f"**{st.rigid_body_modes}**. "
         + (
             "The train turns as a whole with the speeds below (each over the first body's); "
-            "the nonlinear model removes this rotation (one pivot coordinate follows from "
-            "the others).\n"
+            "the nonlinear model removes this rotation: "
+            f"`{_pivot(st)}` follows from the others (the rotation that carries the "
+            "train's momentum, `φ_0ᵀ M q = 0`).\n"
             if st.rigid_body_modes == 1
             else "Going round a loop the speed ratios do not come back to 1: the loop is "
             "locked and cannot turn; only its modes are derived.\n"
@@ -180,3 +181,11 @@ def train_index(structures: list) -> str:
             f"[derivation/{name}.md](derivation/{name}.md) |"
         )
     return "\n".join(lines) + "\n"
+
+
+def _pivot(st: TrainStructure) -> str:
+    """The coordinate the nonlinear model fixes by the others (``body_dynamics.reduction``:
+    the largest ``|M_ii phi_0,i|``)."""
+    from ..equations.body_dynamics import reduction
+
+    return reduction(st.physical, st.mass, st.incidence, st.rigid_body_modes)[1]
