@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import sys
 from pathlib import Path
 
@@ -226,7 +227,9 @@ def _cache_files(built) -> dict[str, str]:
     models = {m.name for m in built.models}
     for rel, text in built.files.items():  # a planetary set's page: no module beside it
         if rel.startswith("docs/derivation/") and Path(rel).stem not in models:
-            files[str(model_cache() / Path(rel).name)] = text
+            # named by its content too: two files of one name keep a page each
+            digest = hashlib.sha256(text.encode("utf-8")).hexdigest()[:12]
+            files[str(model_cache() / f"{Path(rel).stem}_{digest}.md")] = text
     return files
 
 
