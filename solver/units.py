@@ -236,6 +236,8 @@ class InUnits:
         lyapunov = "lyapunov" in columns
         extra_names += ["lyapunov_per_s"] * lyapunov
         speeds = [k for k in (SPEED, MESH_HZ) if k not in columns and k in base.scales]
+        # a model in body coordinates states no speed: its rows' mesh frequency from omega
+        hz = MESH_HZ not in columns and MESH_HZ not in base.scales
         out = []
         for row in rows:
             key = tuple(float(row[k]) for k in where)
@@ -244,9 +246,9 @@ class InUnits:
             if lyapunov:
                 omega_n = u.scales["omega_n_rad_per_s"]
                 extra.append(_times(_num(row[columns.index("lyapunov")]), omega_n))
-            extra += [u.scales[k] for k in speeds]
+            extra += [u.scales[k] for k in speeds] + [u.frequency(u.omega)] * hz
             out.append([*row, *extra])
-        return [*columns, *extra_names, *speeds], out
+        return [*columns, *extra_names, *speeds, *[MESH_HZ] * hz], out
 
     def block(self) -> dict:
         """The ``in_units`` block (``{}`` in model units)."""

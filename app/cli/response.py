@@ -121,7 +121,8 @@ def register(sub) -> None:
         fr,
         "the figure in mesh frequency (Hz) and dynamic transmission-error amplitude (µm), "
         "and the result files with added columns (<coordinate>_amplitude_um and the other "
-        "deflections in µm, speed_rpm, mesh_frequency_hz) and an in_units block",
+        "deflections in µm, speed_rpm where the model has a gear's speed, "
+        "mesh_frequency_hz) and an in_units block",
     )
     fr.add_argument("--physical", action="store_true", help="the same as --units physical")
     fr.add_argument("--out", metavar="DIR", help="output folder (default response_<model>)")

@@ -122,3 +122,17 @@ def test_a_body_model_in_physical_units_states_its_mesh_frequency_and_micrometre
     for mesh, row in rows.items():
         key = "sun_planet" if mesh.startswith("s") else "ring_planet"
         assert row["half_backlash_um"] == pytest.approx(d[f"{key}_half_backlash_um"])
+
+
+def test_a_body_models_rows_in_physical_units_carry_their_mesh_frequency():
+    """A sweep of the set over omega in physical units adds each row's mesh frequency,
+    omega omega_n / 2 pi (the module's OMEGA_N), where a tree model adds its speed too."""
+    from gearsym.solver.sweep import sweep
+    from gearsym.solver.units import in_units
+
+    lp = planetary_system(resolve_target("lin-parker-1999-3-backlash"))
+    sw = sweep(lp, "omega", [0.09, 0.1], transient=5, periods=5, continuation=False)
+    columns, rows = in_units(sw, lp).to_table()
+    k = columns.index("mesh_frequency_hz")
+    for row, w in zip(rows, (0.09, 0.1), strict=True):
+        assert row[k] == pytest.approx(w * lp.module.OMEGA_N / (2 * np.pi), rel=1e-12)
