@@ -109,19 +109,19 @@ class FrequencyResponse:
 
     def to_table(self) -> tuple[list, list]:
         coords = self.system.coordinates
+        # the dynamic factor where the model emits its mesh forces (its coordinates are
+        # its meshes); a model in body coordinates has none, not a column of blanks
+        provides = self.system.contract.provides("mesh_force", "static_mesh_force")
+        quantities = (*QUANTITIES, "dynamic_factor") if provides else QUANTITIES
         columns = ["method", self.parameter, "stable"] + [
-            f"{c}_{q}" for c in coords for q in (*QUANTITIES, "dynamic_factor")
+            f"{c}_{q}" for c in coords for q in quantities
         ]
         rows = []
         for r in self.records():
             method = r["method"] + (f" {r['direction']}" if "direction" in r else "")
             rows.append(
                 [method, r[self.parameter], r["stable"]]
-                + [
-                    r[c].get(q, float("nan"))
-                    for c in coords
-                    for q in (*QUANTITIES, "dynamic_factor")
-                ]
+                + [r[c].get(q, float("nan")) for c in coords for q in quantities]
             )
         return columns, rows
 
