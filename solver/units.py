@@ -266,9 +266,13 @@ class InUnits:
             c: meaning.get(c, f"{c[:-3]} in µm (half backlashes x b x 1e6, b at the row)")
             for c in columns[first:]
         }
+        swept = [q for q in self.parameters if q in (base.forcing, SPEED, MESH_HZ)]
         return {
             "units": base.kind,
-            "operating_point": base.operating_point(),
+            # the rows' own frequency where it is what varies (their columns hold it)
+            "operating_point": f"{swept[0]} varies by row (its column)"
+            if swept
+            else base.operating_point(),
             "columns": about,
             "table": {c: [r[k] for r in rows] for k, c in enumerate(columns) if k >= first},
         }

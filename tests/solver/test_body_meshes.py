@@ -136,3 +136,5 @@ def test_a_body_models_rows_in_physical_units_carry_their_mesh_frequency():
     k = columns.index("mesh_frequency_hz")
     for row, w in zip(rows, (0.09, 0.1), strict=True):
         assert row[k] == pytest.approx(w * lp.module.OMEGA_N / (2 * np.pi), rel=1e-12)
+    # the header does not state one frequency for rows that each have their own
+    assert in_units(sw, lp).block()["operating_point"] == "omega varies by row (its column)"
