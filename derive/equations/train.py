@@ -37,9 +37,12 @@ their power by rounding, at most 1e-9 of it, is taken out along the rigid rotati
 **Transmission error** (``transmission_error``, as a tree's mesh states it): ``e_j(t) =
 sum_l a_l cos(l (h_j omega tau - 2 pi gamma_j) + phi_l)`` is excess material on the loaded
 flank, so it adds ``s_j e_j`` to the mesh's deflection, in its force and its damper, ``k (1 +
-v) b g((delta + s e) / b) + c (delta' + s e')``, as the tree models' ``x = C A theta + s e``:
-``s_j`` the sign of the mesh's deflection in the linear static solution at the file's load,
-every mesh's teeth touching (``loaded_flanks``; +1 where it carries none).
+v) b g((delta + s e) / b) + c (delta' + s e')``: ``s_j`` the sign of the mesh's deflection in
+the linear static solution at the file's load, every mesh's teeth touching
+(``loaded_flanks``; +1 where it carries none).  The tree models' ``x = C A theta + s e``
+differ: their ``s`` is the coordinate's orientation of the load reading, not its loaded
+flank, so on a mesh loaded on its back flank (a braking pinion's) the two add the error
+with opposite signs (``tests/derive/test_tree_as_train.py`` states it and bridges it).
 
 **Locked-in torque** of a loop of two pairs of equal ratio ``i`` joined by two shafts (a
 back-to-back rig), the meshes' teeth touching: going round the loop, the twists and the
