@@ -153,11 +153,9 @@ def loaded_sides(system) -> dict:
     y = np.linalg.lstsq(
         np.asarray(static["stiffness"]), system.p[1] * np.asarray(static["load"]), rcond=None
     )[0]
-    out = {}
-    for mesh, d in module.MESHES.items():
-        u = float(np.dot(d["row"], y))
-        out[mesh] = -1 if u < -1e-9 * max(1.0, float(np.max(np.abs(y)))) else 1
-    return out
+    u = {mesh: float(np.dot(d["row"], y)) for mesh, d in module.MESHES.items()}
+    small = 1e-12 * max(1e-300, max(map(abs, u.values()), default=0.0))
+    return {mesh: -1 if v < -small else 1 for mesh, v in u.items()}
 
 
 def body_mesh_deflections(tr: Trajectory) -> dict:

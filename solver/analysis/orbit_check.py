@@ -55,6 +55,9 @@ __all__ = ["OrbitCheck", "check_orbit"]
 
 _H = 1e-5  # relative step of the central differences (piecewise force laws)
 _MU_ERROR = 1e-6  # the multipliers' stated error (see the module text), with a margin
+# a multiplier at +1 to rounding: a family's (flat along it); a fold's multiplier is within
+# 1e-9 of 1 only some 1e-18 of its parameter from the fold
+_NEUTRAL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -92,13 +95,16 @@ class OrbitCheck:
     @property
     def neutral(self) -> bool:
         """Converged, of minimal period n, every multiplier inside the unit circle by more
-        than their error but one or more at +1 within it: the orbit is one of a family
-        (a free motion, such as bodies turning inside their backlash with every mesh
-        apart), which neither attracts nor repels along it."""
+        than their error but one or more at +1 to rounding (:data:`_NEUTRAL`): the orbit is
+        one of a family (a free motion, such as bodies turning inside their backlash with
+        every mesh apart, where the flow is flat along the family and the multiplier is 1
+        exactly), which neither attracts nor repels along it.  A saddle-node orbit has a
+        multiplier near +1 too, but only at the fold itself does it reach 1; within the
+        multipliers' error of it (1e-6) it is still a lone orbit, stable or not."""
         if not (self.converged and self.minimal_period == self.n) or self.multipliers is None:
             return False
         mu = np.asarray(self.multipliers)
-        on = np.abs(mu - 1.0) <= _MU_ERROR
+        on = np.abs(mu - 1.0) <= _NEUTRAL
         return bool(on.any() and np.all(np.abs(mu[~on]) < 1 - _MU_ERROR))
 
     def exponent(self, period: float) -> float:

@@ -60,7 +60,13 @@ class FrequencyResponse:
     curves: tuple[Curve, ...]
 
     def records(self) -> list[dict]:
-        return [r for c in self.curves for r in c.records()]
+        out = [r for c in self.curves for r in c.records()]
+        if not self.system.contract.provides("mesh_force", "static_mesh_force"):
+            # no mesh forces, no dynamic factor (not a null for every body coordinate)
+            for r in out:
+                for c in self.system.coordinates:
+                    r[c].pop("dynamic_factor", None)
+        return out
 
     def _curves_text(self) -> str:
         return ", ".join(f"{c.method} {len(c.values)}" for c in self.curves)

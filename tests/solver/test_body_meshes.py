@@ -46,6 +46,11 @@ def test_neutral_needs_every_other_multiplier_inside():
     assert _check([1.0, 0.5]).neutral and not _check([1.0, 0.5]).attracting
     assert not _check([1.0, 1.2]).neutral  # another multiplier outside: unstable
     assert not _check([1.0 + 1e-4, 0.5]).neutral  # not +1 within the error: a fold's near
+    # a saddle-node orbit of reference-light at its fold (omega 0.45838, the frequency
+    # response's): its multiplier within the multipliers' error of 1, but not at 1 to
+    # rounding -- a lone orbit, not a family (the review found it called neutral)
+    assert not _check([-0.556 + 0.360j, -0.556 - 0.360j, 1.000000693, 0.4398]).neutral
+    assert _check([1.0 - 1.6e-15, 0.2206, 0.0828]).neutral  # the rig's, at rest
     assert not _check([-1.0, 0.5]).neutral  # -1 is a flip, not a free motion
     assert not _check([0.5, 0.2]).neutral and _check([0.5, 0.2]).attracting
 
@@ -68,6 +73,7 @@ def test_each_meshs_loaded_flank_is_the_derivations():
     want = dict(zip((m.id for m in st.train.meshes), loaded_flanks(st), strict=True))
     assert want == {"test": -1, "slave": 1}
     assert loaded_sides(rig) == want
+    assert loaded_sides(rig.with_values(load_factor=1e-10)) == want  # relative, not absolute
     shares = contact(simulate(rig, rig.module.static_state(rig.p), transient=20, periods=20))
     for mesh in want:
         assert (shares[mesh]["loaded_flank"], shares[mesh]["back_flank"]) == (1.0, 0.0)
