@@ -21,10 +21,12 @@ import numpy as np  # noqa: E402
 
 from .analysis import spectrum  # noqa: E402
 from .analysis.point import verdict_line  # noqa: E402
+from .analysis.spectra import ROUNDING  # noqa: E402
 from .integrate import Trajectory  # noqa: E402
 from .plots_style import (  # noqa: E402
     BIFURCATIONS,
     MOTION_CLASSES,
+    at_rest,
     categorical,
     legend_below,
     motion_class,
@@ -167,6 +169,7 @@ def point_figure(point, title: str = "", periods_shown: int = 20):
                 ls="--",
                 label=None if k else f"contact edges {c} = {where} (the model's contract)",
             )
+        at_rest(ax, "y", u[shown])
         ax.set_xlabel("τ (non-dimensional time)")
         ax.set_ylabel(f"{c} (half backlashes)")
         ax.set_title(f"{c}: time series (last {periods_shown} periods)", fontsize=9)
@@ -183,6 +186,8 @@ def point_figure(point, title: str = "", periods_shown: int = 20):
             color="#ce1256",
             label="Poincaré points (τ = 0 mod T)",
         )
+        at_rest(ax, "x", u[tail])
+        at_rest(ax, "y", du[tail])
         ax.set_xlabel(f"{c} (half backlashes)")
         ax.set_ylabel(f"d{c}/dτ")
         shown_periods = min(PORTRAIT_PERIODS, tr.poincare.shape[1])
@@ -212,10 +217,18 @@ def _spectrum_panel(ax, tr: Trajectory, c: str) -> None:
     keep = (sp.frequency <= top) & (sp.amplitude > 0)
     ax.semilogy(sp.frequency[keep], sp.amplitude[keep], lw=0.8, color="#1f1f1f")
     ax.set_xlim(0, top)
-    # what the integration's relative tolerance cannot resolve, where something lies below
+    # what the integration's relative tolerance cannot resolve, and what is rounding of
+    # the signal (the spectrum's own floor: a coordinate at rest has nothing above it)
     level = tr.rtol * float(sp.amplitude[keep].max()) if np.any(keep) else 0.0
+    level = max(level, ROUNDING * sp.level)
     if level > (bottom := ax.get_ylim()[0]):
-        ax.axhspan(bottom, level, color="0.9", zorder=0, label="below rtol × the largest peak")
+        ax.axhspan(
+            bottom,
+            level,
+            color="0.9",
+            zorder=0,
+            label="below rtol × the largest peak, or rounding (1e-10 of the signal)",
+        )
         ax.set_ylim(bottom=bottom)
     ax.set_xlabel("frequency (rad per unit τ)")
     ax.set_ylabel(f"amplitude of {c} (half backlashes)")

@@ -24,7 +24,9 @@ __all__ = [
     "MESHING_CLASSES",
     "MOTION_CLASSES",
     "OUTCOMES",
+    "REST",
     "SWEEPS",
+    "at_rest",
     "categorical",
     "legend_below",
     "motion_class",
@@ -234,3 +236,23 @@ def save_figure(fig, path, box=None) -> Path:
     fig.savefig(path, dpi=DPI, bbox_inches=tight)
     plt.close(fig)
     return path
+
+
+# a coordinate whose span over a panel is below this share of max(1, its size) is at
+# rest: its axis is drawn round it at that width, not stretched over rounding (a body
+# inside its backlash drifts by 1e-14 half backlashes, which autoscaling drew as motion)
+REST = 1e-9
+
+
+def at_rest(ax, axis: str, values) -> None:
+    """Draw the ``axis`` ("x" or "y") of ``ax`` round ``values`` at width :data:`REST`
+    where they are constant to rounding, in plain numbers (no offset)."""
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    if not v.size:
+        return
+    mid, width = float(np.mean(v)), REST * max(1.0, float(np.max(np.abs(v))))
+    if float(np.ptp(v)) <= width:
+        (ax.set_ylim if axis == "y" else ax.set_xlim)(mid - 1e3 * width, mid + 1e3 * width)
+        ax.ticklabel_format(axis=axis, useOffset=False, style="plain")
+        ax.locator_params(axis=axis, nbins=3)  # long plain numbers: few of them

@@ -170,3 +170,24 @@ def test_a_fold_is_drawn_at_the_turn_not_a_grid_step_along_the_curve():
     assert event_point(values, fold) == 2
     # no index: the nearest value over the curve
     assert event_point(values, SimpleNamespace(index=-1, value=0.4507)) in (0, 3)
+
+
+def test_a_coordinate_at_rest_is_drawn_flat_not_stretched_over_rounding():
+    """A value constant to 1e-14 (a body inside its backlash) gets an axis 2e-6 wide round
+    it in plain numbers; a real motion of 1e-3 keeps matplotlib's own limits."""
+    from gearsym.solver.plots_style import at_rest
+
+    fig, ax = plt.subplots()
+    rest = -0.4428 + 1e-14 * np.arange(50)
+    ax.plot(rest)
+    at_rest(ax, "y", rest)
+    lo, hi = ax.get_ylim()
+    assert hi - lo == pytest.approx(2e-6, rel=1e-9) and lo < rest.mean() < hi
+    assert not ax.yaxis.get_major_formatter().get_useOffset()
+    moving = 1e-3 * np.sin(np.arange(50))
+    ax.cla()
+    ax.plot(moving)
+    before = ax.get_ylim()
+    at_rest(ax, "y", moving)
+    assert ax.get_ylim() == before
+    plt.close(fig)
