@@ -36,6 +36,7 @@ from pathlib import Path
 from ..mesh.backlash import fit_dead_zone
 from .features import BACKLASH_KEYS, Features, parse_features
 from .reader import InputError, Table, load_toml, nearest, parse_expression
+from .stated import SPEED, TORQUE, stated_physically
 from .supports import load_topology_data
 from .topology import Topology, load_topology, parse_topology
 
@@ -203,9 +204,10 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
     for key in pt.data:
         parameters[key] = pt.number(key)
     pt.finish()
+    topology = stated_physically(pt, parameters, topology)
     for required in ("omega", "damping_ratio"):
-        if required not in parameters:
-            raise pt.error(required, "is required but missing")
+        if required not in parameters and not (required == "omega" and SPEED in pt.data):
+            raise pt.error(required, "is required but missing (or speed_rpm for omega)")
     for key, value in (overrides or {}).items():
         if key not in parameters:
             raise InputError(
@@ -218,6 +220,22 @@ def load_scene(path: Path | str, overrides: dict[str, float] | None = None) -> S
 
     loads = expressions = None
     lt = top.table("loads", None)
+    torques = [k for k in pt.data if k.startswith(TORQUE)]
+    if lt is not None and torques:
+        raise pt.error(
+            torques[0],
+            "and [loads] both state the loads; keep the torques (physical) or [loads] "
+            "(non-dimensional)",
+        )
+    if lt is None:  # loads from the torques: every other key must be one the model uses
+        for key in parameters:
+            if key not in PARAMETER_LIMITS:
+                raise pt.error(
+                    key,
+                    "is not a parameter of a scene whose loads come from its torques; "
+                    "parameters: omega or speed_rpm, damping_ratio, torque_Nm_<gear>"
+                    + nearest(key, ["omega", "damping_ratio", SPEED]),
+                )
     if lt is not None:
         coords = [m.coordinate for m in topology.meshes]
         loads, expressions = {}, {}

@@ -1,0 +1,87 @@
+"""A scene states its operating point in the engineer's units (issue 25, point 1).
+
+``speed_rpm`` and ``torque_Nm_<gear>`` in a scene's ``[parameters]`` take the place of
+``omega`` and ``[loads]``; they were ignored without a word (the model ran at the omega of
+a default speed, a stray key passed).  The reference: the same gears loaded as the
+shipped dead-zone scene and given the same speed and torques at run time (``with_values``,
+the generated ``parameters()``'s closed forms, the audit page's) -- the model derived from
+the statement has the same parameter vector; and the mesh frequency is z n / 60.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from gearsym.derive.input.scene import builtin_root
+from gearsym.resolve import load
+
+SCENE = """[scene]
+name = "light-physical"
+topology = "{topology}"
+description = "the dead-zone scene's gears at a stated speed and torques"
+
+[features]
+stiffness_harmonics = 3
+backlash = "dead-zone"
+transmission_error = true
+mesh_phase = true
+damping_coupling = true
+
+[parameters]
+speed_rpm = 3000
+damping_ratio = 0.03
+torque_Nm_p = 400
+torque_Nm_q = -50
+torque_Nm_g = -700
+"""
+
+
+def _write(tmp_path, text: str):
+    path = tmp_path / "physical.toml"
+    topology = builtin_root() / "topologies" / "diso.toml"
+    path.write_text(text.format(topology=topology.as_posix()), encoding="utf-8")
+    return path
+
+
+def test_a_scene_stated_in_rpm_and_newton_metres_is_the_model_set_to_them(tmp_path):
+    stated = load(str(_write(tmp_path, SCENE)))
+    # the shipped scene of the same gears and features, its loads read the same way
+    # (q braking: the topology's own reading of the torques' signs)
+    ref = load("reference-dead-zone", load_reading="q-braking").with_values(
+        speed_rpm=3000.0, torque_Nm_p=400.0, torque_Nm_q=-50.0, torque_Nm_g=-700.0
+    )
+    omega_n = stated.module.OMEGA_N
+    assert omega_n == pytest.approx(ref.module.OMEGA_N, rel=1e-12)
+    assert stated.parameter("omega") == pytest.approx(
+        2 * np.pi * (50 * 3000 / 60) / omega_n, rel=1e-9
+    )
+    for name in ("omega", "f_u", "f_v", "kappa_u_v", "xi_u_v", "E_u_1", "phi_v"):
+        assert stated.parameter(name) == pytest.approx(ref.parameter(name), rel=1e-9), name
+
+
+@pytest.mark.parametrize(
+    ("change", "words"),
+    [
+        (("speed_rpm = 3000", "speed_rpm = 3000\nomega = 0.5"), "and omega both state the speed"),
+        (("torque_Nm_g = -700", "torque_Nm_g = -700\nbogus_key = 5"), "bogus_key: is not a"),
+        (("torque_Nm_g = -700", "torque_Nm_x = -700"), "torque_Nm_x: names no gear"),
+        (("speed_rpm = 3000", "speed_rpm = -1000"), "give a speed above 0 rpm"),
+        (
+            ("torque_Nm_g = -700", "torque_Nm_g = -700\n\n[loads]\nu = 0.1\nv = 0.01"),
+            "and [loads] both state the loads",
+        ),
+    ],
+)
+def test_what_a_scene_cannot_state_is_refused_in_one_line(tmp_path, change, words):
+    path = _write(tmp_path, SCENE.replace(*change))
+    done = subprocess.run(
+        [sys.executable, "-m", "gearsym", "derive", str(path), "--dry-run"],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 2, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and words in lines[0], done.stderr
