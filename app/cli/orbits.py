@@ -14,6 +14,7 @@ from ._common import (
     out_folder,
     parse_set,
     refuse_conflicts,
+    refuse_restated,
     require,
 )
 from ._limits import MAX_PERIOD, MAX_SEGMENTS, MAX_SETTLED, MAX_TRIES, MIN_STEP, bounded_shoot
@@ -310,6 +311,7 @@ def _cmd_continue(args) -> int:
 
     refuse_conflicts(args, [args.param], f"--param {args.param}")
     system = system_of(args.scene, parse_set(args.set))
+    refuse_restated(args, system.module, [args.param], f"--param {args.param}")
     if needs_derivation(args.param, system.module):
         raise Fail(
             f"--param {args.param}: an open value (each value derives its own model), "

@@ -14,6 +14,7 @@ from ._common import (
     parse_range,
     parse_set,
     refuse_conflicts,
+    refuse_restated,
     require,
 )
 from ._output import format_option, units_option, write_result
@@ -280,6 +281,7 @@ def _cmd_sweep(args) -> int:
     from gearsym.resolve import needs_derivation
 
     system = system_of(args.scene, parse_set(args.set))
+    refuse_restated(args, system.module, [args.param], f"--param {args.param}")
     if needs_derivation(args.param, system.module):
         raise Fail(
             f"--param {args.param}: an open value (each value derives its own model); sweep "

@@ -13,6 +13,7 @@ from ._common import (
     out_folder,
     parse_set,
     refuse_conflicts,
+    refuse_restated,
     require,
 )
 from ._limits import MAX_PERIOD
@@ -207,6 +208,7 @@ def _cmd_response(args) -> int:
         raise Fail(f"--tail must be a share in (0, 1), got {args.tail}")
     refuse_conflicts(args, [name], f"--param {args.param}")
     system = system_of(args.scene, parse_set(args.set))
+    refuse_restated(args, system.module, [name], f"--param {args.param}")
     if needs_derivation(name, system.module):
         raise Fail(
             f"--param {name}: an open value (each value derives its own model), not a "

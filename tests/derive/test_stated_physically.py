@@ -85,3 +85,32 @@ def test_what_a_scene_cannot_state_is_refused_in_one_line(tmp_path, change, word
     assert done.returncode == 2, done.stderr
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and words in lines[0], done.stderr
+
+
+@pytest.mark.parametrize(
+    ("argv", "words"),
+    [
+        (
+            ["sweep", "reference-light", "--param", "speed_rpm", "--range", "1000:3000:3"]
+            + ["--set", "omega=0.3"],
+            "--set omega=0.3 and --param speed_rpm state one quantity",
+        ),
+        (
+            ["sweep", "reference-light", "--param", "half_backlash_um_pg", "--range", "40:60:3"]
+            + ["--set", "half_backlash_um=50"],
+            "state one quantity (half_backlash_um and half_backlash_um_pg)",
+        ),
+    ],
+)
+def test_a_set_value_the_sweep_states_under_another_name_is_refused(tmp_path, argv, words):
+    """The helper's find: a sweep over the speed with --set omega ran (the sweep's value
+    won) and recorded the omega beside it; one quantity under two names is refused, as
+    a map refuses it.  Another quantity beside the swept one is not (a torque of q while
+    p's is swept)."""
+    done = subprocess.run(
+        [sys.executable, "-m", "gearsym", *argv, "--out", str(tmp_path / "o")],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 2 and words in done.stderr, done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1
