@@ -104,9 +104,9 @@ def register(sub) -> None:
     co.add_argument(
         "--step",
         type=float,
-        default=0.02,
-        help=f"initial arclength step ({MIN_STEP:g} to |TO - FROM|; it then adapts up to "
-        "four times this)",
+        default=None,
+        help=f"first arclength step, {MIN_STEP:g} to |TO - FROM|, then up to four times it "
+        "(default 0.02 x max(1, |TO - FROM|) up to |TO - FROM|: rpm step by their range)",
     )
     co.add_argument(
         "--switch", action="store_true", help="switch to the period-2n branch at a period doubling"
@@ -284,17 +284,16 @@ def _cmd_continue(args) -> int:
     for name in ("from_", "to"):
         if not math.isfinite(getattr(args, name)):
             raise Fail(f"--{name.rstrip('_')} must be a finite number")
+    if args.from_ == args.to:
+        raise Fail(f"--to {args.to:g} equals --from: nothing to continue; give another end")
+    span = abs(args.to - args.from_)  # the default step by it: 0.02 of omega, 120 of 6,000 rpm
+    args.step = min(0.02 * max(1.0, span), span) if args.step is None else args.step
     if not (args.step > 0 and math.isfinite(args.step)):
         raise Fail(f"--step must be a positive number, got {args.step}")
     if args.period < 1:
         raise Fail(f"--period must be >= 1, got {args.period}")
     if args.settle < 0:
         raise Fail(f"--settle must be >= 0, got {args.settle}")
-    if args.from_ == args.to:
-        raise Fail(
-            f"--to {args.to:g} equals --from: there is nothing to continue; give another end"
-        )
-    span = abs(args.to - args.from_)
     if not MIN_STEP <= args.step <= span:
         raise Fail(
             f"--step {args.step:g}: give {MIN_STEP:g} to {span:g} (|--to - --from|; "

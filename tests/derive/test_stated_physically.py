@@ -114,3 +114,22 @@ def test_a_set_value_the_sweep_states_under_another_name_is_refused(tmp_path, ar
     )
     assert done.returncode == 2 and words in done.stderr, done.stderr
     assert len(done.stderr.strip().splitlines()) == 1
+
+
+def test_a_continuation_over_the_speed_steps_by_its_range(tmp_path):
+    """``continue --param speed_rpm`` with the default step: it stepped 0.02 rpm (omega's
+    step) and stopped at its 400-point cap 32 rpm in (the second new-user pass); the step
+    now follows the range (0.02 of it), so the branch reaches --to."""
+    import json
+
+    out = tmp_path / "c"
+    done = subprocess.run(
+        [sys.executable, "-m", "gearsym", "continue", "reference-light", "--param"]
+        + ["speed_rpm", "--from", "1000", "--to", "1200", "--out", str(out)],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 0, done.stderr
+    branches = json.loads((out / "branches.json").read_text(encoding="utf-8"))["branches"]
+    reached = max(max(b["values"]) for b in branches)
+    assert reached == pytest.approx(1200.0, abs=1e-6)
