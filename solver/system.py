@@ -18,7 +18,29 @@ import numpy as np
 
 from .contract import Contract, load_generated
 
-__all__ = ["System"]
+__all__ = ["System", "restates"]
+
+
+def restates(module, a: str, b: str) -> bool:
+    """Whether the named values ``a`` and ``b`` of ``module`` state one quantity: one
+    name, an alias and the name it stands for (``half_backlash_um``, ``_pg``), a body
+    model's physical name and its parameter (``mesh_frequency_hz``, ``omega``), or a
+    physical quantity and a parameter it replaces (``speed_rpm``, ``omega``; a torque
+    and ``lambda``).  Two quantities that replace the same parameters are not one: the
+    torques of two gears both replace the non-dimensional loads, and each keeps its own."""
+    physical = getattr(module, "PHYSICAL", {})
+    aliases = getattr(module, "PHYSICAL_ALIASES", {})
+    replaces = getattr(module, "PHYSICAL_REPLACES", {})
+
+    def names(k: str) -> set:
+        out = {k, *aliases.get(k, ())}
+        to = physical.get(k)
+        return out | {to} if isinstance(to, str) else out
+
+    na, nb = names(a), names(b)
+    return bool(na & nb) or any(
+        n in replaces.get(m, ()) or m in replaces.get(n, ()) for n in na for m in nb
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -73,23 +95,12 @@ class System:
     def _kept(self, values: dict) -> dict:
         """This system's named values less those that ``values`` state again under another
         name (``omega`` after ``speed_rpm``, ``mesh_frequency_hz`` after ``omega``): the
-        later value wins, as it does under one name."""
-        module = self.module
-        physical = getattr(module, "PHYSICAL", {})
-        aliases = getattr(module, "PHYSICAL_ALIASES", {})
-        replaces = getattr(module, "PHYSICAL_REPLACES", {})
-
-        def names(k: str) -> set:
-            out = {k, *aliases.get(k, ())}
-            to = physical.get(k)
-            if isinstance(to, str):  # a body model's physical name of a parameter
-                out.add(to)
-            for n in list(out):
-                out |= set(replaces.get(n, ()))
-            return out
-
-        new = set().union(*(names(k) for k in values)) if values else set()
-        return {k: v for k, v in self.values.items() if not names(k) & new}
+        later value wins, as it does under one name (:func:`restates`)."""
+        return {
+            k: v
+            for k, v in self.values.items()
+            if not any(restates(self.module, k, n) for n in values)
+        }
 
     def with_values(self, **values) -> System:
         """The same model with some named values changed (the rest kept; a value stated

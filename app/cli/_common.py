@@ -216,14 +216,12 @@ def refuse_restated(args, module, varied: list[str], option: str) -> None:
     """``--set`` of a quantity that a varied parameter states under another name: omega
     beside a sweep over ``speed_rpm`` (the sweep's value won, and the record kept the --set
     beside it), an alias of a mesh's own name, a non-dimensional load beside a torque."""
-    replaces = getattr(module, "PHYSICAL_REPLACES", {})
-    aliases = getattr(module, "PHYSICAL_ALIASES", {})
+    from gearsym.solver.system import restates
+
     for item in getattr(args, "set", None) or []:
         key = item.partition("=")[0].strip()
         for v in varied:
-            a, b = {key, *aliases.get(key, ())}, {v, *aliases.get(v, ())}
-            pairs = [(n, m) for n in a for m in b] + [(m, n) for n in a for m in b]
-            if key != v and (a & b or any(n in replaces.get(m, ()) for n, m in pairs)):
+            if key != v and restates(module, key, v):
                 said = f"--set {item} and {option} state one quantity ({key} and {v})"
                 raise Fail(f"{said}; drop the --set")
 

@@ -133,3 +133,17 @@ def test_a_continuation_over_the_speed_steps_by_its_range(tmp_path):
     branches = json.loads((out / "branches.json").read_text(encoding="utf-8"))["branches"]
     reached = max(max(b["values"]) for b in branches)
     assert reached == pytest.approx(1200.0, abs=1e-6)
+
+
+def test_each_gears_torque_is_kept_when_another_is_set():
+    """Setting p's torque dropped q's, set before it (both replace the non-dimensional
+    loads, which made them one quantity to ``System._kept``): a sweep over p's torque with
+    --set of q's ran at q's default torque.  The reference: the model given both at once."""
+    light = load("reference-light")
+    both = light.with_values(torque_Nm_q=-40.0, torque_Nm_p=300.0)
+    one_by_one = light.with_values(torque_Nm_q=-40.0).with_values(torque_Nm_p=300.0)
+    assert one_by_one.values == {"torque_Nm_q": -40.0, "torque_Nm_p": 300.0}
+    np.testing.assert_array_equal(one_by_one.p, both.p)
+    # one quantity under two names: the later wins, as before
+    assert light.with_values(speed_rpm=2000.0).with_values(omega=0.4).values == {"omega": 0.4}
+    assert light.with_values(f1=0.2).with_values(torque_Nm_p=300.0).values == {"torque_Nm_p": 300.0}
