@@ -62,12 +62,17 @@ def contact(tr) -> dict:
     (``(1 + v(tau)) g(u)``, the stiffness variation included); read from the samples
     (``samples_per_period`` of the run), so a contact loss shorter than a sample can be
     missed."""
-    from gearsym.solver.analysis.meshing import body_mesh_deflections, loaded_sides
+    from gearsym.solver.analysis.meshing import (
+        body_mesh_deflections,
+        loaded_sides,
+        meshing_states,
+    )
 
     module = tr.system.module
     omega = tr.system.p[list(module.PARAMETERS).index("omega")]
     tau = np.asarray(tr.t, dtype=float)
     sides = loaded_sides(tr.system)
+    shares = meshing_states(tr)  # the shares every record of the run carries
     out = {}
     for mesh, u in body_mesh_deflections(tr).items():
         v = sum(
@@ -76,11 +81,11 @@ def contact(tr) -> dict:
         )
         force = (1.0 + v) * np.where(u > 1.0, u - 1.0, np.where(u < -1.0, u + 1.0, 0.0))
         out[mesh] = {
-            "apart": float(np.mean(np.abs(u) <= 1.0)),
+            "apart": shares[mesh]["separated"],
             "loaded_side": sides[mesh],
             "half_backlash_um": 1e6 * float(module.MESHES[mesh]["half_backlash_m"]),
-            "loaded_flank": float(np.mean(sides[mesh] * u > 1.0)),
-            "back_flank": float(np.mean(sides[mesh] * u < -1.0)),
+            "loaded_flank": shares[mesh]["forward"],
+            "back_flank": shares[mesh]["backward"],
             "min": float(u.min()),
             "max": float(u.max()),
             "force_min": float(force.min()),
