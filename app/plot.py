@@ -41,16 +41,17 @@ def save(fig, path):
     return save_figure(fig, path)
 
 
-def point(result, title: str = "", periods_shown: int = 20):
+def point(result, title: str = "", periods_shown: int = 20, *, units: str = "model"):
     """One operating point: time series, phase portrait with its Poincaré points and
     spectrum of each mesh coordinate, one row per coordinate.
 
     ``result``: a ``PointResult`` (``gearsym.analyse``; its verdict and evidence go into
-    the title) or a ``Trajectory`` (``gearsym.simulate``; no verdict).  Returns a Figure.
+    the title) or a ``Trajectory`` (``gearsym.simulate``; no verdict).  ``units``:
+    ``model`` (half backlashes, τ) or ``physical`` (µm, ms, m/s, Hz).  Returns a Figure.
     """
     from gearsym.solver.plots import point_figure
 
-    return point_figure(result, title=title, periods_shown=periods_shown)
+    return point_figure(result, title=title, periods_shown=periods_shown, units=units)
 
 
 def bifurcation(sweeps, states=None, title: str = "", *, system=None, units: str = "model"):

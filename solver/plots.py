@@ -11,22 +11,16 @@ of one operating point says that point (ω̄, loads, backlash model) and its ver
 
 from __future__ import annotations
 
-import textwrap
-
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .analysis import spectrum  # noqa: E402
-from .analysis.point import verdict_line  # noqa: E402
-from .analysis.spectra import ROUNDING  # noqa: E402
-from .integrate import Trajectory  # noqa: E402
+from .plots_point import point_figure  # noqa: E402
 from .plots_style import (  # noqa: E402
     BIFURCATIONS,
     MOTION_CLASSES,
-    at_rest,
     categorical,
     legend_below,
     motion_class,
@@ -47,9 +41,6 @@ __all__ = [
     "point_figure",
     "save_figure",
 ]
-
-PORTRAIT_PERIODS = 500  # periods a phase portrait draws at most
-HARMONICS_SHOWN = 6  # a spectrum runs to (HARMONICS_SHOWN + 1/2) omega: the 6th is whole
 
 
 def _distinct(pts: np.ndarray, lo: float, cell: float) -> np.ndarray:
@@ -127,122 +118,6 @@ def _parameter_axis(axes, system, units: str, name: str) -> None:
     label, top = parameter_axis(Units.of(system, units), name)
     axes[-1, 0].set_xlabel(label)
     secondary_axis(axes[0, 0], top)
-
-
-def _title(tr: Trajectory, point, title: str) -> str:
-    lines = [title] if title else []
-    lines.append(operating_point(tr.system))
-    if point is not None:
-        lines.append(textwrap.fill(verdict_line(point), 150))
-    return "\n".join(lines)
-
-
-def point_figure(point, title: str = "", periods_shown: int = 20):
-    """One operating point: time series, phase portrait with Poincaré points, and spectrum
-    of each mesh coordinate (one row per coordinate).
-
-    ``point`` is a :class:`~.analysis.PointResult` (any point, periodic or chaotic: its
-    verdict per coordinate and largest Lyapunov exponent go into the title) or a bare
-    :class:`~.integrate.Trajectory` (no verdict).  The title states ω̄, the loads and the
-    backlash model.  Spectra: amplitude in half backlashes (Hann window, a cosine of
-    amplitude a reads a) against frequency in rad per unit τ, up to 6.5 ω̄ so the sixth
-    harmonic is whole; the top axis counts multiples of ω̄.  Nothing is floored: bins the
-    FFT finds exactly zero are left out of the log axis.
-    """
-    tr = getattr(point, "trajectory", point)
-    result = None if tr is point else point
-    coords = tr.system.coordinates
-    fig, axes = plt.subplots(len(coords), 3, figsize=(13, 3.3 * len(coords)), squeeze=False)
-    spp = tr.samples_per_period
-    shown = slice(max(0, tr.t.size - periods_shown * spp), None)
-    for row, c in enumerate(coords):
-        u, du = tr.coordinate(c), tr.velocity(c)
-        ax = axes[row, 0]
-        ax.plot(tr.t[shown], u[shown], lw=0.8, color="#1f1f1f", label="response")
-        edges = tr.system.contract.contact.get(c, ())
-        for k, edge in enumerate(edges):
-            where = ", ".join(f"{e:g}" for e in edges)
-            ax.axhline(
-                edge,
-                color="grey",
-                lw=0.8,
-                ls="--",
-                label=None if k else f"contact edges {c} = {where} (the model's contract)",
-            )
-        at_rest(ax, "y", u[shown])
-        ax.set_xlabel("τ (non-dimensional time)")
-        ax.set_ylabel(f"{c} (half backlashes)")
-        ax.set_title(f"{c}: time series (last {periods_shown} periods)", fontsize=9)
-        ax = axes[row, 1]
-        # at most the last PORTRAIT_PERIODS periods (a path of every sample of a long run
-        # takes matplotlib gigabytes); the Poincare points likewise
-        tail = slice(max(0, tr.t.size - PORTRAIT_PERIODS * spp), None)
-        ax.plot(u[tail], du[tail], lw=0.3, color="#1f1f1f", alpha=0.6)
-        ax.plot(
-            tr.poincare[tr.system.index(c)][-PORTRAIT_PERIODS:],
-            tr.poincare[tr.system.velocity_index(c)][-PORTRAIT_PERIODS:],
-            "o",
-            ms=3,
-            color="#ce1256",
-            label="Poincaré points (τ = 0 mod T)",
-        )
-        at_rest(ax, "x", u[tail])
-        at_rest(ax, "y", du[tail])
-        ax.set_xlabel(f"{c} (half backlashes)")
-        ax.set_ylabel(f"d{c}/dτ")
-        shown_periods = min(PORTRAIT_PERIODS, tr.poincare.shape[1])
-        ax.set_title(f"{c}: phase portrait (last {shown_periods} periods)", fontsize=9)
-        _spectrum_panel(axes[row, 2], tr, c)
-    fig.suptitle(_title(tr, result, title), fontsize=10)
-    fig.tight_layout()
-    handles = {}  # every panel's entries once (a band may be drawn in one row only)
-    for c, ax in ((c, ax) for c, row in zip(coords, axes, strict=True) for ax in row):
-        for h, label in zip(*ax.get_legend_handles_labels(), strict=True):
-            handles.setdefault(label.replace(f" {c} = ", " = "), h)
-    fig.legend(
-        handles.values(),
-        handles.keys(),
-        loc="upper center",
-        bbox_to_anchor=(0.5, 0.0),
-        ncol=len(handles),
-        fontsize=8,
-        frameon=False,
-    )
-    return fig
-
-
-def _spectrum_panel(ax, tr: Trajectory, c: str) -> None:
-    sp = spectrum(tr, c)
-    top = (HARMONICS_SHOWN + 0.5) * sp.omega
-    keep = (sp.frequency <= top) & (sp.amplitude > 0)
-    ax.semilogy(sp.frequency[keep], sp.amplitude[keep], lw=0.8, color="#1f1f1f")
-    ax.set_xlim(0, top)
-    # what the integration's relative tolerance cannot resolve, and what is rounding of
-    # the signal (the spectrum's own floor: a coordinate at rest has nothing above it)
-    level = tr.rtol * float(sp.amplitude[keep].max()) if np.any(keep) else 0.0
-    level = max(level, ROUNDING * sp.level)
-    if level > (bottom := ax.get_ylim()[0]):
-        ax.axhspan(
-            bottom,
-            level,
-            color="0.9",
-            zorder=0,
-            label="below rtol × the largest peak, or rounding (1e-10 of the signal)",
-        )
-        ax.set_ylim(bottom=bottom)
-    ax.set_xlabel("frequency (rad per unit τ)")
-    ax.set_ylabel(f"amplitude of {c} (half backlashes)")
-    harmonics = ax.secondary_xaxis(
-        "top", functions=(lambda f, w=sp.omega: f / w, lambda k, w=sp.omega: k * w)
-    )
-    harmonics.set_xticks(range(HARMONICS_SHOWN + 1))
-    harmonics.tick_params(labelsize=7)
-    ax.set_title(
-        f"{c}: spectrum, top axis in multiples of ω̄ = {sp.omega:g}; "
-        f"{sp.duration:.0f} τ, bin {sp.resolution:.2g}",
-        fontsize=8,
-    )
-    ax.grid(alpha=0.3)
 
 
 def map_figure(

@@ -50,25 +50,37 @@ def _segments(x, y, stable):
 
 def frequency_response_figure(resp, physical: bool = False, title: str = ""):
     """One panel per mesh coordinate of a :class:`~.sweep.frequency.FrequencyResponse`;
-    returns the ``Figure`` (nothing saved).  ``physical``: mesh frequency in Hz and the
-    dynamic transmission error's amplitude in µm (over the forcing frequency, or over a
-    model's own mesh frequency in Hz: a planetary set's or a train's ``mesh_frequency_hz``)."""
+    returns the ``Figure`` (nothing saved).  ``physical``: the dynamic transmission
+    error's amplitude in µm (with the half backlash at each value of the parameter), over
+    the mesh frequency in Hz where the parameter is the forcing frequency (or a model's
+    own mesh frequency in Hz: a planetary set's or a train's ``mesh_frequency_hz``), over
+    the speed in rpm with the mesh frequency on a top axis where it is ``speed_rpm``, and
+    over any other parameter as it is."""
+    from .units import Units, parameter_axis, secondary_axis, state_factors
+
     system = resp.system
     coords = system.coordinates
     scales = system.scales()
     forcing = system.contract.forcing_frequency
     # a model's own name for the forcing frequency in Hz (a planetary set's or a train's
-    # mesh_frequency_hz): the axis is Hz already, the amplitudes turn into µm as well
+    # mesh_frequency_hz): the axis is Hz already
     in_hz = getattr(system.module, "PHYSICAL", {}).get(resp.parameter) == forcing
-    physical = physical and (resp.parameter == forcing or in_hz)
-    fx = scales["omega_n_rad_per_s"] / (2 * math.pi) if physical and not in_hz else 1.0
+    hz = physical and resp.parameter == forcing
+    fx = scales["omega_n_rad_per_s"] / (2 * math.pi) if hz else 1.0
+    xlabel, top = resp.parameter, None
+    if hz or (physical and in_hz):
+        xlabel = "mesh frequency (Hz)"
+    elif physical:
+        xlabel, top = parameter_axis(Units.of(system, "physical"), resp.parameter)
+    kind = "physical" if physical else "model"
     fig, axes = plt.subplots(
         len(coords), 1, figsize=(8, 3.2 * len(coords)), sharex=True, squeeze=False
     )
     for ax, c in zip(axes[:, 0], coords, strict=True):
-        fy = scales["half_backlash_m"].get(c, 1.0) * 1e6 if physical else 1.0
+        unit = "half backlashes"
         for curve in resp.curves:
             x = curve.values * fx
+            fy, unit = state_factors(system, kind, resp.parameter, curve.values, c)
             y = curve.stats[c]["amplitude"] * fy
             colour = METHODS.get(curve.method, "k")
             if curve.method == "integration":
@@ -110,9 +122,10 @@ def frequency_response_figure(resp, physical: bool = False, title: str = ""):
                     mfc="none",
                     label=f"{e.name}" + (" (a sweep jumps here)" if e.jump else ""),
                 )
-        ax.set_ylabel(f"half peak-to-peak of {c}" + (" (µm)" if physical else " (half backlashes)"))
+        ax.set_ylabel(f"half peak-to-peak of {c} ({unit})")
         ax.grid(alpha=0.3)
-    axes[-1, 0].set_xlabel("mesh frequency (Hz)" if physical else resp.parameter)
+    axes[-1, 0].set_xlabel(xlabel)
+    secondary_axis(axes[0, 0], top)
     if title:
         axes[0, 0].set_title(title, fontsize=10)
     legend_below(fig, axes.ravel())  # one legend: each entry once, not once per panel

@@ -12,8 +12,7 @@ generated ``scales()``, so a changed inertia or backlash moves them) and convert
   and to orders of the reference mesh frequency (``w / omega``);
 * a time to s (``tau / omega_n``).
 
-``kind = "model"`` leaves every number as it is, with the model's words for the units, so
-that one code path prints either.
+``kind = "model"`` leaves every number as it is, in the model's words for the units.
 """
 
 from __future__ import annotations
@@ -231,13 +230,16 @@ class InUnits:
             return list(columns), [list(r) for r in rows]
         where = [list(columns).index(p) for p in self.parameters if p in columns]
         added = [(c, coordinate_of(base, c)) for c in columns if coordinate_of(base, c)]
+        tau = "tau" in columns  # a trajectory's samples: their time in seconds
         memo: dict = {}
         extra_names = [f"{c}_um" for c, _ in added]
         lyapunov = "lyapunov" in columns
         extra_names += ["lyapunov_per_s"] * lyapunov
-        speeds = [k for k in (SPEED, MESH_HZ) if k not in columns and k in base.scales]
-        # a model in body coordinates states no speed: its rows' mesh frequency from omega
-        hz = MESH_HZ not in columns and MESH_HZ not in base.scales
+        extra_names += ["t_s"] * tau
+        # the rows' speed and mesh frequency (from omega if the model states no speed); not
+        # for a trajectory's samples, all at the one operating point the block states
+        speeds = [k for k in (SPEED, MESH_HZ) if k not in columns and k in base.scales] * (not tau)
+        hz = MESH_HZ not in columns and MESH_HZ not in base.scales and not tau
         out = []
         for row in rows:
             key = tuple(float(row[k]) for k in where)
@@ -246,6 +248,8 @@ class InUnits:
             if lyapunov:
                 omega_n = u.scales["omega_n_rad_per_s"]
                 extra.append(_times(_num(row[columns.index("lyapunov")]), omega_n))
+            if tau:
+                extra.append(u.time(float(row[columns.index("tau")])))
             extra += [u.scales[k] for k in speeds] + [u.frequency(u.omega)] * hz
             out.append([*row, *extra])
         return [*columns, *extra_names, *speeds, *[MESH_HZ] * hz], out
@@ -259,6 +263,7 @@ class InUnits:
         first = len(self.result.to_table()[0])
         meaning = {
             "lyapunov_per_s": "largest Lyapunov exponent per second (lyapunov x omega_n)",
+            "t_s": "time in seconds (tau / omega_n)",
             SPEED: f"speed of gear '{base.scales.get('speed_gear', '?')}' in rpm at the row",
             MESH_HZ: "mesh frequency in Hz at the row (omega omega_n / 2 pi)",
         }
@@ -267,7 +272,10 @@ class InUnits:
             for c in columns[first:]
         }
         swept = [q for q in self.parameters if q in (base.forcing, SPEED, MESH_HZ)]
-        return {
+        # one analysed point: its ranges, peaks and forces in units (point_in_units)
+        point = hasattr(self.result, "classification") and hasattr(self.result, "trajectory")
+        summary = {"coordinates": point_in_units(self.result, base)["coordinates"]} if point else {}
+        return summary | {
             "units": base.kind,
             # the rows' own frequency where it is what varies (their columns hold it)
             "operating_point": f"{swept[0]} varies by row (its column)"

@@ -129,6 +129,7 @@ SOLVER_ORDER = {
     "plots_maps": 6,
     "plots_style": 6,
     "plots_modes": 6,
+    "plots_point": 6,
     "plots_response": 6,
 }
 

@@ -276,3 +276,63 @@ def test_frequency_response_files_in_physical_units(tmp_path, capsys):
     assert main([*argv, "--out", str(tmp_path / "model")]) == 0
     head = (tmp_path / "model" / "frequency_response.csv").read_text().splitlines()
     assert not any("_um" in ln for ln in head if not ln.startswith("#"))
+
+
+def test_simulate_writes_its_samples_and_draws_its_figure_in_physical_units(tmp_path, capsys):
+    """`simulate --units physical`: the point files add µm and seconds beside the model's
+    columns, and the figure's axes are in µm, ms, m/s and Hz.  References: x b with
+    b = 50 µm (scenes/topologies/diso.toml), t = tau / omega_n, d/dt = omega_n d/dtau, and
+    the mesh frequency omega omega_n / 2 pi."""
+    from scipy.io import loadmat
+
+    argv = ["simulate", "reference-light", "--transient", "20", "--periods", "10"]
+    code, said = _run([*argv, "--units", "physical", "--out", str(tmp_path)], capsys)
+    assert code == 0 and "µm" in said
+    table = _csv(tmp_path / "point.csv")
+    doc = json.loads((tmp_path / "point.json").read_text(encoding="utf-8"))
+    omega_n = doc["scales"]["omega_n_rad_per_s"]
+    assert np.allclose(table["u_um"], 50.0 * table["u"], rtol=1e-12, atol=0)
+    assert np.allclose(table["t_s"], table["tau"] / omega_n, rtol=1e-12, atol=0)
+    assert "speed_rpm" not in table  # one operating point, stated once in the block
+    block = doc["in_units"]
+    assert block["coordinates"]["v"]["range"] == pytest.approx(
+        [50.0 * table["v"].min(), 50.0 * table["v"].max()], rel=1e-12
+    )
+    mat = loadmat(tmp_path / "point.mat", simplify_cells=True)
+    assert np.allclose(mat["table"]["v_um"], table["v_um"], rtol=1e-15, atol=0)
+
+    from gearsym.solver.plots import point_figure
+
+    system = gearsym.load("reference-light")
+    point = gearsym.analyse(system, transient=20, periods=10, lyapunov_periods=10)
+    fig = point_figure(point, units="physical")
+    series, portrait, spectrum = fig.axes[:3]
+    assert series.get_ylabel() == "u (µm)" and series.get_xlabel() == "t (ms)"
+    assert portrait.get_ylabel() == "du/dt (m/s)" and spectrum.get_xlabel() == "frequency (Hz)"
+    tr = point.trajectory
+    line = series.get_lines()[0]
+    shown = tr.t[-line.get_xdata().size :]
+    assert np.allclose(line.get_xdata(), shown / omega_n * 1e3, rtol=1e-12)
+    assert np.allclose(line.get_ydata(), 50.0 * tr.coordinate("u")[-shown.size :], rtol=1e-12)
+    du = portrait.get_lines()[0].get_ydata()
+    assert np.allclose(du, 50e-6 * omega_n * tr.velocity("u")[-du.size :], rtol=1e-12)
+    hz = omega_n / (2 * math.pi)
+    assert spectrum.get_xlim()[1] == pytest.approx(6.5 * system.omega * hz, rel=1e-12)
+
+
+def test_a_frequency_response_over_the_speed_is_drawn_in_um(tmp_path):
+    """Over speed_rpm the response's amplitudes are µm (x b, b = 50 µm), its axis the speed
+    with the mesh frequency (teeth x speed / 60, 50 teeth on p) on top."""
+    from gearsym.solver.plots_response import frequency_response_figure
+
+    system = gearsym.load("reference-light")
+    resp = gearsym.frequency_response(system, "speed_rpm", 900.0, 1000.0, points=4, methods=("hb",))
+    fig = frequency_response_figure(resp, physical=True)
+    ax = fig.axes[0]
+    assert ax.get_ylabel() == "half peak-to-peak of u (µm)"
+    drawn = np.concatenate([ln.get_ydata() for ln in ax.get_lines()])
+    expected = np.concatenate([50.0 * c.stats["u"]["amplitude"] for c in resp.curves])
+    assert np.min(np.abs(drawn[:, None] - expected[None, :]), axis=1).max() < 1e-12
+    assert expected.min() < 3.0 < expected.max() and drawn.size >= expected.size
+    top = [a for a in ax.child_axes if a.get_xlabel() == "mesh frequency (Hz)"]
+    assert top and fig.axes[-1].get_xlabel().startswith("speed_rpm")

@@ -42,7 +42,9 @@ def register(sub) -> None:
     units_option(
         si,
         "deflections (dynamic transmission error) in µm, mesh forces in N with the dynamic "
-        "factor, frequencies in Hz and orders of the mesh frequency, the speed in rpm",
+        "factor, frequencies in Hz and orders of the mesh frequency, the speed in rpm; "
+        "point.png in µm, ms, m/s and Hz; the point files with added columns "
+        "(<coordinate>_um, t_s) and an in_units block",
     )
     si.add_argument(
         "--out", metavar="DIR", help="also write point.json, .csv, .mat (--format) and point.png"
@@ -135,17 +137,20 @@ def _cmd_simulate(args) -> int:
     if args.out:
         from gearsym.solver import plots
 
+        from gearsym.solver.units import in_units as with_units
+
         out = out_folder(args.out)
         write_result(
             out,
             "point",
-            result,
+            with_units(result, system) if units.physical else result,
             args,
             initial_state=data["initial_state"],
             meshes=data.get("meshes"),  # a planetary set's or a train's, as --json has them
             shafts=data.get("shafts"),
         )
-        plots.save_figure(plots.point_figure(result, title=system.name), out / "point.png")
+        figure = plots.point_figure(result, title=system.name, units=args.units)
+        plots.save_figure(figure, out / "point.png")
     tr = result.trajectory
     # exit status 3: the run ended invalid, divergent or failed (docs/user-guide.md)
     code = 0 if tr.status == "ok" else 3
