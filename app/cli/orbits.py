@@ -20,7 +20,7 @@ from ._common import (
 from ._limits import MAX_PERIOD, MAX_SEGMENTS, MAX_SETTLED, MAX_TRIES, MIN_STEP, bounded_shoot
 from ._output import branches_document, format_option, units_option, write_result
 from ._start import resolve_start, start_options
-from ._system import system_of
+from ._system import system_of, unknown_names
 
 __all__ = ["register"]
 
@@ -249,22 +249,22 @@ def _cmd_shoot(args) -> int:
         "  multipliers: "
         + ", ".join(f"{m.real:+.6f}{m.imag:+.6f}i (|{abs(m):.6f}|)" for m in fl.multipliers)
     )
-    losing = {
-        "fold": "+1 (fold)",
-        "period-doubling": "-1 (period doubling)",
-        "neimark-sacker": "a complex pair (Neimark-Sacker)",
+    what, where = {
+        "fold": ("real and positive", "a fold"),
+        "period-doubling": ("real and negative", "a period doubling"),
+        "neimark-sacker": ("one of a complex pair", "a Neimark-Sacker bifurcation"),
     }[fl.kind]
     if fl.stability == "neutral":
         verdict = (
             f"neutral: the largest multiplier is on the unit circle (|mu| - 1 = "
             f"{abs(fl.critical) - 1:+.1e}, within ±{fl.tolerance:.1e}, the monodromy's "
-            "estimated error)"
+            f"estimated error); it is {what}, as at {where}"
         )
     else:
-        verdict = (
-            f"{fl.stability} (|mu| - 1 = {abs(fl.critical) - 1:+.1e}, tolerance "
-            f"±{fl.tolerance:.1e}); the largest multiplier is on the side of {losing}"
-        )
+        side = "were it to reach" if fl.stability == "stable" else "it is outside"
+        verdict = f"{fl.stability} (|mu| - 1 = {abs(fl.critical) - 1:+.1e}, tolerance "
+        verdict += f"±{fl.tolerance:.1e}); the largest multiplier is {what} ({side} the "
+        verdict += f"unit circle: {where})"
     print(f"  {verdict}; Liouville error |log det M - ∫ tr J| = {fl.liouville_error:.2e}")
     for k, v in data.get("monodromy_agreement", {}).items():
         print(f"  monodromy {k}: {v:.2e} (max difference / max entry)")
@@ -326,7 +326,8 @@ def _cmd_continue(args) -> int:
                 start = point
                 check_start(point)
         except KeyError as err:
-            raise Fail(f"--param: {err.args[0]}") from None
+            said = unknown_names(system.module, [args.param], "--param")
+            raise Fail(said or f"--param: {err.args[0]}") from None
         except ValueError as err:
             raise Fail(f"{option} {value:g}: {args.param} = {value:g}: {err}") from None
     out = out_folder(args.out or f"continue_{system.name}_{args.param}")

@@ -46,7 +46,8 @@ def test_simulate_json_has_the_verdicts_and_their_evidence(capsys):
 def test_simulate_rejects_unknown_parameters_in_one_line(capsys):
     assert main(["simulate", "reference-light", "--set", "lamda=0.8"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "unknown parameter(s) ['lamda']" in err
+    assert err.count("\n") == 1 and "--set lamda: not a parameter of reference_light" in err
+    assert "(did you mean 'lambda'?)" in err and len(err) < 700
 
 
 def test_sweep_writes_data_and_a_bifurcation_diagram(tmp_path, capsys):
@@ -163,6 +164,14 @@ BAD_COMMANDS = [
     ),
     (["shoot", "reference-light", "--settle", "-1"], "--settle >= 0"),
     (
+        ["continue", "reference-light", "--param", "lamda", "--from", "0.1", "--to", "0.2"],
+        "--param lamda: not a parameter of reference_light (did you mean 'lambda'?)",
+    ),
+    (
+        ["frequency-response", "reference-light", "--param=f_1=0.1:0.2:3"],
+        "--param f_1: not a parameter of reference_light (did you mean 'f1'?)",
+    ),
+    (
         ["simulate", "reference-light", "--set", "omega=0"],
         "omega must be in [0.001, 1000]",
     ),
@@ -174,7 +183,7 @@ BAD_COMMANDS = [
     (["sweep", "reference-light", "--param", "lambda", "--range", "0:1:1"], "NUM must be >= 2"),
     (
         ["sweep", "reference-light", "--param", "lamda", "--range", "0:1:3"],
-        "unknown parameter(s) ['lamda']",
+        "--param lamda: not a parameter of reference_light (did you mean 'lambda'?)",
     ),
 ]
 
@@ -304,3 +313,15 @@ def test_long_periods_do_not_break_the_liouville_check(capsys):
     assert main(argv) == 0
     error = json.loads(capsys.readouterr().out)["floquet"]["liouville_error"]
     assert error is None or error >= 0
+
+
+def test_shoot_says_where_a_stable_orbit_would_lose_stability(capsys):
+    """A stable orbit whose largest multipliers are a complex pair is not a Neimark-Sacker
+    point: the line says the pair would have to reach the unit circle.  Reference: the
+    multipliers printed beside it (complex, modulus below 1)."""
+    assert main(["shoot", "reference-light"]) == 0
+    out = capsys.readouterr().out
+    line = next(ln for ln in out.splitlines() if ln.strip().startswith("stable"))
+    assert "one of a complex pair (were it to reach the unit circle" in line
+    mus = next(ln for ln in out.splitlines() if "multipliers:" in ln)
+    assert "i (|0.68" in mus and "(Neimark-Sacker)" not in out
