@@ -40,7 +40,10 @@ def test_map_prints_one_record_per_grid_point_and_attractor(capsys, tmp_path):
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (("--x=lamda=0:1:3", "--y=f1=0.1:0.3:2"), "--x lamda: unknown parameter"),
+        (
+            ("--x=lamda=0:1:3", "--y=f1=0.1:0.3:2"),
+            "--x lamda: not a parameter of reference_light (did you mean 'lambda'?)",
+        ),
         (("--x=lambda=0:1", "--y=f1=0.1:0.3:2"), "--x lambda=0:1: expected START:STOP:NUM"),
         (("--x=lambda=0:1:3", "--y=lambda=0:1:3"), "name the same parameter"),
         (("--x=lambda=0:1:3", "--y=f1=0.1:0.3:2", "--initial-states=0"), "--initial-states"),

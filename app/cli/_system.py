@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from ._common import Fail
 
-__all__ = ["system_of"]
+__all__ = ["system_of", "unknown_names"]
 
 
 def system_of(scene_arg: str, sets: dict[str, float]):
@@ -33,13 +33,35 @@ def system_of(scene_arg: str, sets: dict[str, float]):
     try:
         return note_backlash(System.load(module, **rest))
     except KeyError as err:
-        from gearsym.derive.input.open_values import OPEN_VALUE_BASES
-        from gearsym.derive.input.reader import nearest
-
-        unknown = [k for k in rest if k not in module.PARAMETERS]
-        hint = nearest(unknown[0], OPEN_VALUE_BASES) if unknown else ""
-        more = f"{hint}; open values (derived anew): {', '.join(sorted(OPEN_VALUE_BASES))}"
-        raise Fail(f"--set: {err.args[0]}{more}") from None
+        raise Fail(unknown_names(module, rest) or f"--set: {err.args[0]}") from None
     except ValueError as err:
         given = " ".join(f"{k}={v}" for k, v in rest.items())
         raise Fail(f"--set {given}: {err}" if given else f"{scene_arg}: {err}") from None
+
+
+def unknown_names(module, names, flag: str = "--set") -> str:
+    """The line for ``flag`` naming a parameter the model does not take: the name, the
+    nearest it does take, and what it takes in short (the per-mesh forms once, the
+    model's own parameters by count); "" when every name is known."""
+    from gearsym.derive.input.open_values import OPEN_VALUE_BASES
+    from gearsym.derive.input.reader import nearest
+
+    if not hasattr(module, "SCENE_PARAMETERS") or not hasattr(module, "PARAMETERS"):
+        return ""
+    aliases = getattr(module, "PHYSICAL_ALIASES", {})
+    physical = getattr(module, "PHYSICAL", {})
+    known = [*module.SCENE_PARAMETERS, *physical, *aliases, *module.PARAMETERS]
+    unknown = [k for k in names if k not in known]
+    if not unknown:
+        return ""
+    each = {m for members in aliases.values() for m in members}
+    short = sorted(aliases) + sorted(k for k in physical if k not in each)
+    suffixes = sorted({m.rsplit("_", 1)[1] for m in each})
+    return (
+        f"{flag} {unknown[0]}: not a parameter of {module.NAME}"
+        f"{nearest(unknown[0], [*known, *OPEN_VALUE_BASES])}; it takes "
+        f"{', '.join(sorted(module.SCENE_PARAMETERS))}; in physical units {', '.join(short)}"
+        + (f" (most also per mesh or gear: <name>_{'|'.join(suffixes)})" if suffixes else "")
+        + f"; its {len(module.PARAMETERS)} model parameters (the audit page of `gearsym "
+        f"derive`); open values, derived anew: {', '.join(sorted(OPEN_VALUE_BASES))}"
+    )

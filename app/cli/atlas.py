@@ -18,7 +18,7 @@ from ._common import (
     require,
 )
 from ._output import format_option, units_option, write_result
-from ._system import system_of
+from ._system import system_of, unknown_names
 
 __all__ = ["register"]
 
@@ -236,7 +236,8 @@ def _cmd_map(args) -> int:
             first({xn: xv[0], yn: yv[0]} | {name: values[0]})
             first({xn: xv[-1], yn: yv[-1]} | {name: values[-1]})
         except KeyError as err:
-            raise Fail(f"{flag} {name}: {err.args[0]}") from None
+            said = unknown_names(system.module, (xn, yn), flag) if name in (xn, yn) else ""
+            raise Fail(said or f"{flag} {name}: {err.args[0]}") from None
         except ValueError as err:
             raise Fail(f"{flag} {name}: {err}") from None
     out = out_folder(args.out or f"map_{system.name}_{xn}_{yn}")

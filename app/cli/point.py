@@ -19,7 +19,7 @@ from ._common import (
 )
 from ._output import format_option, units_option, write_result
 from ._start import resolve_start, start_options
-from ._system import system_of
+from ._system import system_of, unknown_names
 from ._verdict import verdict_lines
 
 __all__ = ["register"]
@@ -136,7 +136,6 @@ def _cmd_simulate(args) -> int:
             data["shafts"] = shaft_torques(result.trajectory)
     if args.out:
         from gearsym.solver import plots
-
         from gearsym.solver.units import in_units as with_units
 
         out = out_folder(args.out)
@@ -298,7 +297,8 @@ def _cmd_sweep(args) -> int:
     try:
         checked_values(system, args.param, values)  # before the folder is made
     except ValueError as err:
-        raise Fail(f"--param {args.param} --range {args.range}: {err}") from None
+        said = unknown_names(system.module, [args.param], "--param")
+        raise Fail(said or f"--param {args.param} --range {args.range}: {err}") from None
     out = out_folder(args.out or f"sweep_{system.name}_{args.param}")
     bar = _Bar(len(values), f"{args.param}", enabled=not args.quiet)
     try:

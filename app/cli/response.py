@@ -18,7 +18,7 @@ from ._common import (
 )
 from ._limits import MAX_PERIOD
 from ._output import format_option, units_option, write_result
-from ._system import system_of
+from ._system import system_of, unknown_names
 
 __all__ = ["register"]
 
@@ -219,7 +219,8 @@ def _cmd_response(args) -> int:
         try:
             system.parameters_with(**{name: value})
         except KeyError as err:
-            raise Fail(f"--param {name}: {err.args[0]}") from None
+            said = unknown_names(system.module, [name], "--param")
+            raise Fail(said or f"--param {name}: {err.args[0]}") from None
         except ValueError as err:
             raise Fail(f"--param {args.param}: {name} = {value:g}: {err}") from None
     # the harmonic balance's Jacobian and Hill's matrix: (n (2H + 1))^2 numbers, a few times
