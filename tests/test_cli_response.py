@@ -20,7 +20,7 @@ def test_records_files_and_folds(capsys, tmp_path):
     assert len(records) >= 60
     for r in records:
         assert r["method"] == "hb" and isinstance(r["stable"], bool)
-        assert set(r) == {"method", "omega", "stable", "u", "v"}
+        assert set(r) == {"method", "curve", "omega", "stable", "u", "v"}
         assert set(r["u"]) == {"mean", "amplitude", "rms", "min", "max", "dynamic_factor"}
         assert r["u"]["amplitude"] >= 0 and r["u"]["dynamic_factor"] >= 1 - 1e-9
     omegas = [r["omega"] for r in records]
@@ -88,3 +88,21 @@ def test_an_unwritable_folder_is_refused_before_computing(capsys, tmp_path):
         f"--out={blocker / 'sub'}",
     )
     assert code == 2 and "--out" in err and "cannot write there" in err
+
+
+def test_a_second_curve_of_one_method_is_told_apart(capsys, tmp_path):
+    """Harmonic balance from both ends of a range its branch turned out of: the CSV's
+    'curve' column and the printed lines tell the two curves apart (the branch of
+    reference-light over 900 to 1,000 rpm turns at its fold near 969 rpm, issue 25's
+    new-user pass)."""
+    argv = ["frequency-response", "reference-light", "--param=speed_rpm=900:1000:4"]
+    code, out, err = run(capsys, *argv, "--no-figure", f"--out={tmp_path}")
+    assert code == 0, err
+    assert "hb (curve 0, column 'curve')" in out and "hb (curve 1, column 'curve')" in out
+    assert "a second curve, from the other end (speed_rpm = 1000)" in out
+    lines = [ln for ln in (tmp_path / "frequency_response.csv").read_text().splitlines()]
+    names, *rows = [ln.split(",") for ln in lines if not ln.startswith("#")]
+    curves = [int(r[names.index("curve")]) for r in rows]
+    assert curves == sorted(curves) and set(curves) == {0, 1}
+    first = [float(r[names.index("speed_rpm")]) for r in rows if r[1] == "1"][0]
+    assert first == 1000.0

@@ -284,8 +284,11 @@ def _cmd_response(args) -> int:
             "docs/analysis.md); --method all adds shooting"
             + (", which locates the kinks" if system.contract.switching_surfaces else "")
         )
-    for c in resp.curves:
+    methods = [c.method for c in resp.curves]
+    for k, c in enumerate(resp.curves):
         stable = int(c.stable.sum())
+        # one method's second curve (harmonic balance from the other end) named by its index
+        which = f" (curve {k}, column 'curve')" if methods.count(c.method) > 1 else ""
         if c.method == "integration":
             print(
                 f"integration, {c.details['direction']} sweep: {len(c.values)} points in "
@@ -299,7 +302,8 @@ def _cmd_response(args) -> int:
                 f"{c.details['largest_tail_share']:.1e} of the response"
             )
         print(
-            f"{c.method}: {len(c.values)} points ({stable} stable) in {c.wall_time:.2f} s" + extra
+            f"{c.method}{which}: {len(c.values)} points ({stable} stable) in "
+            f"{c.wall_time:.2f} s{extra}"
         )
         for e in c.events:
             ev = e.evidence

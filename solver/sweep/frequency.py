@@ -333,7 +333,13 @@ def frequency_response(
             if curve.details["status"] not in ("complete", "boundary"):
                 # the branch turned back out of the range: the rest of the range from the
                 # other end (the solution a simulation settles on there)
-                curves.append(_hb_curve(system, parameter, stop, start, harmonics, n, ds, grid))
+                rest = _hb_curve(system, parameter, stop, start, harmonics, n, ds, grid)
+                rest.details["notes"].insert(
+                    0,
+                    f"a second curve, from the other end ({parameter} = {stop:g}): the "
+                    "first turned back at a fold and left the range where it started",
+                )
+                curves.append(rest)
         elif m == "integration":
             curves += _integration_curves(
                 system, parameter, start, stop, points, settle, sampled, samples_per_period

@@ -60,7 +60,9 @@ class FrequencyResponse:
     curves: tuple[Curve, ...]
 
     def records(self) -> list[dict]:
-        out = [r for c in self.curves for r in c.records()]
+        """Every point of every curve, each with its curve's index in ``curves`` (one
+        method may give two: harmonic balance from both ends of a range it turned out of)."""
+        out = [r | {"curve": k} for k, c in enumerate(self.curves) for r in c.records()]
         if not self.system.contract.provides("mesh_force", "static_mesh_force"):
             # no mesh forces, no dynamic factor (not a null for every body coordinate)
             for r in out:
@@ -103,12 +105,13 @@ class FrequencyResponse:
             "curves": [
                 {
                     "method": c.method,
+                    "curve": k,
                     "points": len(c.values),
                     "wall_time_s": c.wall_time,
                     "events": [e.to_dict() for e in c.events],
                     **c.details,
                 }
-                for c in self.curves
+                for k, c in enumerate(self.curves)
             ],
             "records": self.records(),
         }
@@ -119,14 +122,14 @@ class FrequencyResponse:
         # its meshes); a model in body coordinates has none, not a column of blanks
         provides = self.system.contract.provides("mesh_force", "static_mesh_force")
         quantities = (*QUANTITIES, "dynamic_factor") if provides else QUANTITIES
-        columns = ["method", self.parameter, "stable"] + [
+        columns = ["method", "curve", self.parameter, "stable"] + [
             f"{c}_{q}" for c in coords for q in quantities
         ]
         rows = []
         for r in self.records():
             method = r["method"] + (f" {r['direction']}" if "direction" in r else "")
             rows.append(
-                [method, r[self.parameter], r["stable"]]
+                [method, r["curve"], r[self.parameter], r["stable"]]
                 + [r[c].get(q, float("nan")) for c in coords for q in quantities]
             )
         return columns, rows
