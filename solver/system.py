@@ -189,6 +189,46 @@ class System:
         )
 
     @property
+    def torque_note(self) -> str | None:
+        """One sentence when the external torques in effect are not in balance over the
+        train's rigid rotation ``r`` (the null space of the mesh incidence: ``T . r != 0``):
+        the mesh coordinates remove that rotation, so the meshes carry the loads of a train
+        accelerating as a whole, not of steady running.  It names the torque on one gear
+        that balances the others (the last not set by name: the output, where the inputs
+        are given).  None when balanced (to
+        1e-9 of the largest term), or for models without torques."""
+        import numpy as np
+
+        m = self.module
+        physical = getattr(m, "PHYSICAL", {})
+        structure = getattr(m, "STRUCTURE", {})
+        gears = [b.removeprefix("theta_") for b in structure.get("physical", ())]
+        names = [f"torque_Nm_{g}" for g in gears]
+        if not names or not all(n in physical for n in names) or not hasattr(m, "_physical"):
+            return None
+        given = m._physical(self.values)[0] or [v[0] for v in physical.values()]
+        q = dict(zip(physical, given, strict=True))
+        torque = np.array([float(q[n]) for n in names])
+        incidence = np.atleast_2d(np.asarray(structure.get("incidence", ()), float))
+        if incidence.shape != (len(gears) - 1, len(gears)):
+            return None  # not a tree of gears (one rigid rotation, one mesh fewer than gears)
+        null = np.linalg.svd(incidence)[2]
+        r = null[-1] / null[-1][np.argmax(np.abs(null[-1]))]
+        net = float(torque @ r)
+        if abs(net) <= 1e-9 * float(np.max(np.abs(torque * r))):
+            return None
+        unset = [i for i, n in enumerate(names) if n not in self.values]
+        k = unset[-1] if unset else len(names) - 1
+        steady = torque[k] - net / r[k]
+        ratio = ", ".join(f"{v:.4g}" for v in r)
+        return (
+            f"the torques are not in balance: sum of T r over the rigid rotation r = ({ratio}) "
+            f"of {', '.join(gears)} is {net:.6g} N m, so the meshes carry the loads of a "
+            f"train accelerating as a whole; torque_Nm_{gears[k]} = {steady:.6g} balances "
+            "the others (steady running)"
+        )
+
+    @property
     def model_hash(self) -> str:
         return self.module.INPUTS_SHA256
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import sys
 
-__all__ = ["forget", "note_backlash", "say"]
+__all__ = ["forget", "note_backlash", "note_torques", "say"]
 
 _PENDING: dict[str, str] = {}  # model name -> note of the command under way
 
@@ -26,6 +26,19 @@ def note_backlash(system):
     note = system.backlash_note
     if note:
         _PENDING.setdefault(system.name, note)
+    return system
+
+
+def note_torques(system, swept: dict | None = None):
+    """Note ``system.torque_note`` (external torques out of balance) once per model and
+    command, at each value of ``swept`` (``{name: values}``, for a run over a torque: at
+    its ends); return ``system``."""
+    ends = [{k: float(v[i]) for k, v in (swept or {}).items()} for i in (0, -1)]
+    torques = any(k.startswith("torque_Nm_") for k in swept or {})
+    notes = [system.with_values(**e).torque_note for e in ends] if torques else []
+    note = next((n for n in notes if n), None) or system.torque_note
+    if note:
+        _PENDING.setdefault(f"{system.name} torques", note)
     return system
 
 

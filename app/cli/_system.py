@@ -11,7 +11,7 @@ __all__ = ["system_of", "unknown_names"]
 def system_of(scene_arg: str, sets: dict[str, float]):
     """The System of a scene (name or path) with ``--set`` values (``gearsym.resolve``),
     a polynomial backlash noted once (``_notes``); a bad scene raises its own InputError."""
-    from gearsym.cli._notes import note_backlash
+    from gearsym.cli._notes import note_backlash, note_torques
     from gearsym.derive.input.reader import InputError
     from gearsym.resolve import module_for, planetary_path, planetary_system, split_open_values
     from gearsym.solver.system import System
@@ -31,7 +31,7 @@ def system_of(scene_arg: str, sets: dict[str, float]):
     opened, rest = split_open_values(sets, module)
     module = module_for(scene_arg, opened) if opened else module
     try:
-        return note_backlash(System.load(module, **rest))
+        return note_torques(note_backlash(System.load(module, **rest)))
     except KeyError as err:
         raise Fail(unknown_names(module, rest) or f"--set: {err.args[0]}") from None
     except ValueError as err:
