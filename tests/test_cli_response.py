@@ -2,6 +2,7 @@
 
 import json
 
+import numpy as np
 import pytest
 from gearsym.cli import main
 
@@ -106,3 +107,25 @@ def test_a_second_curve_of_one_method_is_told_apart(capsys, tmp_path):
     assert curves == sorted(curves) and set(curves) == {0, 1}
     first = [float(r[names.index("speed_rpm")]) for r in rows if r[1] == "1"][0]
     assert first == 1000.0
+
+
+def test_a_response_over_the_speed_in_rpm_folds_where_the_one_over_omega_does():
+    """The arclength counts a parameter whose range exceeds 1 in units of that range
+    (engine.Settings.scale): over 600 to 1,900 rpm harmonic balance took steps of
+    hundreds in the unknowns, crossed the branch at its first fold and came back as a
+    spurious branch point.  Reference: the same continuation over omega (its range under
+    1, so unscaled), the folds mapped to rpm by the model's own linear speed-omega rule."""
+    import gearsym
+    from gearsym.solver.sweep.frequency import frequency_response
+
+    system = gearsym.load("reference-light")
+    per_rpm = system.parameters_with(speed_rpm=1000.0)[0] / 1000.0
+    rpm = frequency_response(system, "speed_rpm", 600.0, 1900.0, points=60)
+    omega = frequency_response(system, "omega", 600.0 * per_rpm, 1900.0 * per_rpm, points=60)
+    assert [c.method for c in rpm.curves] == ["hb"]  # one curve, through every fold
+    names = {e.name for e in rpm.curves[0].events}
+    assert names == {"fold"}
+    folds = sorted(e.value for e in rpm.curves[0].events)
+    expected = sorted(e.value / per_rpm for c in omega.curves for e in c.events)
+    assert len(folds) == 4 and np.allclose(folds, expected, rtol=1e-6)
+    assert 0 < int(rpm.curves[0].stable.sum()) < len(rpm.curves[0].values)

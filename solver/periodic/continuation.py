@@ -155,8 +155,15 @@ def continue_orbit(
     if start not in prob.valid:
         raise ValueError(f"{parameter} = {start:g}: outside its valid range {prob.valid.rule()}")
     first = shoot(prob.system(start), x0, n, flow=prob.map.flow)
+    # a range longer than 1 is the parameter's unit in the arclength (engine.Settings)
+    k = max(1.0, abs(stop - start))
     settings = Settings(
-        ds=ds, ds_min=ds_min, ds_max=ds_max, max_points=max_points, locate_tol=locate_tol
+        ds=ds / k,
+        ds_min=ds_min / k,
+        ds_max=ds_max / k,
+        max_points=max_points,
+        locate_tol=locate_tol,
+        scale=k,
     )
     branch = continue_branch(prob, np.concatenate([first.x0, [start]]), stop, settings)
     return replace(branch, wall_time=time.perf_counter() - started)

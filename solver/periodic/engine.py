@@ -132,6 +132,11 @@ class Settings:
     shrink: float = 1.5
     locate_tol: float = 1e-7
     locate_iter: int = 12
+    # the parameter's unit in the arclength: lambda counts as lambda / scale beside the
+    # unknowns, and ds, ds_min, ds_max, locate_tol are in those units (the front doors
+    # take the range when it exceeds 1: a speed in rpm or a torque in N m then moves the
+    # unknowns as much per step as omega does; at 1, the arclength of (u, lambda))
+    scale: float = 1.0
 
     def next_step(self, ds: float, steps: int, t_lam: float) -> float:
         """The step after a correction of ``steps`` Newton steps."""
@@ -144,29 +149,35 @@ class Settings:
         return ds
 
 
-def tangent(Gu, Glam, previous=None) -> np.ndarray:
+def tangent(Gu, Glam, previous=None, scale: float = 1.0) -> np.ndarray:
     """The unit tangent ``t`` (m + 1,) of the branch: the null vector of ``[G_u, G_lambda]``
     (by SVD), or, given the previous tangent, the solution of the bordered system
-    ``[G_u G_lambda; previous] t = (0, 1)`` (so it keeps the orientation)."""
+    ``[G_u G_lambda; previous] t = (0, 1)`` (so it keeps the orientation); unit in the
+    norm that counts lambda as lambda / ``scale`` (:class:`Settings`)."""
     A = np.hstack([Gu, Glam[:, None]])
     if previous is None:
         t = np.linalg.svd(A)[2][-1]
-    else:
+    else:  # (the orientation in the scaled inner product, as the step's hyperplane)
+        row = previous if scale == 1.0 else np.r_[previous[:-1], previous[-1] / scale**2]
         t = np.linalg.solve(
-            np.vstack([A, previous[None, :]]), np.concatenate([np.zeros(A.shape[0]), [1.0]])
+            np.vstack([A, row[None, :]]), np.concatenate([np.zeros(A.shape[0]), [1.0]])
         )
-    return t / np.linalg.norm(t)
+    if scale == 1.0:
+        return t / np.linalg.norm(t)
+    return t / np.sqrt(t[:-1] @ t[:-1] + (t[-1] / scale) ** 2)
 
 
-def correct(problem: ContinuationProblem, z_pred, t, tol: float, max_iter: int):
-    """Newton on ``(G(z), t . (z - z_pred))`` from the prediction; returns the point, the
-    Newton steps taken and the linearisation there.  Raises one of :data:`FAILURES`."""
+def correct(problem: ContinuationProblem, z_pred, t, tol: float, max_iter: int, scale: float = 1.0):
+    """Newton on ``(G(z), t . W (z - z_pred))`` from the prediction (``W`` weighs lambda
+    by ``1 / scale**2``: the step's hyperplane in the scaled arclength); returns the point,
+    the Newton steps taken and the linearisation there.  Raises one of :data:`FAILURES`."""
     column = problem.frozen_column(z_pred)
+    row = t if scale == 1.0 else np.r_[t[:-1], t[-1] / scale**2]
 
     def fun(z):
         lin = problem.linearise(z, column)
-        H = np.concatenate([lin.G, [t @ (z - z_pred)]])
-        A = np.vstack([np.hstack([lin.Gu, lin.Glam[:, None]]), t[None, :]])
+        H = np.concatenate([lin.G, [row @ (z - z_pred)]])
+        A = np.vstack([np.hstack([lin.Gu, lin.Glam[:, None]]), row[None, :]])
         return H, A, lin
 
     found = newton(fun, z_pred, tol=tol, max_iter=max_iter, damped=False, min_steps=1)
@@ -185,7 +196,7 @@ def continue_branch(
     Returns the :class:`~.records.Branch` with the bifurcations located (``locate``)."""
     start = float(z[-1])
     lin = problem.linearise(z)
-    t = tangent(lin.Gu, lin.Glam)
+    t = tangent(lin.Gu, lin.Glam, scale=settings.scale)
     if np.sign(t[-1]) != (np.sign(stop - start) or 1.0):
         t = -t
     fl = problem.stability(z, lin)
@@ -222,7 +233,7 @@ def continue_branch(
                 break
             ds = (end - z[-1]) / t[-1]
         try:
-            z_new, steps, lin_new = correct(problem, z + ds * t, t, s.tol, s.max_iter)
+            z_new, steps, lin_new = correct(problem, z + ds * t, t, s.tol, s.max_iter, s.scale)
         except FAILURES as err:
             if end is not None:
                 status, message = land(end, z[:-1] + ds * t[:-1], _sign(t))
@@ -239,7 +250,7 @@ def continue_branch(
                 notes.append(message)
                 break
             continue
-        t_new = tangent(lin_new.Gu, lin_new.Glam, t)
+        t_new = tangent(lin_new.Gu, lin_new.Glam, t, s.scale)
         fl_new = problem.stability(z_new, lin_new)
         tests_new = problem.tests(z_new, lin_new, fl_new)
         if locate:
@@ -310,7 +321,7 @@ def _locate(problem, z0, t0, ds, kind, k, ends, s: Settings, index) -> Bifurcati
         if not min(a, b) < mid < max(a, b):
             mid = 0.5 * (a + b)
         try:
-            z_try, _, lin_try = correct(problem, z0 + mid * t0, t0, s.tol, s.locate_iter)
+            z_try, _, lin_try = correct(problem, z0 + mid * t0, t0, s.tol, s.locate_iter, s.scale)
         except FAILURES as err:  # keep the bracket reached so far, and say so
             why = str(err).splitlines()[0] if str(err) else type(err).__name__
             failed = (
@@ -320,7 +331,7 @@ def _locate(problem, z0, t0, ds, kind, k, ends, s: Settings, index) -> Bifurcati
             break
         z_mid, lin = z_try, lin_try
         if k is None:
-            f = tangent(lin.Gu, lin.Glam, t0)[-1]
+            f = tangent(lin.Gu, lin.Glam, t0, s.scale)[-1]
         else:
             f = problem.tests(z_mid, lin)[k]
         if np.sign(f) == np.sign(f_a):

@@ -225,10 +225,11 @@ def continue_hb(
     curve = HarmonicBalanceProblem(
         system, parameter, problem, tol=tol, stability=stability, check=check
     )
+    scale = max(1.0, span)  # (engine.Settings.scale; the steps below in its units)
     settings = Settings(
-        ds=ds or span / 200,
-        ds_min=span * 1e-9,
-        ds_max=ds_max or span / 20,
+        ds=(ds or span / 200) / scale,
+        ds_min=span * 1e-9 / scale,
+        ds_max=(ds_max or span / 20) / scale,
         dlam_max=dlam_max,
         max_points=max_points,
         tol=tol,
@@ -238,6 +239,7 @@ def continue_hb(
         shrink=2.0,
         locate_tol=1e-10,
         locate_iter=9,
+        scale=scale,
     )
     z = np.r_[first.coefficients.ravel(), float(start)]
     branch = continue_branch(curve, z, stop, settings, locate=locate)

@@ -365,10 +365,10 @@ def test_a_fold_whose_location_fails_says_so_and_is_not_called_non_smooth(monkey
     run = simulate(system, np.zeros(2), method="cvodes", transient=300, periods=1)
     real = engine.correct
 
-    def failing(problem, z_pred, t, tol, max_iter):
+    def failing(problem, z_pred, t, tol, max_iter, scale=1.0):
         if inspect.stack()[1].function == "_locate":
             raise RuntimeError("the flow stopped: too many steps\nsecond line")
-        return real(problem, z_pred, t, tol, max_iter)
+        return real(problem, z_pred, t, tol, max_iter, scale)
 
     monkeypatch.setattr(engine, "correct", failing)
     branch = continue_orbit(system, "omega", 1.0, 2.5, run.poincare[:, 0], ds=0.05, ds_max=0.1)
