@@ -49,7 +49,7 @@ _EXPORTS = {
     "reproduce": "gearsym.studies.reproduce",
     "plot": ("gearsym.plot", None),  # the module itself: the figures
     "Units": "gearsym.solver.units",
-    "in_units": "gearsym.solver.units",
+    "in_units": "gearsym.solver.units_table",
     "orbit_in_units": "gearsym.solver.units",
     **{
         name: "gearsym.solver"

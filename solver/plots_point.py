@@ -27,27 +27,29 @@ HARMONICS_SHOWN = 6  # a spectrum runs to (HARMONICS_SHOWN + 1/2) omega: the 6th
 
 class _Scale:
     """What one coordinate's panels multiply by and the units they write: deflection,
-    time, velocity and frequency (``units.Units``; physical time in ms, velocity in m/s)."""
+    time, velocity and frequency (``units.Units``, None: the model's units; physical time
+    in ms, velocity in m/s where the deflection is in µm)."""
 
-    def __init__(self, units: Units, c: str):
+    def __init__(self, units: Units | None, c: str):
+        self.physical = units is not None
+        self.x, self.x_unit, self.t, self.v, self.f = 1.0, "half backlashes", 1.0, 1.0, 1.0
+        self.t_label, self.v_label = "τ (non-dimensional time)", f"d{c}/dτ"
+        self.f_label = "frequency (rad per unit τ)"
+        if units is None:
+            return
         self.x, self.x_unit = units.deflection(c, 1.0), units.deflection_unit(c)
-        physical = units.physical
-        per_s = 1.0 / units.time(1.0) if physical else 1.0  # omega_n: tau per second
-        self.t = 1e3 / per_s if physical else 1.0
-        self.t_label = "t (ms)" if physical else "τ (non-dimensional time)"
-        # d/dt = omega_n d/dtau; µm per s to m/s
-        self.v = self.x * per_s * 1e-6 if physical and self.x_unit == "µm" else 1.0
-        self.v_label = f"d{c}/dt (m/s)" if self.v != 1.0 else f"d{c}/dτ"
-        self.f = units.frequency(1.0)
-        self.f_label = "frequency (Hz)" if physical else "frequency (rad per unit τ)"
-        self.physical = physical
+        per_s = 1.0 / units.time(1.0)  # omega_n: tau per second
+        self.t, self.t_label = 1e3 / per_s, "t (ms)"
+        if self.x_unit == "µm":  # d/dt = omega_n d/dtau; µm per s to m/s
+            self.v, self.v_label = self.x * per_s * 1e-6, f"d{c}/dt (m/s)"
+        self.f, self.f_label = units.frequency(1.0), "frequency (Hz)"
 
 
-def _title(tr: Trajectory, point, title: str, units: Units) -> str:
+def _title(tr: Trajectory, point, title: str, units: Units | None) -> str:
     lines = [title] if title else []
     head = operating_point(tr.system)
-    if units.physical:
-        head += f"; {units.operating_point()}"
+    if units is not None:  # (omega is in the head already)
+        head += "; " + units.operating_point().split(" (omega")[0]
     lines.append(head)
     if point is not None:
         lines.append(textwrap.fill(verdict_line(point), 150))
@@ -70,7 +72,9 @@ def point_figure(point, title: str = "", periods_shown: int = 20, units: str = "
     """
     tr = getattr(point, "trajectory", point)
     result = None if tr is point else point
-    inu = Units.of(tr.system, units)
+    if units not in ("model", "physical"):
+        raise ValueError(f"units '{units}': not one of model, physical")
+    inu = Units.of(tr.system, units) if units == "physical" else None
     coords = tr.system.coordinates
     fig, axes = plt.subplots(len(coords), 3, figsize=(13, 3.3 * len(coords)), squeeze=False)
     spp = tr.samples_per_period
@@ -82,7 +86,8 @@ def point_figure(point, title: str = "", periods_shown: int = 20, units: str = "
         ax.plot(tr.t[shown] * k.t, u[shown], lw=0.8, color="#1f1f1f", label="response")
         edges = tr.system.contract.contact.get(c, ())
         for n, edge in enumerate(edges):
-            where = ", ".join(f"{e * k.x:g}" for e in edges)
+            unit = " µm" if k.x_unit == "µm" else ""
+            where = ", ".join(f"{e * k.x:g}" for e in edges) + unit
             ax.axhline(
                 edge * k.x,
                 color="grey",

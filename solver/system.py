@@ -195,8 +195,8 @@ class System:
         the mesh coordinates remove that rotation, so the meshes carry the loads of a train
         accelerating as a whole, not of steady running.  It names the torque on one gear
         that balances the others (the last not set by name: the output, where the inputs
-        are given).  None when balanced (to
-        1e-9 of the largest term), or for models without torques."""
+        are given).  None when balanced (to 1e-7 of the largest term), or for models without
+        torques."""
         import numpy as np
 
         m = self.module
@@ -215,7 +215,9 @@ class System:
         null = np.linalg.svd(incidence)[2]
         r = null[-1] / null[-1][np.argmax(np.abs(null[-1]))]
         net = float(torque @ r)
-        if abs(net) <= 1e-9 * float(np.max(np.abs(torque * r))):
+        # balanced to 1e-7 of the largest term: a torque set to the balancing value this
+        # note prints (9 digits) is balanced
+        if abs(net) <= 1e-7 * float(np.max(np.abs(torque * r))):
             return None
         unset = [i for i, n in enumerate(names) if n not in self.values]
         k = unset[-1] if unset else len(names) - 1
@@ -224,7 +226,7 @@ class System:
         return (
             f"the torques are not in balance: sum of T r over the rigid rotation r = ({ratio}) "
             f"of {', '.join(gears)} is {net:.6g} N m, so the meshes carry the loads of a "
-            f"train accelerating as a whole; torque_Nm_{gears[k]} = {steady:.6g} balances "
+            f"train accelerating as a whole; torque_Nm_{gears[k]} = {steady:.9g} balances "
             "the others (steady running)"
         )
 

@@ -22,9 +22,7 @@ from dataclasses import dataclass
 
 __all__ = [
     "UNITS",
-    "InUnits",
     "Units",
-    "in_units",
     "orbit_in_units",
     "parameter_axis",
     "point_in_units",
@@ -204,121 +202,6 @@ def secondary_axis(ax, top) -> None:
     if top is not None:
         label, forward, inverse = top
         ax.secondary_xaxis("top", functions=(forward, inverse)).set_xlabel(label, fontsize=8)
-
-
-@dataclass(frozen=True)
-class InUnits:
-    """A result (sweep, map, branches: anything with ``to_dict`` and ``to_table``) with its
-    table in physical units beside the model's: ``to_table`` appends columns, never
-    replacing one (``<col>_um`` for each deflection column, ``lyapunov_per_s``, and the
-    row's ``speed_rpm`` and ``mesh_frequency_hz``), and ``to_dict`` adds the block
-    ``in_units`` (the operating point, each added column's meaning and its values).  The
-    scales of a row are those with its ``parameters`` (columns) set."""
-
-    result: object
-    system: object
-    parameters: tuple = ()
-    kind: str = "physical"
-
-    def _units(self, values: tuple) -> Units:
-        return at(self.system, self.kind, dict(zip(self.parameters, values, strict=True)))
-
-    def to_table(self) -> tuple[list, list]:
-        columns, rows = self.result.to_table()
-        base = Units.of(self.system, self.kind)
-        if not base.physical:
-            return list(columns), [list(r) for r in rows]
-        where = [list(columns).index(p) for p in self.parameters if p in columns]
-        added = [(c, coordinate_of(base, c)) for c in columns if coordinate_of(base, c)]
-        tau = "tau" in columns  # a trajectory's samples: their time in seconds
-        memo: dict = {}
-        extra_names = [f"{c}_um" for c, _ in added]
-        lyapunov = "lyapunov" in columns
-        extra_names += ["lyapunov_per_s"] * lyapunov
-        extra_names += ["t_s"] * tau
-        # the rows' speed and mesh frequency (from omega if the model states no speed); not
-        # for a trajectory's samples, all at the one operating point the block states
-        speeds = [k for k in (SPEED, MESH_HZ) if k not in columns and k in base.scales] * (not tau)
-        hz = MESH_HZ not in columns and MESH_HZ not in base.scales and not tau
-        out = []
-        for row in rows:
-            key = tuple(float(row[k]) for k in where)
-            u = memo.get(key) or memo.setdefault(key, self._units(key) if where else base)
-            extra = [_times(_num(row[columns.index(c)]), u.deflection(q, 1.0)) for c, q in added]
-            if lyapunov:
-                omega_n = u.scales["omega_n_rad_per_s"]
-                extra.append(_times(_num(row[columns.index("lyapunov")]), omega_n))
-            if tau:
-                extra.append(u.time(float(row[columns.index("tau")])))
-            extra += [u.scales[k] for k in speeds] + [u.frequency(u.omega)] * hz
-            out.append([*row, *extra])
-        return [*columns, *extra_names, *speeds, *[MESH_HZ] * hz], out
-
-    def block(self) -> dict:
-        """The ``in_units`` block (``{}`` in model units)."""
-        base = Units.of(self.system, self.kind)
-        if not base.physical:
-            return {}
-        columns, rows = self.to_table()
-        first = len(self.result.to_table()[0])
-        meaning = {
-            "lyapunov_per_s": "largest Lyapunov exponent per second (lyapunov x omega_n)",
-            "t_s": "time in seconds (tau / omega_n)",
-            SPEED: f"speed of gear '{base.scales.get('speed_gear', '?')}' in rpm at the row",
-            MESH_HZ: "mesh frequency in Hz at the row (omega omega_n / 2 pi)",
-        }
-        about = {
-            c: meaning.get(c, f"{c[:-3]} in µm (half backlashes x b x 1e6, b at the row)")
-            for c in columns[first:]
-        }
-        swept = [q for q in self.parameters if q in (base.forcing, SPEED, MESH_HZ)]
-        # one analysed point: its ranges, peaks and forces in units (point_in_units)
-        point = hasattr(self.result, "classification") and hasattr(self.result, "trajectory")
-        summary = {"coordinates": point_in_units(self.result, base)["coordinates"]} if point else {}
-        return summary | {
-            "units": base.kind,
-            # the rows' own frequency where it is what varies (their columns hold it)
-            "operating_point": f"{swept[0]} varies by row (its column)"
-            if swept
-            else base.operating_point(),
-            "columns": about,
-            "table": {c: [r[k] for r in rows] for k, c in enumerate(columns) if k >= first},
-        }
-
-    def to_dict(self) -> dict:
-        block = self.block()
-        return self.result.to_dict() | ({"in_units": block} if block else {})
-
-    def save(self, path, **extra):
-        """Write to ``path``: ``.json``, ``.csv`` or ``.mat`` (``solver/export.py``)."""
-        from .export import save
-
-        return save(self, path, **extra)
-
-
-def _num(v) -> float | None:
-    """A finite number, else None (text, a missing value, NaN)."""
-    if v is None or isinstance(v, str):
-        return None
-    v = float(v)
-    return v if math.isfinite(v) else None
-
-
-def _times(v: float | None, factor: float) -> float | None:
-    return None if v is None else v * factor
-
-
-def in_units(result, system, kind: str = "physical") -> InUnits:
-    """``result`` with its table in ``kind`` units (:class:`InUnits`); the parameters that
-    set each row's scales are the result's own (a sweep's parameter, a map's x and y)."""
-    if kind not in UNITS:
-        raise ValueError(f"units '{kind}': not one of {', '.join(UNITS)}")
-    if hasattr(result, "x") and hasattr(result, "y"):
-        names = (result.x, result.y)
-    else:
-        name = getattr(result, "parameter", None) or result.to_dict().get("parameter")
-        names = (name,) if name else ()
-    return InUnits(result, system, tuple(names), kind)
 
 
 def state_unit(system, kind: str, state: str) -> str:

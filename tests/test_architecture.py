@@ -121,6 +121,7 @@ SOLVER_ORDER = {
     "provenance": 0,
     "system": 1,
     "units": 1,
+    "units_table": 1,
     "integrate": 2,
     "periodic": 3,
     "analysis": 4,

@@ -44,6 +44,10 @@ def test_map_prints_one_record_per_grid_point_and_attractor(capsys, tmp_path):
             ("--x=lamda=0:1:3", "--y=f1=0.1:0.3:2"),
             "--x lamda: not a parameter of reference_light (did you mean 'lambda'?)",
         ),
+        (
+            ("--x=lambda=0:1:3", "--y=f_1=0.1:0.3:2"),
+            "--y f_1: not a parameter of reference_light (did you mean 'f1'?)",
+        ),
         (("--x=lambda=0:1", "--y=f1=0.1:0.3:2"), "--x lambda=0:1: expected START:STOP:NUM"),
         (("--x=lambda=0:1:3", "--y=lambda=0:1:3"), "name the same parameter"),
         (("--x=lambda=0:1:3", "--y=f1=0.1:0.3:2", "--initial-states=0"), "--initial-states"),

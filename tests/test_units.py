@@ -75,7 +75,7 @@ def _rpm(omega: float, omega_n: float) -> float:
 
 def test_a_table_in_physical_units_adds_columns_and_keeps_the_model_ones():
     from gearsym.solver.export import Document
-    from gearsym.solver.units import InUnits
+    from gearsym.solver.units_table import InUnits
 
     system = gearsym.load("reference-light")
     omega_n = system.scales()["omega_n_rad_per_s"]  # inertias and stiffness: not swept here

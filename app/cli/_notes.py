@@ -35,8 +35,11 @@ def note_torques(system, swept: dict | None = None):
     its ends); return ``system``."""
     ends = [{k: float(v[i]) for k, v in (swept or {}).items()} for i in (0, -1)]
     torques = any(k.startswith("torque_Nm_") for k in swept or {})
-    notes = [system.with_values(**e).torque_note for e in ends] if torques else []
-    note = next((n for n in notes if n), None) or system.torque_note
+    notes = [(e, system.with_values(**e).torque_note) for e in ends] if torques else []
+    at, note = next(((e, n) for e, n in notes if n), (None, system.torque_note))
+    if at and note:  # say at which end of the run (the other may be balanced)
+        where = ", ".join(f"{k} = {v:g}" for k, v in at.items())
+        note = f"at {where}, {note}"
     if note:
         _PENDING.setdefault(f"{system.name} torques", note)
     return system

@@ -21,7 +21,8 @@ def system_of(scene_arg: str, sets: dict[str, float]):
         try:
             return planetary_system(planetary, **sets)
         except KeyError as err:
-            raise Fail(f"--set: {err.args[0]}") from None
+            said = unknown_names(planetary_system(planetary).module, sets)
+            raise Fail(said or f"--set: {err.args[0]}") from None
         except ValueError as err:
             if isinstance(err, InputError):
                 raise
@@ -57,11 +58,15 @@ def unknown_names(module, names, flag: str = "--set") -> str:
     each = {m for members in aliases.values() for m in members}
     short = sorted(aliases) + sorted(k for k in physical if k not in each)
     suffixes = sorted({m.rsplit("_", 1)[1] for m in each})
+    # open values are a tree model's (a model in body coordinates derives none)
+    opened = [] if hasattr(module, "MESHES") else sorted(OPEN_VALUE_BASES)
+    scene = ", ".join(sorted(module.SCENE_PARAMETERS))
     return (
         f"{flag} {unknown[0]}: not a parameter of {module.NAME}"
-        f"{nearest(unknown[0], [*known, *OPEN_VALUE_BASES])}; it takes "
-        f"{', '.join(sorted(module.SCENE_PARAMETERS))}; in physical units {', '.join(short)}"
+        f"{nearest(unknown[0], [*known, *opened])}; it takes "
+        + (f"{scene}; " if scene else "")
+        + f"in physical units {', '.join(short)}"
         + (f" (most also per mesh or gear: <name>_{'|'.join(suffixes)})" if suffixes else "")
         + f"; its {len(module.PARAMETERS)} model parameters (the audit page of `gearsym "
-        f"derive`); open values, derived anew: {', '.join(sorted(OPEN_VALUE_BASES))}"
+        "derive`)" + (f"; open values, derived anew: {', '.join(opened)}" if opened else "")
     )

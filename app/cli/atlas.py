@@ -237,7 +237,9 @@ def _cmd_map(args) -> int:
             first({xn: xv[0], yn: yv[0]} | {name: values[0]})
             first({xn: xv[-1], yn: yv[-1]} | {name: values[-1]})
         except KeyError as err:
-            said = unknown_names(system.module, (xn, yn), flag) if name in (xn, yn) else ""
+            said = unknown_names(system.module, [xn], "--x") or unknown_names(
+                system.module, [yn], "--y"
+            )
             raise Fail(said or f"{flag} {name}: {err.args[0]}") from None
         except ValueError as err:
             raise Fail(f"{flag} {name}: {err}") from None
@@ -269,7 +271,7 @@ def _cmd_map(args) -> int:
     except ValueError as err:
         raise Fail(f"map: {err}") from None
     from gearsym.solver.provenance import provenance
-    from gearsym.solver.units import in_units
+    from gearsym.solver.units_table import in_units
 
     physical = args.units == "physical"
     table = in_units(result, system, args.units) if physical else result

@@ -26,9 +26,8 @@ from ._system import system_of, unknown_names
 __all__ = ["register"]
 
 
-# Bounded work (each stated in its option's help).  A period-n orbit costs about n times a
-# period-1 one (0.3 s a period on the reference scenes, minutes for period 64 on the
-# largest model); the guess is settled by CVODES at about a millisecond a period.
+# Bounded work (each in its option's help): a period-n orbit costs about n times a period-1
+# one (0.3 s a period on the reference scenes, minutes for period 64 on the largest model)
 def register(sub) -> None:
     sh = sub.add_parser(
         "shoot",
@@ -280,7 +279,8 @@ def _cmd_continue(args) -> int:
         continue_orbit,
         switch_period_doubling,
     )
-    from gearsym.solver.units import in_units, parameter_span
+    from gearsym.solver.units import parameter_span
+    from gearsym.solver.units_table import in_units
 
     for name in ("from_", "to"):
         if not math.isfinite(getattr(args, name)):

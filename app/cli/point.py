@@ -137,7 +137,7 @@ def _cmd_simulate(args) -> int:
             data["shafts"] = shaft_torques(result.trajectory)
     if args.out:
         from gearsym.solver import plots
-        from gearsym.solver.units import in_units as with_units
+        from gearsym.solver.units_table import in_units as with_units
 
         out = out_folder(args.out)
         write_result(
@@ -196,7 +196,9 @@ def _cmd_simulate(args) -> int:
         if units.physical:
             orders = ", ".join(f"{p['order']:.3g}" for p in row["peaks"])
             what = "displacement" if hasattr(system.module, "MESHES") else "dynamic TE"
-            line = f"  {label}: {what} [{num(low, '.2f')}, {num(high, '.2f')}] µm  " + (
+            b = units.deflection(c, 1.0)  # (the relative displacement: contact beyond ±b)
+            edge = f" (contact beyond ±{b:g} µm)" if c in system.contract.contact else ""
+            line = f"  {label}: {what} [{num(low, '.2f')}, {num(high, '.2f')}] µm{edge}  " + (
                 f"peaks at {peaks} Hz (orders {orders})" if peaks else none
             )
             if row.get("force_range"):
@@ -321,7 +323,8 @@ def _cmd_sweep(args) -> int:
     failed = [p.value for p in result.points if not p.ok]
     if result.resumed:
         print(f"resumed: {result.resumed} of {len(values)} points came from {out / 'store'}")
-    from gearsym.solver.units import in_units, parameter_span, poincare_range
+    from gearsym.solver.units import parameter_span, poincare_range
+    from gearsym.solver.units_table import in_units
 
     physical = args.units == "physical"
     paths = write_result(

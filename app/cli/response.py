@@ -257,7 +257,7 @@ def _cmd_response(args) -> int:
         raise RunFailed(f"frequency-response: {err}") from None
     physical = args.physical or args.units == "physical"
     if physical:  # the model's columns and keys kept; µm, rpm and Hz columns added
-        from gearsym.solver.units import in_units
+        from gearsym.solver.units_table import in_units
 
         written = write_result(out, "frequency_response", in_units(resp, system), args)
     else:

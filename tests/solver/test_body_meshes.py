@@ -134,7 +134,7 @@ def test_a_body_models_rows_in_physical_units_carry_their_mesh_frequency():
     """A sweep of the set over omega in physical units adds each row's mesh frequency,
     omega omega_n / 2 pi (the module's OMEGA_N), where a tree model adds its speed too."""
     from gearsym.solver.sweep import sweep
-    from gearsym.solver.units import in_units
+    from gearsym.solver.units_table import in_units
 
     lp = planetary_system(resolve_target("lin-parker-1999-3-backlash"))
     sw = sweep(lp, "omega", [0.09, 0.1], transient=5, periods=5, continuation=False)

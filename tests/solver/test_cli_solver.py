@@ -168,6 +168,11 @@ BAD_COMMANDS = [
         "--param lamda: not a parameter of reference_light (did you mean 'lambda'?)",
     ),
     (
+        ["simulate", "lin-parker-1999-3-backlash", "--set", "omgea=1"],
+        "--set omgea: not a parameter of lin-parker-1999-3-backlash (did you mean 'omega'?); "
+        "it takes in physical units damping_ratio, mesh_frequency_hz, sun_force_N",
+    ),
+    (
         ["frequency-response", "reference-light", "--param=f_1=0.1:0.2:3"],
         "--param f_1: not a parameter of reference_light (did you mean 'f1'?)",
     ),
