@@ -235,13 +235,17 @@ def parameter_span(system, kind: str, name: str, values) -> str:
     if SPEED not in ends[0]:
         return ""
 
+    def g(x: float) -> str:  # 4 digits, 16000 not 1.6e+04
+        text = f"{x:.4g}"
+        return f"{x:.0f}" if "e+" in text and abs(x) < 1e9 else text
+
     def span(key: str) -> str:
         a, b = (float(e[key]) for e in ends)
-        return f"{a:.4g}" if a == b else f"{a:.4g} to {b:.4g}"
+        return g(a) if a == b else f"{g(a)} to {g(b)}"
 
     gear = ends[0].get("speed_gear", "?")
     lo, hi = min(values), max(values)
-    shown = f"{lo:.4g}" if lo == hi else f"{lo:.4g} to {hi:.4g}"
+    shown = g(lo) if lo == hi else f"{g(lo)} to {g(hi)}"
     return f"{name} {shown}: gear '{gear}' at {span(SPEED)} rpm, mesh frequency {span(MESH_HZ)} Hz"
 
 

@@ -325,10 +325,16 @@ def _physical(m, system, table) -> None:
     """The map's span and the extremes of its mesh deflections in physical units."""
     from gearsym.solver.units import parameter_span
 
+    speeds = {"speed_rpm", "mesh_frequency_hz", system.contract.forcing_frequency}
     for name, values in ((m.x, m.x_values), (m.y, m.y_values)):
-        span = parameter_span(system, "physical", name, values)
+        # the speed the map runs at, said by its speed axis (another axis holds it fixed)
+        span = parameter_span(system, "physical", name, values) if name in speeds else ""
         if span:
             print(f"  {span}")
+    if not {m.x, m.y} & speeds:
+        from gearsym.solver.units import Units
+
+        print(f"  at {Units.of(system).operating_point()}")
     columns, rows = table.to_table()
     for c in m.coordinates:
         found = []

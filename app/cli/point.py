@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+import time
 
 from ._common import (
     MAX_TOTAL_PERIODS,
@@ -113,6 +114,7 @@ def _cmd_simulate(args) -> int:
 
     start = resolve_start(args)
     system = start.system
+    started = time.perf_counter()
     try:
         result = analyse_point(system, start.x0, **analysis_settings(args))
     except SimulationError as err:
@@ -159,9 +161,13 @@ def _cmd_simulate(args) -> int:
         if code:  # stdout is for the reading program; the failure is said on stderr too
             print(f"gearsym: run failed: status {tr.status}: {tr.message}", file=sys.stderr)
         return code
+    run = getattr(result.verdict, "periods_run", None) or tr.transient + tr.periods
+    # the run the verdict needed, which may have gone on past --transient + --periods; the
+    # samples (figure, spectra, files) are its last window
+    kept = "" if run == tr.transient + tr.periods else f", the last {tr.periods} kept"
     print(
-        f"{system.name}: {tr.method}, rtol {tr.rtol:g}, {tr.transient} + {tr.periods} periods, "
-        f"{tr.wall_time:.2f} s, status {tr.status}"
+        f"{system.name}: {tr.method}, rtol {tr.rtol:g}, {run} periods run{kept}, "
+        f"{time.perf_counter() - started:.2f} s, status {tr.status}"
     )
     if start.x0 is not None:
         print(f"  started from {start.source}: " + ", ".join(f"{v:.6g}" for v in start.x0))

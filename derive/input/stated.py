@@ -25,7 +25,7 @@ def stated_physically(pt, parameters: dict, topology):
     if not physical:
         return topology
     if SPEED in physical and "omega" in parameters:
-        raise pt.error(SPEED, "and omega both state the speed; keep one of them")
+        raise pt.error(SPEED, "stated beside omega, which states the speed too; keep one of them")
     gears = {g.id for g in topology.gears}
     torques = dict(topology.torques)
     for key, value in physical.items():

@@ -65,7 +65,10 @@ def test_a_scene_stated_in_rpm_and_newton_metres_is_the_model_set_to_them(tmp_pa
 @pytest.mark.parametrize(
     ("change", "words"),
     [
-        (("speed_rpm = 3000", "speed_rpm = 3000\nomega = 0.5"), "and omega both state the speed"),
+        (
+            ("speed_rpm = 3000", "speed_rpm = 3000\nomega = 0.5"),
+            "stated beside omega, which states the speed too; keep one",
+        ),
         (("torque_Nm_g = -700", "torque_Nm_g = -700\nbogus_key = 5"), "bogus_key: is not a"),
         (("torque_Nm_g = -700", "torque_Nm_x = -700"), "torque_Nm_x: names no gear"),
         (("speed_rpm = 3000", "speed_rpm = -1000"), "give a speed above 0 rpm"),
