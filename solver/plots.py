@@ -64,6 +64,9 @@ def bifurcation_diagram(
     points are open circles (6 px across) drawn first, the forward sweep's filled dots
     (3.5 px) on top; hysteresis shows as rings and dots apart.  Points whose run did not
     end normally (diverged, left the valid range) are crosses on the panel's lower edge.
+    Behind a mesh coordinate's points: the range its runs covered over their sampled
+    periods (the forward sweep's, a light band) and the contact edges (dashed), so that
+    teeth parting between two Poincaré points shows.
     ``system``: the model the sweeps ran on; the title then states ω̄ and the loads (from
     the sweep's first to its last value).  ``units``: ``model`` (half backlashes, and per
     unit τ for velocities) or ``physical`` (needs ``system``: deflections in µm, with the
@@ -80,6 +83,8 @@ def bifurcation_diagram(
         finite = np.concatenate(finite) if finite else np.zeros(0)
         lo = finite.min() if finite.size else 0.0
         cell = max(float(np.ptp(finite)) if finite.size else 0.0, 1e-12) * 1e-4
+        if sweeps:  # where the state went between its Poincaré points, and the contact edges
+            _range_and_edges(ax, order[-1], state, system, units)
         for sw in order:
             xs, ys = [], []
             scale, unit = state_factors(system, units, sw.parameter, sw.values, state)
@@ -107,6 +112,30 @@ def bifurcation_diagram(
         axes[0, 0].set_title(head, fontsize=10)
     legend_below(fig, axes.ravel())
     return fig
+
+
+def _range_and_edges(ax, sw: SweepResult, state: str, system, units: str) -> None:
+    """Behind a mesh coordinate's Poincaré points: its range over each run's sampled
+    periods (a light band: the teeth part where it crosses an edge between two Poincaré
+    points) and the model's contact edges (dashed), in the panel's units."""
+    edges = system.contract.contact.get(state, ()) if system is not None else ()
+    if system is not None and state not in system.coordinates:
+        return
+    scale, unit = state_factors(system, units, sw.parameter, sw.values, state)
+    lo, hi = sw.minima(state) * scale, sw.maxima(state) * scale
+    ax.fill_between(
+        sw.values,
+        lo,
+        hi,
+        color="0.88",
+        lw=0,
+        zorder=0,
+        label=f"range of the {sw.direction} sweep's runs over their sampled periods",
+    )
+    for n, edge in enumerate(edges):
+        where = ", ".join(f"{e:g}" for e in edges)
+        label = None if n else f"contact edges, {where} half backlashes (teeth touch beyond)"
+        ax.plot(sw.values, edge * scale, ls="--", lw=0.8, color="grey", zorder=1, label=label)
 
 
 def _parameter_axis(axes, system, units: str, name: str) -> None:

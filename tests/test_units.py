@@ -131,13 +131,21 @@ def test_a_bifurcation_diagram_in_um(tmp_path):
     fig = plots.bifurcation_diagram([sw], ["u", "du"], system=system, units="physical")
     u_ax, du_ax = fig.axes[:2]
     assert u_ax.get_ylabel().endswith("µm") and "per unit τ" in du_ax.get_ylabel()
-    ys = np.concatenate([line.get_ydata() for line in u_ax.get_lines() if len(line.get_xdata())])
+    marks = [ln for ln in u_ax.get_lines() if ln.get_linestyle() == "None"]
+    ys = np.concatenate([ln.get_ydata() for ln in marks if len(ln.get_xdata())])
     expected = np.concatenate(
         [np.asarray(p) * v for p, v in zip(sw.poincare("u"), sw.values, strict=True)]
     )
     # each value's distinct points (a period-1 orbit: one), times that value's b in µm
     assert np.all(np.min(np.abs(ys[:, None] - expected[None, :]), axis=1) < 1e-9 * np.abs(ys).max())
     assert du_ax.get_xlabel() == "half_backlash_um"
+    # behind the points: each run's range (x b at its value) and the contact edges +-b
+    edges = [ln for ln in u_ax.get_lines() if ln.get_linestyle() == "--"]
+    assert len(edges) == 2 and np.allclose(sorted(e.get_ydata()[1] for e in edges), [-60, 60])
+    band = u_ax.collections[0].get_paths()[0].vertices[:, 1]
+    b = np.array(sw.values)
+    assert np.isclose(band.max(), np.max(sw.maxima("u") * b), rtol=1e-12)
+    assert np.isclose(band.min(), np.min(sw.minima("u") * b), rtol=1e-12)
 
 
 def _csv(path) -> dict:
