@@ -115,27 +115,38 @@ def bifurcation_diagram(
 
 
 def _range_and_edges(ax, sw: SweepResult, state: str, system, units: str) -> None:
-    """Behind a mesh coordinate's Poincaré points: its range over each run's sampled
-    periods (a light band: the teeth part where it crosses an edge between two Poincaré
-    points) and the model's contact edges (dashed), in the panel's units."""
-    edges = system.contract.contact.get(state, ()) if system is not None else ()
-    if system is not None and state not in system.coordinates:
+    """Behind a mesh coordinate's Poincaré points (``system`` given): its range over each
+    run's sampled periods, a light bar at the run's value (the teeth part where it crosses
+    an edge between two Poincaré points; nothing is drawn between runs), and the model's
+    contact edges, dashed, in the panel's units."""
+    if system is None or state not in system.coordinates:
         return
-    scale, unit = state_factors(system, units, sw.parameter, sw.values, state)
-    lo, hi = sw.minima(state) * scale, sw.maxima(state) * scale
-    ax.fill_between(
+    scale, _ = state_factors(system, units, sw.parameter, sw.values, state)
+    ax.vlines(
         sw.values,
-        lo,
-        hi,
-        color="0.88",
-        lw=0,
+        sw.minima(state) * scale,
+        sw.maxima(state) * scale,
+        color="0.8",
+        lw=3,
         zorder=0,
-        label=f"range of the {sw.direction} sweep's runs over their sampled periods",
+        label=f"range of each {sw.direction} sweep run over its sampled periods",
     )
-    for n, edge in enumerate(edges):
-        where = ", ".join(f"{e:g}" for e in edges)
-        label = None if n else f"contact edges, {where} half backlashes (teeth touch beyond)"
-        ax.plot(sw.values, edge * scale, ls="--", lw=0.8, color="grey", zorder=1, label=label)
+    polynomial = system.backlash == "polynomial"
+    for n, edge in enumerate(system.contract.contact.get(state, ())):
+        label = (
+            "backlash edges ±b (the polynomial fit carries load inside them)"
+            if polynomial
+            else "contact edges ±b (teeth touch beyond them)"
+        )
+        ax.plot(
+            sw.values,
+            edge * scale,
+            ls="--",
+            lw=0.8,
+            color="grey",
+            zorder=1,
+            label=None if n else label,
+        )
 
 
 def _parameter_axis(axes, system, units: str, name: str) -> None:

@@ -142,10 +142,12 @@ def test_a_bifurcation_diagram_in_um(tmp_path):
     # behind the points: each run's range (x b at its value) and the contact edges +-b
     edges = [ln for ln in u_ax.get_lines() if ln.get_linestyle() == "--"]
     assert len(edges) == 2 and np.allclose(sorted(e.get_ydata()[1] for e in edges), [-60, 60])
-    band = u_ax.collections[0].get_paths()[0].vertices[:, 1]
+    bars = np.array(u_ax.collections[0].get_segments())  # one per run, at its value
     b = np.array(sw.values)
-    assert np.isclose(band.max(), np.max(sw.maxima("u") * b), rtol=1e-12)
-    assert np.isclose(band.min(), np.min(sw.minima("u") * b), rtol=1e-12)
+    np.testing.assert_allclose(bars[:, 0, 0], b)
+    np.testing.assert_allclose(bars[:, 0, 1], sw.minima("u") * b, rtol=1e-12)
+    np.testing.assert_allclose(bars[:, 1, 1], sw.maxima("u") * b, rtol=1e-12)
+    assert not [c for c in fig.axes[1].collections]  # a velocity has no range bars
 
 
 def _csv(path) -> dict:

@@ -161,12 +161,15 @@ def _cmd_simulate(args) -> int:
         if code:  # stdout is for the reading program; the failure is said on stderr too
             print(f"gearsym: run failed: status {tr.status}: {tr.message}", file=sys.stderr)
         return code
-    run = getattr(result.verdict, "periods_run", None) or tr.transient + tr.periods
-    # the run the verdict needed, which may have gone on past --transient + --periods; the
-    # samples (figure, spectra, files) are its last window
-    kept = "" if run == tr.transient + tr.periods else f", the last {tr.periods} kept"
+    asked = tr.transient + tr.periods
+    run = getattr(result.verdict, "periods_run", None) or asked
+    # the run the verdict needed, which may have gone on past --transient + --periods (the
+    # samples of figure, spectra and files are its last window); a failed run says what
+    # it was asked for (the status line below says where it stopped)
+    ran = f"{run:,} periods run" if tr.status == "ok" else f"{asked:,} periods asked"
+    kept = "" if run == asked or tr.status != "ok" else f", the last {tr.periods} kept"
     print(
-        f"{system.name}: {tr.method}, rtol {tr.rtol:g}, {run} periods run{kept}, "
+        f"{system.name}: {tr.method}, rtol {tr.rtol:g}, {ran}{kept}, "
         f"{time.perf_counter() - started:.2f} s, status {tr.status}"
     )
     if start.x0 is not None:

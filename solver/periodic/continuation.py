@@ -128,9 +128,9 @@ def continue_orbit(
     x0,
     *,
     n: int = 1,
-    ds: float = 0.02,
-    ds_min: float = 1e-5,
-    ds_max: float = 0.1,
+    ds: float | None = None,
+    ds_min: float | None = None,
+    ds_max: float | None = None,
     max_points: int = 400,
     locate_tol: float = 1e-7,
 ) -> Branch:
@@ -140,11 +140,17 @@ def continue_orbit(
     parameter's valid range (``_bounds.py``: a predictor that would cross it is shortened
     to land on it), after ``max_points`` points, or when the step falls below ``ds_min``;
     :attr:`Branch.status` and :attr:`Branch.message` say which.  The arclength step
-    ``ds`` (in the units of (x0, parameter)) grows by 1.5 after a correction of at most
-    two Newton steps, else shrinks by 1.5; bifurcations are located to ``locate_tol`` in
-    arclength (``engine.py``).
+    ``ds`` grows by 1.5 after a correction of at most two Newton steps, else shrinks by
+    1.5; bifurcations are located to ``locate_tol`` in arclength (``engine.py``).  Steps
+    are in the units of (x0, parameter), the parameter counted in units of its range
+    ``k = max(1, |stop - start|)`` (``engine.Settings.scale``); the defaults ``ds``,
+    ``ds_min``, ``ds_max`` are ``0.02 k``, ``1e-5 k`` and ``0.1 k``.
     """
     started = time.perf_counter()
+    k = max(1.0, abs(stop - start))
+    ds = 0.02 * k if ds is None else ds
+    ds_min = 1e-5 * k if ds_min is None else ds_min
+    ds_max = 0.1 * k if ds_max is None else ds_max
     if not (ds > 0 and ds_min > 0 and ds_max >= ds_min):
         raise ValueError(
             f"steps must be positive (ds = {ds}, ds_min = {ds_min}, ds_max = {ds_max})"
@@ -156,7 +162,6 @@ def continue_orbit(
         raise ValueError(f"{parameter} = {start:g}: outside its valid range {prob.valid.rule()}")
     first = shoot(prob.system(start), x0, n, flow=prob.map.flow)
     # a range longer than 1 is the parameter's unit in the arclength (engine.Settings)
-    k = max(1.0, abs(stop - start))
     settings = Settings(
         ds=ds / k,
         ds_min=ds_min / k,
