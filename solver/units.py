@@ -39,13 +39,14 @@ class Units:
     scales: dict
     omega: float  # the system's non-dimensional excitation frequency
     forcing: str = "omega"  # its name (the contract's forcing frequency)
+    named: tuple = ()  # (name, unit) of the physical quantities a user sets by name
 
     @classmethod
     def of(cls, system, kind: str = "physical") -> Units:
         if kind not in UNITS:
             raise ValueError(f"units '{kind}': not one of {', '.join(UNITS)}")
         forcing = getattr(getattr(system, "contract", None), "forcing_frequency", "omega")
-        return cls(kind, system.scales(), system.omega, forcing)
+        return cls(kind, system.scales(), system.omega, forcing, _named(system.module))
 
     @property
     def physical(self) -> bool:
@@ -175,6 +176,20 @@ def coordinate_of(units: Units, column: str) -> str | None:
 _RESPONSE = "{c}_mean {c}_amplitude {c}_rms {c}_min {c}_max"  # frequency-response columns
 
 
+def _named(module) -> tuple:
+    """(name, unit) of each physical quantity of a generated module (``PHYSICAL``: name ->
+    (value, unit, meaning)) and of its aliases; none that is a plain factor."""
+    table = getattr(module, "PHYSICAL", {})
+    units = {k: v[1] for k, v in table.items() if isinstance(v, tuple) and len(v) > 1}
+    for alias, members in getattr(module, "PHYSICAL_ALIASES", {}).items():
+        if members and members[0] in units:
+            units[alias] = units[members[0]]
+    shown = {"um": "µm", "deg": "°"}
+    return tuple(
+        (k, shown.get(u, u.replace("^2", "²"))) for k, u in units.items() if u not in ("", "1")
+    )
+
+
 def parameter_axis(units: Units, name: str):
     """How a figure shows the parameter ``name``: ``(label, top)``, ``top`` None or
     ``(label, forward, inverse)`` for a secondary axis.  Physical: omega stays the axis
@@ -182,8 +197,10 @@ def parameter_axis(units: Units, name: str):
     rpm on top; the speed in rpm gets the mesh frequency in Hz on top.  Both are linear in
     the value: the speed is ``omega omega_n 30 / (z pi)`` (the audit page's closed form)."""
     s = units.scales
+    unit = dict(units.named).get(name)  # a torque, a backlash: its unit in either kind
+    plain = f"{name} ({unit})" if unit and name != SPEED else name
     if not units.physical or SPEED not in s or not s[SPEED] or not units.omega:
-        return name, None
+        return plain, None
     gear = s.get("speed_gear", "?")
     if name == units.forcing:
         k = s[SPEED] / units.omega
@@ -194,7 +211,7 @@ def parameter_axis(units: Units, name: str):
         k = s[MESH_HZ] / s[SPEED]
         label = f"{name}: speed of gear '{gear}' (rpm)"
         return label, ("mesh frequency (Hz)", lambda r: r * k, lambda f: f / k)
-    return name, None
+    return plain, None
 
 
 def secondary_axis(ax, top) -> None:

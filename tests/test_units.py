@@ -138,7 +138,7 @@ def test_a_bifurcation_diagram_in_um(tmp_path):
     )
     # each value's distinct points (a period-1 orbit: one), times that value's b in µm
     assert np.all(np.min(np.abs(ys[:, None] - expected[None, :]), axis=1) < 1e-9 * np.abs(ys).max())
-    assert du_ax.get_xlabel() == "half_backlash_um"
+    assert du_ax.get_xlabel() == "half_backlash_um (µm)"
     # behind the points: each run's range (x b at its value) and the contact edges +-b
     edges = [ln for ln in u_ax.get_lines() if ln.get_linestyle() == "--"]
     assert len(edges) == 2 and np.allclose(sorted(e.get_ydata()[1] for e in edges), [-60, 60])
@@ -346,3 +346,22 @@ def test_a_frequency_response_over_the_speed_is_drawn_in_um(tmp_path):
     assert expected.min() < 3.0 < expected.max() and drawn.size >= expected.size
     top = [a for a in ax.child_axes if a.get_xlabel() == "mesh frequency (Hz)"]
     assert top and fig.axes[-1].get_xlabel().startswith("speed_rpm")
+
+
+def test_a_physical_parameter_s_axis_says_its_unit():
+    """A map or sweep over a torque, an inertia or a backlash labels its axis with the unit
+    the generated module states for it (PHYSICAL), in either kind of units; a plain factor
+    or a non-dimensional parameter stays bare (a new user's map over torque_Nm_p)."""
+    from gearsym.solver.units import parameter_axis
+
+    system = gearsym.load("reference-light")
+    for kind in ("physical", "model"):
+        units = Units.of(system, kind)
+        label = {n: parameter_axis(units, n)[0] for n in ("torque_Nm_p", "half_backlash_um")}
+        assert label == {
+            "torque_Nm_p": "torque_Nm_p (N m)",
+            "half_backlash_um": "half_backlash_um (µm)",
+        }
+        assert parameter_axis(units, "flywheel_inertia_kg_m2")[0].endswith("(kg m²)")
+        assert parameter_axis(units, "lambda")[0] == "lambda"
+        assert parameter_axis(units, "stiffness_scale")[0] == "stiffness_scale"
