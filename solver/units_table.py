@@ -73,6 +73,10 @@ class InUnits:
 
     def block(self) -> dict:
         """The ``in_units`` block (``{}`` in model units)."""
+        return self._block
+
+    @functools.cached_property
+    def _block(self) -> dict:  # once: every file of a command writes it
         base = Units.of(self.system, self.kind)
         if not base.physical:
             return {}

@@ -323,9 +323,9 @@ def _summary(m) -> None:
 
 def _physical(m, system, table) -> None:
     """The map's span and the extremes of its mesh deflections in physical units."""
-    from gearsym.solver.units import parameter_span
+    from gearsym.solver.units import MESH_HZ, SPEED, parameter_span
 
-    speeds = {"speed_rpm", "mesh_frequency_hz", system.contract.forcing_frequency}
+    speeds = {SPEED, MESH_HZ, system.contract.forcing_frequency}
     for name, values in ((m.x, m.x_values), (m.y, m.y_values)):
         # the speed the map runs at, said by its speed axis (another axis holds it fixed)
         span = parameter_span(system, "physical", name, values) if name in speeds else ""
