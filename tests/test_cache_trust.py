@@ -318,3 +318,28 @@ def test_a_variant_loaded_again_in_one_process_is_not_parsed_again(cache, monkey
     path = Path(first.__file__)
     path.write_bytes(path.read_bytes() + b"\n")  # edited: the stamp differs
     assert resolve.module_for(scene, {"load_reading": "both-driving"}) is first and calls
+
+
+def test_two_processes_that_need_the_same_library_at_once_build_it_once(tmp_path):
+    """Workers that ask for one library at the same moment (a reproduce's first tasks)
+    each compiled it; now the second waits on the first's lock and loads what it built,
+    and both run the same numbers."""
+    env = {**os.environ, "GEARSYM_CACHE": str(tmp_path / "cache")}
+    procs = [
+        subprocess.Popen(
+            [sys.executable, "-c", _LIBRARY_RUN],
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        for _ in range(2)
+    ]
+    outs = []
+    for p in procs:
+        out, err = p.communicate(timeout=300)
+        assert p.returncode == 0, err
+        outs.append(json.loads(out))
+    assert sorted(o["compiled"] for o in outs) == [False, True]
+    assert outs[0]["path"] == outs[1]["path"]
+    assert outs[0]["x"] == outs[1]["x"]

@@ -12,6 +12,7 @@ compile time.
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import functools
 import hashlib
@@ -230,6 +231,27 @@ def _bug_report(module, cc: str, path: Path, c_file: Path, done) -> str:
     )
 
 
+@contextlib.contextmanager
+def _build_lock(path: Path):
+    """Hold an exclusive lock on ``<library>.lock`` beside ``path`` (POSIX ``flock``).  A
+    platform without it, or a cache one may read but not write, goes without: the atomic
+    rename keeps that safe, only the work may be done twice."""
+    try:
+        import fcntl
+
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fh = open(path.with_suffix(".lock"), "a")  # noqa: SIM115 - held across the yield
+    except (ImportError, OSError):  # not POSIX, or a cache one may read, not write
+        yield
+        return
+    with fh:
+        fcntl.flock(fh, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(fh, fcntl.LOCK_UN)
+
+
 def _digest_file(path: Path) -> Path:
     return path.with_suffix(".sha256")
 
@@ -335,40 +357,44 @@ def library(module, variational: bool | str = False, shared=()) -> tuple[ctypes.
     if str(path) in _loaded:
         _paths[memo] = path
         return _loaded[str(path)], facts
-    if path.exists() and not _verified(path):
-        if _digest_file(path).exists():  # without one: built before digests, rebuilt quietly
-            warnings.warn(
-                f"the compiled library {path} does not match the digest stored beside it "
-                "(cut short or changed); building it again",
-                stacklevel=2,
-            )
-        path.unlink(missing_ok=True)
-    if not path.exists():
-        started = time.perf_counter()
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryDirectory(dir=path.parent) as tmp:
-            c_file = Path(tmp) / "model.c"
-            c_file.write_text(source(module, variational), encoding="utf-8")
-            so = Path(tmp) / "lib.so"
-            try:
-                done = subprocess.run(
-                    [cc, *_FLAGS, *defines, "-o", str(so), str(c_file), "-lm"],
-                    capture_output=True,
-                    text=True,
-                    timeout=300,
+    # One build per library across processes: two workers that need the same library
+    # at once (a reproduce's first tasks) compiled it twice; the second now waits for
+    # the first and loads what it built.
+    with _build_lock(path):
+        if path.exists() and not _verified(path):
+            if _digest_file(path).exists():  # without one: built before digests, rebuilt quietly
+                warnings.warn(
+                    f"the compiled library {path} does not match the digest stored beside it "
+                    "(cut short or changed); building it again",
+                    stacklevel=2,
                 )
-            except (OSError, subprocess.SubprocessError) as err:
-                _failed[key] = f"the C compiler {cc} could not be run ({err})"
-                raise NativeUnavailable(_failed[key]) from None
-            if done.returncode != 0 or not so.exists():
-                _failed[key] = _bug_report(module, cc, path, c_file, done)
-                raise NativeUnavailable(_failed[key])
-            digest = hashlib.sha256(so.read_bytes()).hexdigest()
-            stated = Path(tmp) / "lib.sha256"
-            stated.write_text(digest + "\n", encoding="utf-8")
-            os.replace(stated, _digest_file(path))  # the digest first, then the library:
-            os.replace(so, path)  # atomic: parallel workers never see half a library
-        facts.update(compiled=True, seconds=time.perf_counter() - started)
+            path.unlink(missing_ok=True)
+        if not path.exists():
+            started = time.perf_counter()
+            path.parent.mkdir(parents=True, exist_ok=True)
+            with tempfile.TemporaryDirectory(dir=path.parent) as tmp:
+                c_file = Path(tmp) / "model.c"
+                c_file.write_text(source(module, variational), encoding="utf-8")
+                so = Path(tmp) / "lib.so"
+                try:
+                    done = subprocess.run(
+                        [cc, *_FLAGS, *defines, "-o", str(so), str(c_file), "-lm"],
+                        capture_output=True,
+                        text=True,
+                        timeout=300,
+                    )
+                except (OSError, subprocess.SubprocessError) as err:
+                    _failed[key] = f"the C compiler {cc} could not be run ({err})"
+                    raise NativeUnavailable(_failed[key]) from None
+                if done.returncode != 0 or not so.exists():
+                    _failed[key] = _bug_report(module, cc, path, c_file, done)
+                    raise NativeUnavailable(_failed[key])
+                digest = hashlib.sha256(so.read_bytes()).hexdigest()
+                stated = Path(tmp) / "lib.sha256"
+                stated.write_text(digest + "\n", encoding="utf-8")
+                os.replace(stated, _digest_file(path))  # the digest first, then the library:
+                os.replace(so, path)  # atomic: parallel workers never see half a library
+            facts.update(compiled=True, seconds=time.perf_counter() - started)
     _paths[memo] = path
     try:
         lib = ctypes.CDLL(str(path))
