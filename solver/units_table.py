@@ -52,7 +52,12 @@ class InUnits:
 
             cols = [rows[:, columns.index(c)] * base.deflection(q, 1.0) for c, q in added]
             cols.append(rows[:, columns.index("tau")] / base.scales["omega_n_rad_per_s"])
-            return [*columns, *extra_names], np.column_stack([rows, *cols]), len(columns)
+            names, forces = _forces(self.system, base, columns, rows)
+            return (
+                [*columns, *extra_names, *names],
+                np.column_stack([rows, *cols, *forces]),
+                len(columns),
+            )
         # the rows' speed and mesh frequency (from omega if the model states no speed); not
         # for a trajectory's samples, all at the one operating point the block states
         speeds = [k for k in (SPEED, MESH_HZ) if k not in columns and k in base.scales] * (not tau)
@@ -84,6 +89,11 @@ class InUnits:
         meaning = {
             "lyapunov_per_s": "largest Lyapunov exponent per second (lyapunov x omega_n)",
             "t_s": "time in seconds (tau / omega_n)",
+            **{
+                f"{c}_force_N": f"dynamic mesh force of {c} in N at the sample (the model's "
+                "mesh force x k_m b; its static value and the dynamic factor: coordinates)"
+                for c in self.system.coordinates
+            },
             SPEED: f"speed of gear '{base.scales.get('speed_gear', '?')}' in rpm at the row",
             MESH_HZ: "mesh frequency in Hz at the row (omega omega_n / 2 pi)",
         }
@@ -118,6 +128,32 @@ class InUnits:
         from .export import save
 
         return save(self, path, **extra)
+
+
+def _forces(system, units: Units, columns: list, rows) -> tuple[list, list]:
+    """A trajectory's dynamic mesh force at every sample in N, one column per mesh
+    coordinate the model states a stiffness scale for (``<coordinate>_force_N``); none
+    for a model without ``mesh_force``.  A sample that is not finite has no force (NaN:
+    the run left its valid range there)."""
+    import numpy as np
+
+    mesh_force = getattr(system.module, "mesh_force", None)
+    if (
+        mesh_force is None
+        or not len(rows)
+        or not any(units.force_unit(c) == "N" for c in system.coordinates)
+    ):
+        return [], []
+    t = rows[:, columns.index("tau")]
+    x = rows[:, [columns.index(s) for s in system.states]].T
+    ok = np.all(np.isfinite(x), axis=0) & np.isfinite(t)
+    m = len(np.atleast_1d(system.module.static_mesh_force(system.p)))  # the meshes (first)
+    f = np.full((m, t.size), np.nan)
+    if ok.any():
+        f[:, ok] = np.asarray(mesh_force(t[ok], x[:, ok], system.p), float)[:m]
+    # the meshes' coordinates come first, as point_in_units reads them
+    coords = [(k, c) for k, c in enumerate(system.coordinates[:m]) if units.force_unit(c) == "N"]
+    return [f"{c}_force_N" for _, c in coords], [units.force(c, 1.0) * f[k] for k, c in coords]
 
 
 def _num(v) -> float | None:

@@ -365,3 +365,36 @@ def test_a_physical_parameter_s_axis_says_its_unit():
         assert parameter_axis(units, "flywheel_inertia_kg_m2")[0].endswith("(kg m²)")
         assert parameter_axis(units, "lambda")[0] == "lambda"
         assert parameter_axis(units, "stiffness_scale")[0] == "stiffness_scale"
+
+
+def test_simulate_writes_each_mesh_force_in_newtons_at_every_sample(tmp_path, capsys):
+    """`simulate --units physical` adds each mesh's dynamic force in N per sample
+    (``<coordinate>_force_N``).  Reference, statics: on a periodic orbit the mean of each
+    mesh's force over whole periods is its static load (the accelerations average to
+    zero), and with balanced torques pinion p's mesh carries T_p / (r_b,p cos beta_b);
+    the linear scene stays in contact, so its orbit is period-1 after the transient."""
+    from gearsym.solver.units import Units
+    from scipy.io import loadmat
+
+    torques = {"torque_Nm_p": 500.0, "torque_Nm_q": 250.0, "torque_Nm_g": -1500.0}
+    sets = [a for k, v in torques.items() for a in ("--set", f"{k}={v}")]
+    argv = ["simulate", "reference-linear", *sets, "--transient", "400", "--periods", "20"]
+    code, said = _run([*argv, "--units", "physical", "--out", str(tmp_path)], capsys)
+    assert code == 0 and "period-1" in said
+    table = _csv(tmp_path / "point.csv")
+    system = gearsym.load("reference-linear", **torques)
+    arm = system.module.STRUCTURE["incidence"][0][0]  # r_b,p cos(beta_b), m
+    assert np.mean(table["u_force_N"]) == pytest.approx(500.0 / arm, rel=1e-6)
+    assert np.mean(table["v_force_N"]) == pytest.approx(250.0 / arm, rel=1e-6)
+    # the column is the model's mesh force at the sample times k_m b, and its extremes
+    # are the range the block states
+    units = Units.of(system)
+    x = np.array([table[s] for s in system.states])
+    model = system.module.mesh_force(table["tau"], x, system.p)
+    assert np.allclose(table["u_force_N"], units.force("u", 1.0) * model[0], rtol=1e-9, atol=0)
+    doc = json.loads((tmp_path / "point.json").read_text(encoding="utf-8"))
+    stated = doc["in_units"]["coordinates"]["v"]["force_range"]
+    assert stated == pytest.approx([table["v_force_N"].min(), table["v_force_N"].max()], rel=1e-9)
+    assert "v_force_N" in doc["in_units"]["columns"]
+    mat = loadmat(tmp_path / "point.mat", simplify_cells=True)
+    assert np.allclose(mat["table"]["u_force_N"], table["u_force_N"], rtol=1e-15, atol=0)
