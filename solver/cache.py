@@ -17,13 +17,14 @@ corruption, not against someone who can already write the user's files
 
 from __future__ import annotations
 
+import contextlib
 import os
 import stat
 import tempfile
 import warnings
 from pathlib import Path
 
-__all__ = ["cache_root"]
+__all__ = ["cache_root", "locked"]
 
 _checked: dict[Path, Path] = {}
 
@@ -83,3 +84,22 @@ def _unwritable(folder: Path) -> str | None:
     except OSError as err:
         return err.strerror or str(err)
     return None
+
+
+@contextlib.contextmanager
+def locked(path: Path):
+    """Hold an exclusive lock on ``<path>.lock`` (POSIX ``flock``) while a cache file is
+    built, so that processes needing it at once build it once.  A platform without
+    ``flock``, or a cache one may read but not write, goes without: the builders' atomic
+    renames keep that safe, only the work may be done twice."""
+    try:
+        import fcntl
+
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fh = open(path.with_suffix(".lock"), "a")  # noqa: SIM115 - held across the yield
+    except (ImportError, OSError):
+        yield
+        return
+    with fh:  # closing it releases the lock
+        fcntl.flock(fh, fcntl.LOCK_EX)
+        yield

@@ -12,7 +12,6 @@ compile time.
 
 from __future__ import annotations
 
-import contextlib
 import ctypes
 import functools
 import hashlib
@@ -27,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...cache import cache_root
+from ...cache import cache_root, locked
 from ..tableau import RK4, c_tables
 from . import abi
 
@@ -231,27 +230,6 @@ def _bug_report(module, cc: str, path: Path, c_file: Path, done) -> str:
     )
 
 
-@contextlib.contextmanager
-def _build_lock(path: Path):
-    """Hold an exclusive lock on ``<library>.lock`` beside ``path`` (POSIX ``flock``).  A
-    platform without it, or a cache one may read but not write, goes without: the atomic
-    rename keeps that safe, only the work may be done twice."""
-    try:
-        import fcntl
-
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fh = open(path.with_suffix(".lock"), "a")  # noqa: SIM115 - held across the yield
-    except (ImportError, OSError):  # not POSIX, or a cache one may read, not write
-        yield
-        return
-    with fh:
-        fcntl.flock(fh, fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(fh, fcntl.LOCK_UN)
-
-
 def _digest_file(path: Path) -> Path:
     return path.with_suffix(".sha256")
 
@@ -360,7 +338,7 @@ def library(module, variational: bool | str = False, shared=()) -> tuple[ctypes.
     # One build per library across processes: two workers that need the same library
     # at once (a reproduce's first tasks) compiled it twice; the second now waits for
     # the first and loads what it built.
-    with _build_lock(path):
+    with locked(path):
         if path.exists() and not _verified(path):
             if _digest_file(path).exists():  # without one: built before digests, rebuilt quietly
                 warnings.warn(
