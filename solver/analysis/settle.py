@@ -25,7 +25,7 @@ from .lyapunov import LyapunovEstimate, largest_lyapunov
 from .orbit_check import OrbitCheck, check_orbit
 from .verdict import Verdict, Window, candidates, judge, settled, spread
 
-__all__ = ["BUDGET", "FIRST_WINDOW", "Settled", "per_coordinate", "settle"]
+__all__ = ["BUDGET", "FIRST_WINDOW", "Settled", "per_coordinate", "settle", "settle_many"]
 
 BUDGET = 3000  # periods a verdict may take, counted from the run's start
 FIRST_WINDOW = 400  # the first continued window; each next one is twice as long
@@ -137,6 +137,124 @@ def settle(
     gone this far (the long budget of a border point: a chaotic transient has time to end).
     """
     run = {"method": method, "rtol": rtol, "atol": atol, "steps_per_period": steps_per_period}
+    steps = _settling(
+        system, points, x_end, t_end, periods_run, tol, budget, first_window, exponent,
+        lyapunov, min_periods,
+    )  # fmt: skip
+    try:
+        request = next(steps)
+        while True:
+            request = steps.send(_extend(system, *request, run, exponent))
+    except StopIteration as done:
+        return done.value
+
+
+def settle_many(
+    runs: list[tuple],
+    *,
+    method: str = "dop853",
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    steps_per_period: int = 512,
+    budget: int = BUDGET,
+    first_window: int = FIRST_WINDOW,
+    exponent: bool = True,
+    min_periods: int = 0,
+) -> list[Settled]:
+    """:func:`settle` for many runs at once, each ``(system, points, x_end, periods_run,
+    tol)`` ending on a whole number of forcing periods (phase 0, as a finished run does).
+    The same verdicts' logic, run by run; what changes is how the windows are run: each
+    round, the windows of the runs still unsettled that share a model, a forcing
+    frequency and a length are one batch of the compiled lockstep engine (a border run
+    alone took its steps one point at a time: about five times the cost per period of
+    the DI-SO in a group).  Each window starts at tau = 0, its phase (the model is
+    periodic in the forcing period).  A model without the compiled engine runs each
+    window alone, as :func:`settle` does."""
+    run = {"method": method, "rtol": rtol, "atol": atol, "steps_per_period": steps_per_period}
+    steps = [
+        _settling(
+            system,
+            points,
+            x,
+            0.0,
+            before,
+            tol,
+            budget,
+            first_window,
+            exponent,
+            None,
+            min_periods,
+        )  # fmt: skip
+        for system, points, x, before, tol in runs
+    ]
+    out: list = [None] * len(runs)
+    pending = {}
+    for k, st in enumerate(steps):
+        try:
+            pending[k] = next(st)
+        except StopIteration as done:
+            out[k] = done.value
+    while pending:
+        batches: dict = {}
+        for k, (_, _, length) in pending.items():
+            system = runs[k][0]
+            key = (system.module.__file__, float(system.omega), length)
+            batches.setdefault(key, []).append(k)
+        answers = {}
+        for ks in batches.values():
+            systems = [runs[k][0] for k in ks]
+            xs = [pending[k][0] for k in ks]
+            length = pending[ks[0]][2]
+            answers.update(zip(ks, _extend_many(systems, xs, length, run, exponent), strict=True))
+        pending = {}
+        for k in sorted(answers):
+            try:
+                pending[k] = steps[k].send(answers[k])
+            except StopIteration as done:
+                out[k] = done.value
+    return out
+
+
+def _extend_many(systems, xs, periods: int, run: dict, exponent: bool) -> list[tuple]:
+    """:func:`_extend` of each system from its state at phase 0, one batch of the compiled
+    engine where the method is native (else one at a time)."""
+    if len(systems) == 1 or get_method(run["method"]).family != "native":
+        pairs = zip(systems, xs, strict=True)
+        return [_extend(s, x, 0.0, periods, run, exponent) for s, x in pairs]
+    from ..integrate.run import Batch
+
+    spec = RunSpec(
+        method=run["method"],
+        rtol=run["rtol"],
+        atol=run["atol"],
+        t0=0.0,
+        transient=0,
+        periods=periods,
+        steps_per_period=run["steps_per_period"],
+        collect=("samples", "extremes", "exponent") if exponent else ("samples", "extremes"),
+        lyapunov_periods=periods if exponent else 0,
+    )
+    P = np.array([s.p for s in systems], dtype=float)
+    res = integrate(Batch.of(systems[0].module, P), np.array(xs, dtype=float), spec)
+    out = []
+    for i, system in enumerate(systems):
+        status, X = res.status[i], res.x[i]
+        lyap = None
+        if exponent and status == "ok":
+            lyap = LyapunovEstimate.from_running(
+                res.exponent[i], run["rtol"], run["atol"], res.label, system.period
+            )
+        out.append((X[:periods].T, X[-1].copy(), status, lyap, (res.xmin[i], res.xmax[i])))
+    return out
+
+
+def _settling(
+    system, points, x_end, t_end, periods_run, tol, budget, first_window, exponent,
+    lyapunov, min_periods,
+):  # fmt: skip
+    """:func:`settle`'s steps: a generator that yields each window it needs,
+    ``(x_end, t_end, periods)``, is sent back what :func:`_extend` gives for it, and
+    returns the :class:`Settled`."""
     x_end = np.asarray(x_end, dtype=float)
     w = Window(periods_run - points.shape[1], points, lyapunov)
     judged: list[dict] = []
@@ -149,7 +267,7 @@ def settle(
             return replace(done, extremes=ext)
         L = min(length, budget - periods_run)
         length *= 2
-        pts, x_new, status, lyap, ext = _extend(system, x_end, t_end, L, run, exponent)
+        pts, x_new, status, lyap, ext = yield (x_end, t_end, L)
         periods_run += L
         if status != "ok":
             motion = "divergent" if status == "divergent" else "undetermined"

@@ -43,7 +43,7 @@ from ..integrate.simulate import default_initial_state
 from ..integrate.spec import RunSpec
 from ..system import System
 from .attractors import group_runs, outcome
-from .borders import BORDER_BUDGET, map_looks, run_look
+from .borders import BORDER_BUDGET, map_looks, run_all
 from .maps_result import Cell, RegimeMap
 from .progress import Progress
 from .store import RunStore
@@ -326,7 +326,7 @@ def regime_map(
     runs = {cell: _ordered(rs) for cell, rs in runs.items()}
     looks = map_looks(runs, grid, (nx, ny), _look_options(opts)) if opts["budget"] else []
     if looks:
-        looked = map_tasks(run_look, [lk for _, _, lk in looks], executor=executor, workers=workers)
+        looked = run_all([lk for _, _, lk in looks], executor=executor, workers=workers)
         for (cell, k, _), r in zip(looks, looked, strict=True):
             runs[cell][k] = r
     cells = tuple(

@@ -19,8 +19,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..analysis.record import Extremes, RunRecord
-from ..analysis.settle import BUDGET, per_coordinate, settle
-from ..contract import load_generated
+from ..analysis.settle import BUDGET, per_coordinate, settle, settle_many
+from ..contract import Contract, load_generated
 from ..system import System
 
 __all__ = [
@@ -30,7 +30,9 @@ __all__ = [
     "border_indices",
     "map_looks",
     "reexamine",
+    "run_all",
     "run_look",
+    "run_looks",
     "sweep_looks",
 ]
 
@@ -84,23 +86,37 @@ def reexamine(
     the Poincare cloud (``point.classification_tolerance``)."""
     if not needs_look(r) or r.x_final is None:
         return r
-    before = int(r.verdict.get("periods_run") or 0)
-    points = r.tail.T
-    cloud = max(float(np.ptp(points, axis=1).max()), 1.0) if points.size else 1.0
+    _, points, x, before, tol = _start(system, r, tol)
     st = settle(
         system,
         points,
-        r.x_final,
+        x,
         0.0,  # the run ended on a whole number of forcing periods: the phase is 0
         periods_run=before,
-        tol=tol * cloud,
+        tol=tol,
         method=method,
         rtol=rtol,
         atol=atol,
         budget=max(budget, before),
         min_periods=budget,
     )
+    return _finish(system, r, st, budget)
+
+
+def _start(system: System, r: RunRecord, tol: float) -> tuple:
+    """What :func:`settle` takes of a run: (system, Poincare points, end state, periods
+    run, repeat tolerance scaled by the cloud)."""
+    before = int(r.verdict.get("periods_run") or 0)
+    points = r.tail.T
+    cloud = max(float(np.ptp(points, axis=1).max()), 1.0) if points.size else 1.0
+    return system, points, r.x_final, before, tol * cloud
+
+
+def _finish(system: System, r: RunRecord, st, budget: int) -> RunRecord:
+    """The run's record with the settled verdict (``reexamined`` says the periods before
+    and the budget)."""
     v = st.verdict
+    before = int(r.verdict.get("periods_run") or 0)
     summary = v.summary() | {"reexamined": {"periods_before": before, "budget": budget}}
     keep = r.tail.shape[0]
     lyap = st.lyapunov
@@ -165,6 +181,78 @@ class Look:
 def run_look(look: Look) -> RunRecord:
     system = System(load_generated(look.source), np.asarray(look.p, float), {})
     return reexamine(system, look.record, **look.options)
+
+
+# Looks per task of :func:`run_all`: a fixed number (not a share per worker), so that the
+# batches, and with them the lockstep groups whose steps the looks share, do not depend
+# on how many workers run them.
+LOOK_BATCH = 32
+
+
+def run_looks(looks: list[Look]) -> list[RunRecord]:
+    """Worker: :func:`run_look` of each look, their windows run together
+    (``settle.settle_many``: the looks of one model, forcing frequency, options and
+    budget in one lockstep batch per window, where one at a time each took its own steps);
+    the records in the order of ``looks``."""
+    out = [look.record for look in looks]
+    groups: dict = {}
+    for k, look in enumerate(looks):
+        r = look.record
+        if not needs_look(r) or r.x_final is None:
+            continue
+        before = int(r.verdict.get("periods_run") or 0)
+        o = look.options
+        budget = o.get("budget", BORDER_BUDGET)
+        key = (tuple(sorted((n, v) for n, v in o.items() if n != "tol")), max(budget, before))
+        groups.setdefault(key, []).append(k)
+    for ks in groups.values():
+        o = looks[ks[0]].options
+        budget = o.get("budget", BORDER_BUDGET)
+        systems = {
+            k: System(load_generated(looks[k].source), np.asarray(looks[k].p, float), {})
+            for k in ks
+        }
+        starts = [_start(systems[k], looks[k].record, looks[k].options["tol"]) for k in ks]
+        before = max(int(looks[k].record.verdict.get("periods_run") or 0) for k in ks)
+        done = settle_many(
+            starts,
+            method=o.get("method", "dop853"),
+            rtol=o.get("rtol", 1e-8),
+            atol=o.get("atol", 1e-10),
+            budget=max(budget, before),
+            min_periods=budget,
+        )
+        for k, st in zip(ks, done, strict=True):
+            out[k] = _finish(systems[k], looks[k].record, st, budget)
+    return out
+
+
+def run_all(looks: list[Look], *, run=None, **options) -> list[RunRecord]:
+    """Every look re-examined (:func:`run_looks`), :data:`LOOK_BATCH` to a task of
+    ``run`` (``executor.map_tasks`` by default, or a result store's ``map``; ``options``
+    go to it), a piecewise model's one to a task; the records in the order of ``looks``."""
+    if run is None:
+        from ..executor import map_tasks as run
+    # A piecewise force law's runs take their own steps in any batch (integrate.run), so
+    # its looks go one to a task, spread over the workers; the others share a task
+    alone = [Contract.of(load_generated(look.source)).piecewise for look in looks]
+    chunks: list[list[int]] = []
+    batch: list[int] = []
+    for k, one in enumerate(alone):
+        if one:
+            chunks.append([k])
+        else:
+            batch.append(k)
+            if len(batch) == LOOK_BATCH:
+                chunks.append(batch)
+                batch = []
+    chunks += [batch] if batch else []
+    parts = run(run_looks, [[looks[k] for k in ks] for ks in chunks], **options)
+    out: list = [None] * len(looks)
+    for ks, part in zip(chunks, parts, strict=True):
+        for k, r in zip(ks, part, strict=True):
+            out[k] = r
+    return out
 
 
 def map_looks(runs: dict, systems, shape, options: dict) -> list[tuple[tuple, int, Look]]:

@@ -27,7 +27,7 @@ from .._json import dumps
 from ..analysis.record import RunRecord
 from ..executor import EXECUTORS, map_tasks
 from ..system import System
-from .borders import run_look, sweep_looks
+from .borders import run_all, sweep_looks
 from .chains import Chain, ChainDone, checked_values, module_ref, plan, run_chain
 from .progress import Progress
 from .result import SweepResult
@@ -170,7 +170,7 @@ def _looked(runs: list, points: list[list], executor, workers, scheduler) -> lis
     out = [list(pts) for pts in points]
     if not looks:
         return out
-    done = map_tasks(run_look, looks, executor=executor, workers=workers, scheduler=scheduler)
+    done = run_all(looks, executor=executor, workers=workers, scheduler=scheduler)
     for (k, i), r in zip(where, done, strict=True):
         out[k][i] = r
     return out

@@ -38,3 +38,37 @@ def test_border_runs_reexamined_by_workers_match_the_serial_run():
         for p, q in zip(a.points, b.points, strict=True):
             assert p.verdict == q.verdict
             assert np.array_equal(p.x_final, q.x_final)
+
+
+def test_border_runs_re_examined_together_agree_with_one_at_a_time():
+    """The looks of a sweep run their windows as lockstep batches (borders.run_looks,
+    settle.settle_many); the reference is the same looks one at a time (borders.run_look,
+    settle.settle): the same verdict and periods run for each, and the chaotic ones'
+    exponents within their two error bars (the batch shares its steps, so a chaotic
+    orbit's points differ, not its statistics).  The light scene at f1 = 0.1 with a 12.5 µm
+    transmission error is chaotic over most of lambda (reproduce's sensitivity maps)."""
+    import sys
+
+    import gearsym
+    from gearsym.solver.sweep import SweepJob, borders, sweep_many
+
+    plain = sys.modules["gearsym.solver.sweep.sweep"]
+    system = gearsym.load("reference-light", f1=0.1, te_amplitude_um=12.5)
+    lam = np.round(np.linspace(0.0, 1.0, 21), 10)
+    settings = dict(
+        method="dop853", rtol=1e-8, atol=1e-10, transient=300, periods=100, lyapunov_periods=400
+    )
+    with pytest.MonkeyPatch.context() as mp:  # the sweep's runs before their looks
+        mp.setattr(plain, "_looked", lambda runs, points, *a, **k: [list(p) for p in points])
+        (sw,) = sweep_many([SweepJob(system, "lambda", lam, settings=settings)])
+    looks = [lk for _, lk in borders.sweep_looks(system, "lambda", list(sw.points), settings)]
+    assert len(looks) >= 3
+    one = [borders.run_look(lk) for lk in looks]
+    together = borders.run_all(looks, executor="serial")
+    for a, b in zip(one, together, strict=True):
+        assert a.verdict["motion"] == b.verdict["motion"]
+        assert a.verdict["periods_run"] == b.verdict["periods_run"]
+        if a.verdict["motion"] == "chaotic":
+            la, lb = a.lyapunov, b.lyapunov
+            bars = la["uncertainty"] + lb["uncertainty"]
+            assert abs(la["exponent"] - lb["exponent"]) <= bars
