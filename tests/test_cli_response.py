@@ -129,3 +129,37 @@ def test_a_response_over_the_speed_in_rpm_folds_where_the_one_over_omega_does():
     expected = sorted(e.value / per_rpm for c in omega.curves for e in c.events)
     assert len(folds) == 4 and np.allclose(folds, expected, rtol=1e-6)
     assert 0 < int(rpm.curves[0].stable.sum()) < len(rpm.curves[0].values)
+
+
+def test_stepped_integration_runs_over_the_speed_in_rpm_as_over_omega():
+    """A speed in rpm sets only the forcing frequency, so the stepped-frequency
+    integration takes it (it refused every parameter but omega).  References: the same
+    sweeps over omega at the speeds' omegas (the model's linear speed-omega rule), and
+    the up sweep's jump between the grid speeds that bracket harmonic balance's fold."""
+    import gearsym
+    from gearsym.solver.sweep.frequency import frequency_response
+
+    system = gearsym.load("reference-light")
+    per_rpm = system.parameters_with(speed_rpm=1000.0)[0] / 1000.0
+    kw = dict(points=16, methods=("integration",), settle=60, sampled=8)
+    rpm = frequency_response(system, "speed_rpm", 900.0, 1050.0, **kw)
+    omega = frequency_response(system, "omega", 900.0 * per_rpm, 1050.0 * per_rpm, **kw)
+    for a, b in zip(rpm.curves, omega.curves, strict=True):
+        assert np.allclose(a.values * per_rpm, b.values, rtol=1e-12)
+        for c in system.coordinates:
+            assert np.allclose(a.stats[c]["amplitude"], b.stats[c]["amplitude"], rtol=1e-6)
+    up = rpm.curves[0]
+    v = up.stats["v"]["amplitude"]
+    jump = int(np.argmax(np.abs(np.diff(v))))  # the last grid speed on the lower branch
+    hb = frequency_response(system, "speed_rpm", 900.0, 1050.0, points=16, methods=("hb",))
+    folds = [e.value for c in hb.curves for e in c.events if e.name == "fold"]
+    assert any(up.values[jump] <= f <= up.values[jump + 1] for f in folds)
+
+
+def test_stepped_integration_refuses_a_parameter_that_sets_more_than_the_frequency():
+    import gearsym
+    from gearsym.solver.sweep.frequency import others_moved
+
+    system = gearsym.load("reference-light")
+    assert others_moved(system, "speed_rpm", (900.0, 1200.0)) == []
+    assert others_moved(system, "lambda", (0.1, 0.8)) == ["f_v"]  # lambda = |f2 / f1|

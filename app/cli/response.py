@@ -102,7 +102,7 @@ def register(sub) -> None:
         choices=("hb", "shooting", "integration", "all"),
         default="hb",
         help="hb (harmonic balance), shooting, integration (up and down stepped "
-        "sweeps in the compiled engine, over the forcing frequency), or all",
+        "sweeps in the compiled engine, over the forcing frequency or a speed in rpm), or all",
     )
     fr.add_argument(
         "--settle",
@@ -198,7 +198,7 @@ def _cmd_response(args) -> int:
     from gearsym.resolve import needs_derivation
     from gearsym.solver._json import dumps
     from gearsym.solver.periodic import HarmonicBalanceError, ShootingError
-    from gearsym.solver.sweep.frequency import frequency_response, harmonics_cap
+    from gearsym.solver.sweep.frequency import frequency_response, harmonics_cap, others_moved
 
     name, start, stop, num = _param(args.param)
     if args.harmonics < 1:
@@ -232,10 +232,13 @@ def _cmd_response(args) -> int:
         raise Fail(f"--settle and --sampled must be >= 1, got {args.settle}, {args.sampled}")
     methods = ("hb", "shooting", "integration") if args.method == "all" else (args.method,)
     _bounded(args, system, num, methods, harmonics_cap(system), abs(stop - start))
-    if "integration" in methods and name != system.contract.forcing_frequency:
+    ends = (start, (start + stop) / 2, stop)
+    moved = "integration" in methods and others_moved(system, name, ends)
+    if moved:
         raise Fail(
             f"--method integration sweeps the forcing frequency "
-            f"'{system.contract.forcing_frequency}' only, not '{name}'; use hb or shooting"
+            f"'{system.contract.forcing_frequency}' only (or a speed, which sets nothing "
+            f"else), not '{name}', which sets {', '.join(moved)}; use hb or shooting"
         )
     out = out_folder(args.out or f"response_{system.name}")
     try:

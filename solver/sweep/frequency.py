@@ -193,6 +193,19 @@ def _shooting_curve(system, parameter, start, stop, n, ds, guess, grid) -> Curve
     )
 
 
+def others_moved(system, parameter: str, values) -> list[str]:
+    """The model parameters other than the forcing frequency that ``parameter`` changes
+    over ``values`` (none for the forcing frequency itself, or a speed in rpm that only
+    sets it): what the stepped-frequency integration, which runs its lanes in the
+    excitation phase, cannot follow."""
+    ff = system.contract.forcing_frequency
+    if parameter == ff:
+        return []
+    P = np.array([system.parameters_with(**{parameter: float(v)}) for v in values])
+    names = system.module.PARAMETERS
+    return [n for k, n in enumerate(names) if n != ff and np.ptp(P[:, k]) != 0.0]
+
+
 def _integration_curves(system, parameter, start, stop, points, settle, sampled, spp):
     """Up and down stepped-frequency sweeps by time integration, the two in one lockstep
     group in the excitation phase (``native.phase``): at each step every lane runs
@@ -203,13 +216,15 @@ def _integration_curves(system, parameter, start, stop, points, settle, sampled,
     from ..integrate import default_initial_state
     from ..integrate.native.phase import run_phase
 
-    if parameter != system.contract.forcing_frequency:
+    up = np.linspace(start, stop, points)
+    moved = others_moved(system, parameter, up)
+    if moved:
         raise ValueError(
             f"integration sweeps run over the forcing frequency "
-            f"'{system.contract.forcing_frequency}' only, not '{parameter}'"
+            f"'{system.contract.forcing_frequency}' only (or a quantity that sets nothing "
+            f"else, such as a speed), not '{parameter}', which sets {', '.join(moved)}"
         )
     started = time.perf_counter()
-    up = np.linspace(start, stop, points)
     lanes = (up, up[::-1])
     x = np.array([default_initial_state(system)] * 2)
     coords = system.coordinates
