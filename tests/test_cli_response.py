@@ -163,3 +163,25 @@ def test_stepped_integration_refuses_a_parameter_that_sets_more_than_the_frequen
     system = gearsym.load("reference-light")
     assert others_moved(system, "speed_rpm", (900.0, 1200.0)) == []
     assert others_moved(system, "lambda", (0.1, 0.8)) == ["f_v"]  # lambda = |f2 / f1|
+
+
+def test_a_curve_already_computed_stands_when_the_other_end_cannot_start(capsys, tmp_path):
+    """The dead-zone scene's branch from omega = 0.3 turns back at a fold and leaves the
+    range; the second curve would start at omega = 0.9, where the simulation settles on a
+    chaotic motion (simulate says so) and harmonic balance has no period-1 orbit to start
+    from.  The whole response failed and the first curve was lost; now it is written, and
+    its note says why there is no second one."""
+    code, out, err = run(
+        capsys,
+        "frequency-response",
+        "reference-dead-zone",
+        "--param=omega=0.3:0.9:40",
+        f"--out={tmp_path}",
+        "--json",
+    )
+    assert code == 0, err
+    doc = json.loads((tmp_path / "frequency_response.json").read_text(encoding="utf-8"))
+    (curve,) = doc["curves"]
+    omegas = [r["omega"] for r in doc["records"]]
+    assert curve["points"] == len(omegas) >= 5 and min(omegas) >= 0.3
+    assert any("no second curve from the other end (omega = 0.9)" in n for n in curve["notes"])

@@ -328,6 +328,8 @@ def frequency_response(
         raise ValueError(f"step must be in (0, |stop - start|], got {step}")
     ds = step or abs(stop - start) / (points - 1)
     grid = np.linspace(start, stop, points)
+    from ..periodic.harmonic_balance import HarmonicBalanceError
+
     curves = []
     guess = None
     for m in methods:
@@ -348,7 +350,20 @@ def frequency_response(
             if curve.details["status"] not in ("complete", "boundary"):
                 # the branch turned back out of the range: the rest of the range from the
                 # other end (the solution a simulation settles on there)
-                rest = _hb_curve(system, parameter, stop, start, harmonics, n, ds, grid)
+                try:
+                    rest = _hb_curve(system, parameter, stop, start, harmonics, n, ds, grid)
+                except HarmonicBalanceError as err:
+                    # the first curve stands; the note says why the rest of the range
+                    # has none (the motion a simulation settles on there has no
+                    # period-n orbit near it, say: a chaotic one)
+                    curve.details["notes"].append(
+                        f"no second curve from the other end ({parameter} = {stop:g}), "
+                        "where the first left the range: harmonic balance found no "
+                        f"period-{n} orbit near the motion a simulation settles on there "
+                        f"({str(err).split('; try')[0]}); the stepped integration "
+                        "(method 'integration') follows the settled motion over the range"
+                    )
+                    continue
                 rest.details["notes"].insert(
                     0,
                     f"a second curve, from the other end ({parameter} = {stop:g}): the "
