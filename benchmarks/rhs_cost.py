@@ -130,13 +130,14 @@ def _compiler() -> str:
 
 def compile_rhs(c_text: str, defines=(), folder: Path | None = None) -> ctypes.CDLL:
     """A library of ``c_text`` (a model's ``C_SOURCE``) with ``rc_prep``/``rc_eval``,
-    built with the flags of the engine (``build._FLAGS``) and ``defines``."""
+    built with the flags of the engine (``build.flags``) and ``defines``."""
     from gearsym.solver.integrate.native import build
 
     folder = Path(folder or tempfile.mkdtemp(prefix="gearsym-rhs-"))
     c_file, so = folder / f"rhs{len(defines)}.c", folder / f"rhs{len(defines)}.so"
     c_file.write_text("#include <math.h>\n" + c_text + _HARNESS, encoding="utf-8")
-    cmd = [_compiler(), *build._FLAGS, *defines, "-o", str(so), str(c_file), "-lm"]
+    cc = _compiler()
+    cmd = [cc, *build.flags(cc), *defines, "-o", str(so), str(c_file), "-lm"]
     subprocess.run(cmd, check=True, capture_output=True, text=True)
     lib = ctypes.CDLL(str(so))
     ptr = np.ctypeslib.ndpointer(np.float64, flags="C")

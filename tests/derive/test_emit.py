@@ -231,7 +231,7 @@ void ev_batch(double tau, int n, const double *X, const double *P, double *DX)
 
 
 def _batch_library(c_text, defines, folder):
-    """``c_text`` compiled as the engine compiles it (build._FLAGS) with ``defines``, and
+    """``c_text`` compiled as the engine compiles it (build.flags) with ``defines``, and
     its loop over points as the preprocessor leaves it."""
     import ctypes
     import subprocess
@@ -244,7 +244,7 @@ def _batch_library(c_text, defines, folder):
     stem = folder / f"m{len(list(folder.glob('*.so')))}"  # a new name: dlopen caches by path
     src, so = stem.with_suffix(".c"), stem.with_suffix(".so")
     src.write_text("#include <math.h>\n" + c_text + _EVAL_BATCH)
-    subprocess.run([cc, *build._FLAGS, *defines, "-o", str(so), str(src), "-lm"], check=True)
+    subprocess.run([cc, *build.flags(cc), *defines, "-o", str(so), str(src), "-lm"], check=True)
     pre = subprocess.run(
         [cc, "-E", "-P", *defines, "-x", "c", "-"], input=c_text, text=True, capture_output=True
     ).stdout

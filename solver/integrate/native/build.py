@@ -13,10 +13,8 @@ compile time.
 from __future__ import annotations
 
 import ctypes
-import functools
 import hashlib
 import os
-import platform
 import shutil
 import subprocess
 import tempfile
@@ -27,8 +25,18 @@ from pathlib import Path
 import numpy as np
 
 from ...cache import cache_root, locked
+from ...contract import Contract
 from ..tableau import RK4, c_tables
 from . import abi
+from .compiler import (
+    _MONODROMY_FLAGS,
+    _MONODROMY_O3_FROM,
+    _SMOOTH_FLAGS,
+    _compiler_id,
+    _no_compiler,
+    compiler,
+    flags,
+)
 
 __all__ = [
     "NativeUnavailable",
@@ -40,25 +48,6 @@ __all__ = [
     "source",
 ]
 
-# -O2, not -O3: the same speed on the generated right-hand sides (0.42 s both for a
-# reference-light sweep with and without the tangent vector, medians of 3) at half the
-# compile time (0.46 s against 0.97 s a library; a first reproduce compiles about 20)
-_FLAGS = (
-    "-O2",
-    "-march=native",
-    "-fno-math-errno",
-    "-fPIC",
-    "-shared",
-    "-Werror=implicit-function-declaration",
-)
-# The monodromy library at -O3: its J W and stage sums over n + n^2 components vectorise
-# there (-O2's cost model leaves loops whose length is not a multiple of the vector
-# width scalar): the three-planet set's one-period monodromy at rtol 1e-12 in 12.5 ms
-# against 18.2 ms (and 33 ms as n copies of the state); one library per model.  A small
-# model's loops are too short to gain from it (the DI-SO's 4 states) and -O3 compiles
-# in 0.94 s against 0.53 s: only from 12 states on
-_MONODROMY_FLAGS = ("-O3",)
-_MONODROMY_O3_FROM = 12
 _loaded: dict[str, ctypes.CDLL] = {}
 _paths: dict[tuple, Path] = {}  # (module file, inputs hash, variational, compiler) -> library
 _failed: dict[str, str] = {}  # cache key -> why it could not be built (once per session)
@@ -68,39 +57,6 @@ class NativeUnavailable(RuntimeError):
     """No C compiler, or the compilation failed: the NumPy path is used instead.  A
     compiler that fails on a model's C text is a bug; its output is saved beside the
     library it should have built (``<name>-<key>.log`` in :func:`cache_dir`)."""
-
-
-def compiler() -> str | None:
-    """The C compiler to use: ``$GEARSYM_CC`` if set (``none`` disables), else cc/gcc/clang.
-    Looked up once per value of ``GEARSYM_CC`` in a process (every run asks: a PATH search
-    per run was a second of a full reproduce)."""
-    return _compiler(os.environ.get("GEARSYM_CC"))
-
-
-@functools.lru_cache(maxsize=8)
-def _compiler(env: str | None) -> str | None:
-    if env is not None:
-        if env.strip().lower() in ("", "none", "0"):
-            return None
-        return shutil.which(env) or (env if Path(env).exists() else None)
-    for name in ("cc", "gcc", "clang"):
-        found = shutil.which(name)
-        if found:
-            return found
-    return None
-
-
-def _no_compiler() -> str:
-    """Why there is no compiler, naming GEARSYM_CC when it is set."""
-    env = os.environ.get("GEARSYM_CC")
-    if env is None:
-        return "no C compiler found (install gcc or clang, or set GEARSYM_CC)"
-    if env.strip().lower() in ("", "none", "0"):
-        return f"GEARSYM_CC={env!r} turns the C compiler off"
-    return (
-        f"GEARSYM_CC={env!r} is not a program on PATH nor a file; set it to a C compiler "
-        "(gcc, clang, or its path), or to none"
-    )
 
 
 def cache_dir() -> Path:
@@ -184,26 +140,6 @@ def _key_text(module, variational) -> str:
     return "\n".join([f"variational={variational}", text, engine, *tables])
 
 
-@functools.lru_cache(maxsize=8)
-def _compiler_id(cc: str) -> str:
-    """The compiler's version line and this CPU's identity: the libraries are built with
-    -march=native, so a cache shared between machines (a cluster's home) keeps one per CPU."""
-    try:
-        out = subprocess.run([cc, "--version"], capture_output=True, text=True, timeout=30)
-        version = out.stdout.splitlines()[0] if out.stdout else cc
-    except (OSError, subprocess.SubprocessError):
-        version = cc
-    cpu = platform.machine()
-    try:
-        with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as fh:
-            for line in fh:
-                if line.startswith(("flags", "Features", "model name")):
-                    cpu += "|" + line.strip()
-    except OSError:
-        cpu += "|" + platform.processor()
-    return version + "|" + cpu
-
-
 def _bug_report(module, cc: str, path: Path, c_file: Path, done) -> str:
     """Save the compiler's full output (and the C text it was given) beside the library it
     should have made, and return the one line that says so: the C code of a model that
@@ -211,7 +147,7 @@ def _bug_report(module, cc: str, path: Path, c_file: Path, done) -> str:
     log, kept = path.with_suffix(".log"), path.with_suffix(".c")
     how = f"exit status {done.returncode}" if done.returncode else "no library written"
     lines = [
-        f"$ {cc} {' '.join(_FLAGS)} -o lib.so {kept.name} -lm",
+        f"$ {cc} {' '.join(flags(cc))} -o lib.so {kept.name} -lm",
         f"({how})",
         "--- stdout ---",
         done.stdout or "",
@@ -304,6 +240,8 @@ def library(module, variational: bool | str = False, shared=()) -> tuple[ctypes.
     defines = _shared_flags(module, shared) if "GS_SHARED_" in text and not monodromy else []
     if monodromy and len(module.CONTRACT["states"]) >= _MONODROMY_O3_FROM:
         defines = list(_MONODROMY_FLAGS)  # (after _FLAGS' -O2, it overrides it)
+    elif not monodromy and not Contract.of(module).piecewise:
+        defines = [*_SMOOTH_FLAGS, *defines]
     memo = (
         getattr(module, "__file__", module.NAME),
         getattr(module, "INPUTS_SHA256", ""),
@@ -322,7 +260,7 @@ def library(module, variational: bool | str = False, shared=()) -> tuple[ctypes.
     # SciPy itself is not imported for a library that is already compiled).
     key = hashlib.sha256(
         "\n".join(
-            [_key_text(module, variational), _compiler_id(cc), " ".join([*_FLAGS, *defines])]
+            [_key_text(module, variational), _compiler_id(cc), " ".join([*flags(cc), *defines])]
         ).encode()
     ).hexdigest()[:20]
     if key in _failed:
@@ -356,7 +294,7 @@ def library(module, variational: bool | str = False, shared=()) -> tuple[ctypes.
                 so = Path(tmp) / "lib.so"
                 try:
                     done = subprocess.run(
-                        [cc, *_FLAGS, *defines, "-o", str(so), str(c_file), "-lm"],
+                        [cc, *flags(cc), *defines, "-o", str(so), str(c_file), "-lm"],
                         capture_output=True,
                         text=True,
                         timeout=300,
