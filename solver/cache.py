@@ -90,16 +90,22 @@ def _unwritable(folder: Path) -> str | None:
 def locked(path: Path):
     """Hold an exclusive lock on ``<path>.lock`` (POSIX ``flock``) while a cache file is
     built, so that processes needing it at once build it once.  A platform without
-    ``flock``, or a cache one may read but not write, goes without: the builders' atomic
-    renames keep that safe, only the work may be done twice."""
+    ``flock``, a cache one may read but not write, or a file system without locks (NFS
+    without its lock service, say) goes without: the builders' atomic renames keep that
+    safe, only the work may be done twice."""
+    fh = None
     try:
         import fcntl
 
         path.parent.mkdir(parents=True, exist_ok=True)
-        fh = open(path.with_suffix(".lock"), "a")  # noqa: SIM115 - held across the yield
-    except (ImportError, OSError):
-        yield
-        return
-    with fh:  # closing it releases the lock
+        fh = open(path.with_name(path.name + ".lock"), "a")  # noqa: SIM115 - held across yield
         fcntl.flock(fh, fcntl.LOCK_EX)
+    except (ImportError, OSError):
+        if fh is not None:
+            fh.close()
+        fh = None
+    try:
         yield
+    finally:
+        if fh is not None:
+            fh.close()  # releases the lock

@@ -90,8 +90,9 @@ class InUnits:
             "lyapunov_per_s": "largest Lyapunov exponent per second (lyapunov x omega_n)",
             "t_s": "time in seconds (tau / omega_n)",
             **{
-                f"{c}_force_N": f"dynamic mesh force of {c} in N at the sample (the model's "
-                "mesh force x k_m b; its static value and the dynamic factor: coordinates)"
+                f"{c}_force_N": f"mesh force of {c} in N at the sample, static load included "
+                "(the model's mesh force x k_m b; the static force and the dynamic factor "
+                "are under coordinates)"
                 for c in self.system.coordinates
             },
             SPEED: f"speed of gear '{base.scales.get('speed_gear', '?')}' in rpm at the row",

@@ -158,7 +158,7 @@ def test_stepped_integration_runs_over_the_speed_in_rpm_as_over_omega():
 
 def test_stepped_integration_refuses_a_parameter_that_sets_more_than_the_frequency():
     import gearsym
-    from gearsym.solver.sweep.frequency import others_moved
+    from gearsym.solver.sweep.frequency_ranges import others_moved
 
     system = gearsym.load("reference-light")
     assert others_moved(system, "speed_rpm", (900.0, 1200.0)) == []

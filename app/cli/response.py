@@ -198,7 +198,8 @@ def _cmd_response(args) -> int:
     from gearsym.resolve import needs_derivation
     from gearsym.solver._json import dumps
     from gearsym.solver.periodic import HarmonicBalanceError, ShootingError
-    from gearsym.solver.sweep.frequency import frequency_response, harmonics_cap, others_moved
+    from gearsym.solver.sweep.frequency import frequency_response, harmonics_cap
+    from gearsym.solver.sweep.frequency_ranges import names_moved, others_moved
 
     name, start, stop, num = _param(args.param)
     if args.harmonics < 1:
@@ -238,7 +239,7 @@ def _cmd_response(args) -> int:
         raise Fail(
             f"--method integration sweeps the forcing frequency "
             f"'{system.contract.forcing_frequency}' only (or a speed, which sets nothing "
-            f"else), not '{name}', which sets {', '.join(moved)}; use hb or shooting"
+            f"else), not '{name}', which sets {names_moved(moved)}; use hb or shooting"
         )
     out = out_folder(args.out or f"response_{system.name}")
     try:

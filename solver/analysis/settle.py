@@ -168,8 +168,11 @@ def settle_many(
     frequency and a length are one batch of the compiled lockstep engine (a border run
     alone took its steps one point at a time: about five times the cost per period of
     the DI-SO in a group).  Each window starts at tau = 0, its phase (the model is
-    periodic in the forcing period).  A model without the compiled engine runs each
-    window alone, as :func:`settle` does."""
+    periodic in the forcing period).  A method outside the compiled engine runs each
+    window alone, as :func:`settle` does, and so does a run of a batch that stopped as a
+    group (a step too small or the step budget spent: :data:`_GROUP_STOPS`).  A batch
+    shares its steps, so a chaotic run's points depend on its batch-mates (its
+    statistics, the verdict's evidence, do not)."""
     run = {"method": method, "rtol": rtol, "atol": atol, "steps_per_period": steps_per_period}
     steps = [
         _settling(
@@ -215,6 +218,11 @@ def settle_many(
     return out
 
 
+# Statuses a lockstep group shares: one run whose steps shrink to nothing, or that
+# exhausts the step budget, stops every run of its group
+_GROUP_STOPS = ("step too small", "too many steps")
+
+
 def _extend_many(systems, xs, periods: int, run: dict, exponent: bool) -> list[tuple]:
     """:func:`_extend` of each system from its state at phase 0, one batch of the compiled
     engine where the method is native (else one at a time)."""
@@ -233,12 +241,16 @@ def _extend_many(systems, xs, periods: int, run: dict, exponent: bool) -> list[t
         steps_per_period=run["steps_per_period"],
         collect=("samples", "extremes", "exponent") if exponent else ("samples", "extremes"),
         lyapunov_periods=periods if exponent else 0,
+        hoist=False,  # looks vary in ways no map column does: the model's one library
     )
     P = np.array([s.p for s in systems], dtype=float)
     res = integrate(Batch.of(systems[0].module, P), np.array(xs, dtype=float), spec)
     out = []
     for i, system in enumerate(systems):
         status, X = res.status[i], res.x[i]
+        if status in _GROUP_STOPS:  # the whole group stopped: this run alone, as settle does
+            out.append(_extend(system, xs[i], 0.0, periods, run, exponent))
+            continue
         lyap = None
         if exponent and status == "ok":
             lyap = LyapunovEstimate.from_running(

@@ -166,7 +166,8 @@ def integrate(
         from .native.engine import shared_parameters
 
         # the library the (first) share of the batch runs with
-        backend = decide_backend(module, spec, backend, shared_parameters(P[chunks[0]]))
+        shared = shared_parameters(P[chunks[0]]) if spec.hoist else ()
+        backend = decide_backend(module, spec, backend, shared)
     if workers > 1 and N > 1:
         from ..executor import map_tasks
 

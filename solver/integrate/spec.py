@@ -100,6 +100,12 @@ class RunSpec:
         Compiled engine only: groups of ``group`` points share time and step size;
         ``dense`` interpolates samples with DOP853's dense output instead of shortening
         steps to land on them. Neither changes what is computed beyond the tolerances.
+    hoist : bool
+        Compiled engine only: the parameters equal across the batch are compiled in (a
+        library per set of them, hoisting what depends on them alone out of the point
+        loop); False: the library for any batch, one per model, for a small batch whose
+        parameters vary in a way no other batch's do (its own library would cost more
+        to compile than it saves).
     """
 
     method: str = "dop853"
@@ -120,6 +126,7 @@ class RunSpec:
     lockstep: bool = True
     group: int = 64
     dense: bool = True
+    hoist: bool = True
 
     def __post_init__(self):
         put = object.__setattr__
@@ -186,6 +193,7 @@ class RunSpec:
         put(self, "group", _whole("group", self.group, 1, _MOST_GROUP))
         put(self, "lockstep", bool(self.lockstep))
         put(self, "dense", bool(self.dense))
+        put(self, "hoist", bool(self.hoist))
 
     @property
     def adaptive(self) -> bool:

@@ -227,26 +227,40 @@ def run_looks(looks: list[Look]) -> list[RunRecord]:
     return out
 
 
+def _batch_key(look: Look):
+    """What looks must share to run their windows in one batch, or None (a piecewise
+    model's, whose runs take their own steps anyway)."""
+    module = load_generated(look.source)
+    contract = Contract.of(module)
+    if contract.piecewise:
+        return None
+    omega = look.p[contract.parameters.index(contract.forcing_frequency)]
+    before = int(look.record.verdict.get("periods_run") or 0)
+    options = tuple(sorted((n, v) for n, v in look.options.items() if n != "tol"))
+    return (look.source, omega, options, before)
+
+
 def run_all(looks: list[Look], *, run=None, **options) -> list[RunRecord]:
-    """Every look re-examined (:func:`run_looks`), :data:`LOOK_BATCH` to a task of
-    ``run`` (``executor.map_tasks`` by default, or a result store's ``map``; ``options``
-    go to it), a piecewise model's one to a task; the records in the order of ``looks``."""
+    """Every look re-examined (:func:`run_looks`) in tasks of ``run``
+    (``executor.map_tasks`` by default, or a result store's ``map``; ``options`` go to
+    it): the looks whose windows can share a batch up to :data:`LOOK_BATCH` to a task,
+    the others (a piecewise model's, a look alone at its frequency) one to a task; the
+    records in the order of ``looks``."""
     if run is None:
         from ..executor import map_tasks as run
-    # A piecewise force law's runs take their own steps in any batch (integrate.run), so
-    # its looks go one to a task, spread over the workers; the others share a task
-    alone = [Contract.of(load_generated(look.source)).piecewise for look in looks]
+    # The looks settle_many can batch (one model, forcing frequency, options and start)
+    # share a task, up to LOOK_BATCH; the rest, and a piecewise force law's (its runs take
+    # their own steps in any batch: integrate.run), one to a task, spread over the workers
+    groups: dict = {}
+    for k, look in enumerate(looks):
+        groups.setdefault(_batch_key(look), []).append(k)
     chunks: list[list[int]] = []
-    batch: list[int] = []
-    for k, one in enumerate(alone):
-        if one:
-            chunks.append([k])
+    for key, ks in groups.items():
+        if key is None or len(ks) == 1:
+            chunks += [[k] for k in ks]
         else:
-            batch.append(k)
-            if len(batch) == LOOK_BATCH:
-                chunks.append(batch)
-                batch = []
-    chunks += [batch] if batch else []
+            chunks += [ks[i : i + LOOK_BATCH] for i in range(0, len(ks), LOOK_BATCH)]
+    chunks.sort()  # in the order of the looks, whatever the grouping
     parts = run(run_looks, [[looks[k] for k in ks] for ks in chunks], **options)
     out: list = [None] * len(looks)
     for ks, part in zip(chunks, parts, strict=True):

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..system import System
 from ._resample import on_grid
+from .frequency_ranges import names_moved, no_second_curve, others_moved
 from .frequency_result import Curve, FrequencyResponse
 
 __all__ = [
@@ -193,19 +194,6 @@ def _shooting_curve(system, parameter, start, stop, n, ds, guess, grid) -> Curve
     )
 
 
-def others_moved(system, parameter: str, values) -> list[str]:
-    """The model parameters other than the forcing frequency that ``parameter`` changes
-    over ``values`` (none for the forcing frequency itself, or a speed in rpm that only
-    sets it): what the stepped-frequency integration, which runs its lanes in the
-    excitation phase, cannot follow."""
-    ff = system.contract.forcing_frequency
-    if parameter == ff:
-        return []
-    P = np.array([system.parameters_with(**{parameter: float(v)}) for v in values])
-    names = system.module.PARAMETERS
-    return [n for k, n in enumerate(names) if n != ff and np.ptp(P[:, k]) != 0.0]
-
-
 def _integration_curves(system, parameter, start, stop, points, settle, sampled, spp):
     """Up and down stepped-frequency sweeps by time integration, the two in one lockstep
     group in the excitation phase (``native.phase``): at each step every lane runs
@@ -222,7 +210,7 @@ def _integration_curves(system, parameter, start, stop, points, settle, sampled,
         raise ValueError(
             f"integration sweeps run over the forcing frequency "
             f"'{system.contract.forcing_frequency}' only (or a quantity that sets nothing "
-            f"else, such as a speed), not '{parameter}', which sets {', '.join(moved)}"
+            f"else, such as a speed), not '{parameter}', which sets {names_moved(moved)}"
         )
     started = time.perf_counter()
     lanes = (up, up[::-1])
@@ -357,11 +345,7 @@ def frequency_response(
                     # has none (the motion a simulation settles on there has no
                     # period-n orbit near it, say: a chaotic one)
                     curve.details["notes"].append(
-                        f"no second curve from the other end ({parameter} = {stop:g}), "
-                        "where the first left the range: harmonic balance found no "
-                        f"period-{n} orbit near the motion a simulation settles on there "
-                        f"({str(err).split('; try')[0]}); the stepped integration "
-                        "(method 'integration') follows the settled motion over the range"
+                        no_second_curve(system, parameter, start, stop, n, err)
                     )
                     continue
                 rest.details["notes"].insert(

@@ -140,14 +140,14 @@ def _key_text(module, variational) -> str:
     return "\n".join([f"variational={variational}", text, engine, *tables])
 
 
-def _bug_report(module, cc: str, path: Path, c_file: Path, done) -> str:
+def _bug_report(module, cc: str, path: Path, c_file: Path, done, defines=()) -> str:
     """Save the compiler's full output (and the C text it was given) beside the library it
     should have made, and return the one line that says so: the C code of a model that
     derives is valid by construction, so a failing compile is a bug to report."""
     log, kept = path.with_suffix(".log"), path.with_suffix(".c")
     how = f"exit status {done.returncode}" if done.returncode else "no library written"
     lines = [
-        f"$ {cc} {' '.join(flags(cc))} -o lib.so {kept.name} -lm",
+        f"$ {cc} {' '.join([*flags(cc), *defines])} -o lib.so {kept.name} -lm",
         f"({how})",
         "--- stdout ---",
         done.stdout or "",
@@ -238,9 +238,10 @@ def library(module, variational: bool | str = False, shared=()) -> tuple[ctypes.
     # (the monodromy library runs its points one at a time: nothing to hoist)
     monodromy = variational == "monodromy"
     defines = _shared_flags(module, shared) if "GS_SHARED_" in text and not monodromy else []
-    if monodromy and len(module.CONTRACT["states"]) >= _MONODROMY_O3_FROM:
+    n_states = len(module.CONTRACT["states"])
+    if monodromy and n_states >= _MONODROMY_O3_FROM:
         defines = list(_MONODROMY_FLAGS)  # (after _FLAGS' -O2, it overrides it)
-    elif not monodromy and not Contract.of(module).piecewise:
+    elif not monodromy and n_states >= _MONODROMY_O3_FROM and not Contract.of(module).piecewise:
         defines = [*_SMOOTH_FLAGS, *defines]
     memo = (
         getattr(module, "__file__", module.NAME),
@@ -303,7 +304,7 @@ def library(module, variational: bool | str = False, shared=()) -> tuple[ctypes.
                     _failed[key] = f"the C compiler {cc} could not be run ({err})"
                     raise NativeUnavailable(_failed[key]) from None
                 if done.returncode != 0 or not so.exists():
-                    _failed[key] = _bug_report(module, cc, path, c_file, done)
+                    _failed[key] = _bug_report(module, cc, path, c_file, done, defines)
                     raise NativeUnavailable(_failed[key])
                 digest = hashlib.sha256(so.read_bytes()).hexdigest()
                 stated = Path(tmp) / "lib.sha256"

@@ -33,14 +33,16 @@ _FLAGS = (
 # model's loops are too short to gain from it (the DI-SO's 4 states) and -O3 compiles
 # in 0.94 s against 0.53 s: only from 12 states on
 _MONODROMY_FLAGS = ("-O3",)
-# A smooth model's libraries at -O3: its lockstep loops over a group's points
-# (gs_rhs_batch, the stage sums) vectorise there and not at -O2, whose cost model leaves
-# them scalar.  Measured on 2 cores, 40-point sweeps of 200 + 100 periods, medians of 3
-# alternating runs: reference-light 1.17 -> 0.74 ms a point (2.49 -> 1.31 with the
-# exponent's tangent), the DI-SO on bearings 16.3 -> 4.5, the two-stage train 73 -> 20,
-# for a compile of about 1.5 s against 0.7 s.  A piecewise model (the dead zone) runs
-# its points one at a time, where -O3 gains nothing (7.34 against 7.44 ms): -O2.
-# (An earlier measurement had -O2 as fast; it does not hold on today's lockstep engine.)
+# A large smooth model's libraries at -O3 too: its lockstep loops over a group's points
+# (gs_rhs_batch, the stage sums) vectorise there and stay scalar at -O2, whose cost model
+# leaves them.  Measured on 2 cores, 40-point sweeps of 200 + 100 periods, medians of 3
+# alternating runs: the DI-SO on bearings (22 states) 16.3 -> 4.5 ms a point, the
+# two-stage train (30) 73 -> 20, for a compile of about 1.5 s against 0.7 s.  The
+# torsional DI-SO (4 states) gains less (1.17 -> 0.74 ms; 2.49 -> 1.31 with the
+# exponent's tangent) than the compile costs a first reproduce, whose runs are short
+# (two first runs side by side, one process each: 218 and 213 s against 203 and 197 s
+# with -O2): from 12 states on, as the monodromy's.  A piecewise model (the dead zone)
+# runs its points one at a time, where -O3 gains nothing: -O2.
 _SMOOTH_FLAGS = ("-O3",)
 _MONODROMY_O3_FROM = 12
 

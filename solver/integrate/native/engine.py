@@ -126,7 +126,8 @@ def run_compiled(module, P, X0, spec: RunSpec, tangent0=None, monodromy=False) -
                 f"tangent0 must be ({N}, {m}), with the exponent collected from the start"
             )
     kind = "monodromy" if monodromy else tangent
-    lib, facts = library(module, variational=kind, shared=shared_parameters(P))
+    shared = shared_parameters(P) if spec.hoist else ()
+    lib, facts = library(module, variational=kind, shared=shared)
     K, L = spec.n_samples, spec.lyapunov_periods
     check = spec.valid_range != "ignore"
     bounds = np.full(n, np.inf)
