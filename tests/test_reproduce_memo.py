@@ -131,3 +131,16 @@ def test_the_key_tells_apart_what_differs_and_ignores_a_dicts_order(tmp_path):
     b = {"y": {"q": (2.0,), "p": 1}, "x": [1.0]}
     assert canonical(a, tmp_path) == canonical(b, tmp_path)
     assert canonical(a, tmp_path) != canonical({**a, "x": [1.5]}, tmp_path)
+
+
+def test_the_source_hash_covers_the_engine_s_c(monkeypatch):
+    """A change to an integrator's C (native_*.c, monodromy.c) changes results as much
+    as one to its Python: the stored results' key reads those files too."""
+    from gearsym.studies import memo
+
+    read = []
+    real = memo._sha256_file
+    monkeypatch.setattr(memo, "_sha256_file", lambda f: read.append(f.name) or real(f))
+    monkeypatch.setattr(memo, "_source", [])
+    memo.source_hash()
+    assert {"native_1_job.c", "native_2_step.c", "native_3_loop.c", "monodromy.c"} <= set(read)

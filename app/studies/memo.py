@@ -59,8 +59,9 @@ def _sha256_file(path) -> str:
 
 
 def source_hash() -> str:
-    """sha256 of gearsym's source files and built-in scenes, with the versions of Python
-    and of the libraries a result depends on, and the C compiler (once per process)."""
+    """sha256 of gearsym's source files (Python and the engine's C) and built-in scenes,
+    with the versions of Python and of the libraries a result depends on, and the C
+    compiler (once per process)."""
     if not _source:
         from importlib.metadata import PackageNotFoundError, version
 
@@ -77,7 +78,9 @@ def source_hash() -> str:
                 h.update(f"{name} {version(name)}\n".encode())
             except PackageNotFoundError:
                 h.update(f"{name} missing\n".encode())
-        found = {f for r in roots for f in r.rglob("*.py")}
+        # the Python and the C of the engine (native_*.c, monodromy.c): a change to an
+        # integrator's C is a change of the results as much as one to its Python
+        found = {f for r in roots for pattern in ("*.py", "*.c") for f in r.rglob(pattern)}
         if scenes.is_dir():
             found |= set(scenes.rglob("*.toml"))
         for f in sorted(found):
