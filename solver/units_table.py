@@ -52,10 +52,11 @@ class InUnits:
 
             cols = [rows[:, columns.index(c)] * base.deflection(q, 1.0) for c, q in added]
             cols.append(rows[:, columns.index("tau")] / base.scales["omega_n_rad_per_s"])
+            speeds_n, speeds = _velocities(self.system, base, columns, rows, added)
             names, forces = _forces(self.system, base, columns, rows)
             return (
-                [*columns, *extra_names, *names],
-                np.column_stack([rows, *cols, *forces]),
+                [*columns, *extra_names, *speeds_n, *names],
+                np.column_stack([rows, *cols, *speeds, *forces]),
                 len(columns),
             )
         # the rows' speed and mesh frequency (from omega if the model states no speed); not
@@ -89,6 +90,11 @@ class InUnits:
         meaning = {
             "lyapunov_per_s": "largest Lyapunov exponent per second (lyapunov x omega_n)",
             "t_s": "time in seconds (tau / omega_n)",
+            **{
+                f"{self.system.states[self.system.velocity_index(c)]}_m_per_s": f"rate of {c} "
+                "in m/s at the sample (omega_n b d/dtau)"
+                for c in self.system.coordinates
+            },
             **{
                 f"{c}_force_N": f"mesh force of {c} in N at the sample, static load included "
                 "(the model's mesh force x k_m b; the static force and the dynamic factor "
@@ -129,6 +135,20 @@ class InUnits:
         from .export import save
 
         return save(self, path, **extra)
+
+
+def _velocities(system, units: Units, columns: list, rows, added) -> tuple[list, list]:
+    """A trajectory's mesh-coordinate rates in m/s (``<velocity state>_m_per_s``: the
+    state times b omega_n, d/dt = omega_n d/dtau), for the coordinates in µm."""
+    names, cols = [], []
+    omega_n = units.scales["omega_n_rad_per_s"]
+    for c, q in added:
+        v = system.states[system.velocity_index(c)]
+        b = units.scales["half_backlash_m"].get(q)
+        if v in columns and b:
+            names.append(f"{v}_m_per_s")
+            cols.append(rows[:, columns.index(v)] * b * omega_n)
+    return names, cols
 
 
 def _forces(system, units: Units, columns: list, rows) -> tuple[list, list]:

@@ -303,6 +303,8 @@ def test_simulate_writes_its_samples_and_draws_its_figure_in_physical_units(tmp_
     omega_n = doc["scales"]["omega_n_rad_per_s"]
     assert np.allclose(table["u_um"], 50.0 * table["u"], rtol=1e-12, atol=0)
     assert np.allclose(table["t_s"], table["tau"] / omega_n, rtol=1e-12, atol=0)
+    # the rates in m/s: d/dt = omega_n d/dtau, times b
+    assert np.allclose(table["du_m_per_s"], 50e-6 * omega_n * table["du"], rtol=1e-12, atol=0)
     assert "speed_rpm" not in table  # one operating point, stated once in the block
     block = doc["in_units"]
     assert block["coordinates"]["v"]["range"] == pytest.approx(

@@ -46,7 +46,8 @@ def register(sub) -> None:
         "deflections (dynamic transmission error) in µm, mesh forces in N with the dynamic "
         "factor, frequencies in Hz and orders of the mesh frequency, the speed in rpm; "
         "point.png in µm, ms, m/s and Hz; the point files with added columns "
-        "(<coordinate>_um, t_s, <coordinate>_force_N) and an in_units block",
+        "(<coordinate>_um, t_s, d<coordinate>_m_per_s, <coordinate>_force_N) and an in_units "
+        "block",
     )
     si.add_argument(
         "--out", metavar="DIR", help="also write point.json, .csv, .mat (--format) and point.png"
