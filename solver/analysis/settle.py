@@ -71,25 +71,8 @@ def _extend(system, x, t, periods: int, run: dict, exponent: bool):
     """``periods`` more periods from state ``x`` at time ``t``: Poincare points (n, L),
     end state, status, the exponent over them (or None), extremes (xmin, xmax)."""
     if get_method(run["method"]).family == "native":
-        spec = RunSpec(
-            method=run["method"],
-            rtol=run["rtol"],
-            atol=run["atol"],
-            t0=t,
-            transient=0,
-            periods=periods,
-            steps_per_period=run["steps_per_period"],
-            collect=("samples", "extremes", "exponent") if exponent else ("samples", "extremes"),
-            lyapunov_periods=periods if exponent else 0,
-        )
-        res = integrate(system, x, spec)
-        status, X = res.status[0], res.x[0]
-        lyap = None
-        if exponent and status == "ok":
-            lyap = LyapunovEstimate.from_running(
-                res.exponent[0], run["rtol"], run["atol"], res.label, system.period
-            )
-        return X[:periods].T, X[-1].copy(), status, lyap, (res.xmin[0], res.xmax[0])
+        res = integrate(system, x, _window_spec(periods, run, exponent, t))
+        return _window(res, 0, system, periods, run, exponent)
     tr = simulate(
         system,
         x,
@@ -231,33 +214,44 @@ def _extend_many(systems, xs, periods: int, run: dict, exponent: bool) -> list[t
         return [_extend(s, x, 0.0, periods, run, exponent) for s, x in pairs]
     from ..integrate.run import Batch
 
-    spec = RunSpec(
+    # looks vary in ways no map column does: the model's one library (hoist=False)
+    spec = _window_spec(periods, run, exponent, 0.0, hoist=False)
+    P = np.array([s.p for s in systems], dtype=float)
+    res = integrate(Batch.of(systems[0].module, P), np.array(xs, dtype=float), spec)
+    return [
+        # a run of a group that stopped as a whole runs alone, as settle runs it
+        _extend(system, xs[i], 0.0, periods, run, exponent)
+        if res.status[i] in _GROUP_STOPS
+        else _window(res, i, system, periods, run, exponent)
+        for i, system in enumerate(systems)
+    ]
+
+
+def _window_spec(periods: int, run: dict, exponent: bool, t0: float, hoist=True) -> RunSpec:
+    """The compiled engine's spec of a continued window of ``periods`` from ``t0``."""
+    return RunSpec(
         method=run["method"],
         rtol=run["rtol"],
         atol=run["atol"],
-        t0=0.0,
+        t0=t0,
         transient=0,
         periods=periods,
         steps_per_period=run["steps_per_period"],
         collect=("samples", "extremes", "exponent") if exponent else ("samples", "extremes"),
         lyapunov_periods=periods if exponent else 0,
-        hoist=False,  # looks vary in ways no map column does: the model's one library
+        hoist=hoist,
     )
-    P = np.array([s.p for s in systems], dtype=float)
-    res = integrate(Batch.of(systems[0].module, P), np.array(xs, dtype=float), spec)
-    out = []
-    for i, system in enumerate(systems):
-        status, X = res.status[i], res.x[i]
-        if status in _GROUP_STOPS:  # the whole group stopped: this run alone, as settle does
-            out.append(_extend(system, xs[i], 0.0, periods, run, exponent))
-            continue
-        lyap = None
-        if exponent and status == "ok":
-            lyap = LyapunovEstimate.from_running(
-                res.exponent[i], run["rtol"], run["atol"], res.label, system.period
-            )
-        out.append((X[:periods].T, X[-1].copy(), status, lyap, (res.xmin[i], res.xmax[i])))
-    return out
+
+
+def _window(res, i: int, system, periods: int, run: dict, exponent: bool) -> tuple:
+    """Run ``i`` of a window's result as :func:`_extend` gives it."""
+    status, X = res.status[i], res.x[i]
+    lyap = None
+    if exponent and status == "ok":
+        lyap = LyapunovEstimate.from_running(
+            res.exponent[i], run["rtol"], run["atol"], res.label, system.period
+        )
+    return X[:periods].T, X[-1].copy(), status, lyap, (res.xmin[i], res.xmax[i])
 
 
 def _settling(

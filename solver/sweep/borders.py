@@ -106,7 +106,7 @@ def reexamine(
 def _start(system: System, r: RunRecord, tol: float) -> tuple:
     """What :func:`settle` takes of a run: (system, Poincare points, end state, periods
     run, repeat tolerance scaled by the cloud)."""
-    before = int(r.verdict.get("periods_run") or 0)
+    before = _before(r)
     points = r.tail.T
     cloud = max(float(np.ptp(points, axis=1).max()), 1.0) if points.size else 1.0
     return system, points, r.x_final, before, tol * cloud
@@ -116,8 +116,7 @@ def _finish(system: System, r: RunRecord, st, budget: int) -> RunRecord:
     """The run's record with the settled verdict (``reexamined`` says the periods before
     and the budget)."""
     v = st.verdict
-    before = int(r.verdict.get("periods_run") or 0)
-    summary = v.summary() | {"reexamined": {"periods_before": before, "budget": budget}}
+    summary = v.summary() | {"reexamined": {"periods_before": _before(r), "budget": budget}}
     keep = r.tail.shape[0]
     lyap = st.lyapunov
     if lyap is not None:
@@ -198,33 +197,37 @@ def run_looks(looks: list[Look]) -> list[RunRecord]:
     groups: dict = {}
     for k, look in enumerate(looks):
         r = look.record
-        if not needs_look(r) or r.x_final is None:
-            continue
-        before = int(r.verdict.get("periods_run") or 0)
-        o = look.options
-        budget = o.get("budget", BORDER_BUDGET)
-        key = (tuple(sorted((n, v) for n, v in o.items() if n != "tol")), max(budget, before))
-        groups.setdefault(key, []).append(k)
-    for ks in groups.values():
+        if needs_look(r) and r.x_final is not None:
+            budget = look.options.get("budget", BORDER_BUDGET)
+            groups.setdefault((_options_key(look), budget, max(budget, _before(r))), []).append(k)
+    for (_, budget, longest), ks in groups.items():
         o = looks[ks[0]].options
-        budget = o.get("budget", BORDER_BUDGET)
         systems = {
             k: System(load_generated(looks[k].source), np.asarray(looks[k].p, float), {})
             for k in ks
         }
         starts = [_start(systems[k], looks[k].record, looks[k].options["tol"]) for k in ks]
-        before = max(int(looks[k].record.verdict.get("periods_run") or 0) for k in ks)
         done = settle_many(
             starts,
             method=o.get("method", "dop853"),
             rtol=o.get("rtol", 1e-8),
             atol=o.get("atol", 1e-10),
-            budget=max(budget, before),
+            budget=longest,
             min_periods=budget,
         )
         for k, st in zip(ks, done, strict=True):
             out[k] = _finish(systems[k], looks[k].record, st, budget)
     return out
+
+
+def _before(r: RunRecord) -> int:
+    """The periods a run went before its look."""
+    return int(r.verdict.get("periods_run") or 0)
+
+
+def _options_key(look: Look) -> tuple:
+    """A look's options but its own tolerance (the tolerance is per run)."""
+    return tuple(sorted((n, v) for n, v in look.options.items() if n != "tol"))
 
 
 def _batch_key(look: Look):
@@ -235,9 +238,7 @@ def _batch_key(look: Look):
     if contract.piecewise:
         return None
     omega = look.p[contract.parameters.index(contract.forcing_frequency)]
-    before = int(look.record.verdict.get("periods_run") or 0)
-    options = tuple(sorted((n, v) for n, v in look.options.items() if n != "tol"))
-    return (look.source, omega, options, before)
+    return (look.source, omega, _options_key(look), _before(look.record))
 
 
 def run_all(looks: list[Look], *, run=None, **options) -> list[RunRecord]:
