@@ -131,21 +131,27 @@ def _prepare(args: tuple) -> None:
 
 
 def _column_shares(system, which: tuple, quick: bool) -> list:
-    """The parameters shared by the rows of each kind of map column the model of
-    ``which`` = ``(scene, f1, reading, key, value)`` has more than one row in: the
-    scene's own model holds a whole column of every map whose value is a parameter of
-    it; a model derived for one value holds one row (the one-point library)."""
-    from gearsym.solver.integrate.native.engine import shared_parameters
+    """The ``shared`` of the library of each kind of map column the model of ``which`` =
+    ``(scene, f1, reading, key, value)`` has more than one row in
+    (``engine.batch_shared``): the scene's own model holds a whole column of every map
+    whose value is a parameter of it; a model derived for one value holds one row (the
+    one-point library)."""
+    from gearsym.solver.integrate.native.engine import batch_shared
+    from gearsym.solver.integrate.spec import RunSpec
+
+    from .cases import RESOLUTIONS
 
     scene, f1, reading, key, _ = which
     if key is not None:
         return []
+    res = RESOLUTIONS["quick" if quick else "full"]
+    spec = RunSpec(transient=res.transient, periods=res.periods)
     out = []
     for k, (values, _, _) in (QUICK_SPREAD if quick else OPEN_SPREAD).items():
         if is_text(values) or _derives(system.module, k, values[0]):
             continue
         P = [_load_value(scene, f1, reading, k, v).with_values(**{"lambda": 0.5}).p for v in values]
-        out.append(shared_parameters(np.array(P)))
+        out.append(batch_shared(system.module, np.array(P), spec))
     return list(dict.fromkeys(out))
 
 

@@ -163,10 +163,10 @@ def integrate(
     N = P.shape[0]
     chunks = [c for c in np.array_split(np.arange(N), min(workers, N)) if c.size]
     if backend != "numpy":
-        from .native.engine import shared_parameters
+        from .native.engine import batch_shared
 
         # the library the (first) share of the batch runs with
-        shared = shared_parameters(P[chunks[0]]) if spec.hoist else ()
+        shared = batch_shared(module, P[chunks[0]], spec)
         backend = decide_backend(module, spec, backend, shared)
     if workers > 1 and N > 1:
         from ..executor import map_tasks

@@ -37,7 +37,7 @@ from ..analysis.record import RunRecord
 from ..analysis.settle import BUDGET
 from ..contract import Contract, load_generated
 from ..executor import map_tasks
-from ..integrate.native.engine import shared_parameters
+from ..integrate.native.engine import batch_shared
 from ..integrate.run import Batch, decide_backend, integrate
 from ..integrate.simulate import default_initial_state
 from ..integrate.spec import RunSpec
@@ -273,7 +273,9 @@ def regime_map(
         for g in col:
             rows.setdefault(g.module.__file__, {}).setdefault(id(col), []).append(g.p)
     backends = {
-        f: decide_backend(m, spec, shared=shared_parameters(np.array(next(iter(rows[f].values())))))
+        f: decide_backend(
+            m, spec, shared=batch_shared(m, np.array(next(iter(rows[f].values()))), spec)
+        )
         for f, m in models.items()
     }
     where = {"native": "compiled", "numpy": "NumPy fallback"}

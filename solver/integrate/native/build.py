@@ -42,6 +42,7 @@ __all__ = [
     "NativeUnavailable",
     "cache_dir",
     "compiler",
+    "level",
     "library",
     "prebuild",
     "single_point",
@@ -219,6 +220,20 @@ def _prebuild_one(item: tuple) -> None:
         pass
 
 
+def level(module, variational: bool | str = False, shared=()) -> tuple[str, ...]:
+    """The optimisation flag of ``library(module, variational, shared)`` beyond
+    ``compiler.flags``' -O2 (``compiler.py`` says what each choice measured): -O3 for a
+    large model's monodromy library, and for a smooth model's libraries of batches
+    (its one-point library only from 12 states on); none for a piecewise model."""
+    n_states = len(module.CONTRACT["states"])
+    if variational == "monodromy":
+        return _MONODROMY_FLAGS if n_states >= _MONODROMY_O3_FROM else ()
+    if Contract.of(module).piecewise:
+        return ()
+    one_point = len(set(shared)) == len(module.CONTRACT["parameters"])
+    return _SMOOTH_FLAGS if n_states >= _MONODROMY_O3_FROM or not one_point else ()
+
+
 def library(module, variational: bool | str = False, shared=()) -> tuple[ctypes.CDLL, dict]:
     """Compile (or load from the cache) the native library of ``module``
     (``variational``: with one tangent; ``"monodromy"``: with the matrix of tangents).
@@ -238,11 +253,7 @@ def library(module, variational: bool | str = False, shared=()) -> tuple[ctypes.
     # (the monodromy library runs its points one at a time: nothing to hoist)
     monodromy = variational == "monodromy"
     defines = _shared_flags(module, shared) if "GS_SHARED_" in text and not monodromy else []
-    n_states = len(module.CONTRACT["states"])
-    if monodromy and n_states >= _MONODROMY_O3_FROM:
-        defines = list(_MONODROMY_FLAGS)  # (after _FLAGS' -O2, it overrides it)
-    elif not monodromy and n_states >= _MONODROMY_O3_FROM and not Contract.of(module).piecewise:
-        defines = [*_SMOOTH_FLAGS, *defines]
+    defines = [*level(module, variational, shared), *defines]
     memo = (
         getattr(module, "__file__", module.NAME),
         getattr(module, "INPUTS_SHA256", ""),

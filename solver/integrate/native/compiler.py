@@ -33,16 +33,17 @@ _FLAGS = (
 # model's loops are too short to gain from it (the DI-SO's 4 states) and -O3 compiles
 # in 0.94 s against 0.53 s: only from 12 states on
 _MONODROMY_FLAGS = ("-O3",)
-# A large smooth model's libraries at -O3 too: its lockstep loops over a group's points
+# A smooth model's batch libraries at -O3 too: the lockstep loops over a group's points
 # (gs_rhs_batch, the stage sums) vectorise there and stay scalar at -O2, whose cost model
 # leaves them.  Measured on 2 cores, 40-point sweeps of 200 + 100 periods, medians of 3
 # alternating runs: the DI-SO on bearings (22 states) 16.3 -> 4.5 ms a point, the
-# two-stage train (30) 73 -> 20, for a compile of about 1.5 s against 0.7 s.  The
-# torsional DI-SO (4 states) gains less (1.17 -> 0.74 ms; 2.49 -> 1.31 with the
-# exponent's tangent) than the compile costs a first reproduce, whose runs are short
-# (two first runs side by side, one process each: 218 and 213 s against 203 and 197 s
-# with -O2): from 12 states on, as the monodromy's.  A piecewise model (the dead zone)
-# runs its points one at a time, where -O3 gains nothing: -O2.
+# two-stage train (30) 73 -> 20, for a compile of about 1.5 s against 0.7 s; the
+# torsional DI-SO (4 states) with the model's one library (``engine.batch_shared``)
+# 2.62 -> 1.05 ms, 4.03 -> 2.25 with the exponent's tangent.  (When every batch had a
+# library of its own, -O3 for the small models' libraries cost a first reproduce more
+# compiling than it saved: 218 and 213 s against 203 and 197 s.)  A small model's
+# one-point library (a sweep's runs) gains nothing (6.8 against 7.1 ms for 300 periods):
+# -O2, as is a piecewise model's (the dead zone runs its points one at a time).
 _SMOOTH_FLAGS = ("-O3",)
 _MONODROMY_O3_FROM = 12
 

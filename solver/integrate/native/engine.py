@@ -34,7 +34,7 @@ from ..spec import RunResult, RunSpec
 from . import abi
 from .build import library
 
-__all__ = ["STATUS", "run_compiled", "shared_parameters"]
+__all__ = ["HOIST_FROM", "STATUS", "batch_shared", "run_compiled", "shared_parameters"]
 
 STATUS = {
     0: "ok",
@@ -52,6 +52,33 @@ _RANGE = {"record": 0, "stop": 1, "ignore": 2}
 def shared_parameters(P: np.ndarray) -> tuple[int, ...]:
     """Indices of the columns of ``P`` (N, n_p) where every row equals the first."""
     return tuple(int(k) for k in np.flatnonzero(np.all(P == P[:1], axis=0)))
+
+
+# A batch's own library (the parameters it shares compiled in, ``build.library``) pays
+# for its compile only on a long batch.  Measured on 2 cores, the torsional DI-SO, 40
+# points of 200 + 100 periods at -O3, medians of 3: 0.79 ms a point with its own library
+# against 1.05 with the model's one library (1.80 against 2.25 with the exponent's
+# tangent), about 1 us a point and period, for a compile of about 1.1 s; the models of
+# 22 and 30 states gain nothing (4.8 against 4.7 ms, 18.9 against 21.5).  A first
+# reproduce compiled 16 such libraries, none of whose batches ran long enough to pay.
+HOIST_FROM = 1_000_000  # points x periods of a batch that gets its own library
+
+
+def batch_shared(module, P: np.ndarray, spec) -> tuple[int, ...]:
+    """The ``shared`` of the library a batch at the rows of ``P`` runs with
+    (``build.library``): every parameter for one point (the one-point library of a
+    sweep's runs); the parameters the rows share for a long batch of a smooth model
+    (:data:`HOIST_FROM`); else none, the model's one library for any batch (a
+    piecewise model runs its points one at a time: nothing to hoist)."""
+    P = np.atleast_2d(P)
+    if not spec.hoist:
+        return ()
+    if P.shape[0] == 1:
+        return shared_parameters(P)
+    work = P.shape[0] * (spec.transient + spec.periods)
+    if work < HOIST_FROM or Contract.of(module).piecewise:
+        return ()
+    return shared_parameters(P)
 
 
 def _tangent_start(n: int, seed: int) -> np.ndarray:
@@ -126,8 +153,7 @@ def run_compiled(module, P, X0, spec: RunSpec, tangent0=None, monodromy=False) -
                 f"tangent0 must be ({N}, {m}), with the exponent collected from the start"
             )
     kind = "monodromy" if monodromy else tangent
-    shared = shared_parameters(P) if spec.hoist else ()
-    lib, facts = library(module, variational=kind, shared=shared)
+    lib, facts = library(module, variational=kind, shared=batch_shared(module, P, spec))
     K, L = spec.n_samples, spec.lyapunov_periods
     check = spec.valid_range != "ignore"
     bounds = np.full(n, np.inf)
