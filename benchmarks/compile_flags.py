@@ -5,8 +5,9 @@ Markdown table; nothing is written).  Per model, a sweep of ``points`` points (t
 DI-SO over lambda in [0, 1], the others over the damping ratio 0.01 to 0.1) of
 200 + 100 periods in the compiled batched DOP853, the two levels alternating, the median
 of ``repeats`` each; and the compile of the model's plain library on an empty cache,
-the median of ``repeats``.  The choice it measures is ``native/compiler.py``'s: -O3 for a
-smooth model from 12 states on (its lockstep loops vectorise), -O2 otherwise.
+the median of ``repeats``.  The choice it measures is ``native/build.level``'s: -O3 for a
+smooth model's batch libraries (their lockstep loops vectorise), and for its one-point
+library from 12 states on; -O2 otherwise (``native/compiler.py`` says why).
 """
 
 from __future__ import annotations
