@@ -11,8 +11,10 @@ The sweep is the headline of ``performance.py``: ``reference_light``, 400 values
 transient + 100 sampled periods, rtol 1e-8, atol 1e-10, DOP853-class methods:
 
 * (a) the generated engine, ``run_batch(..., method="dop853")``, one core, as
-  ``solver/integrate/native/build.py`` builds it; (a-) the same with no parameter declared
-  shared (every point computes every term) and (a+) with ``-DGS_SHARED_k=1`` for the 30
+  ``solver/integrate/native/build.py`` builds it (since the library rule of
+  ``engine.batch_shared``: the model's one library at -O3, no parameter compiled in);
+  (a-) the same with no parameter declared shared (every point computes every term)
+  and (a+) with ``-DGS_SHARED_k=1`` for the 30
   parameters but the loads, so that ``gs_rhs_batch`` computes the stiffness and
   transmission-error terms once per evaluation for the batch (:class:`WrappedBuild`);
 * (b) the hand-written vectorised lockstep DOP853 of ``lockstep_reference.c``;

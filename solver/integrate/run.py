@@ -165,9 +165,9 @@ def integrate(
     if backend != "numpy":
         from .native.engine import batch_shared
 
-        # the library the (first) share of the batch runs with
-        shared = batch_shared(module, P[chunks[0]], spec)
-        backend = decide_backend(module, spec, backend, shared)
+        # the libraries the shares of the batch run with
+        for shared in dict.fromkeys(batch_shared(module, P[c], spec) for c in chunks):
+            backend = decide_backend(module, spec, backend, shared)
     if workers > 1 and N > 1:
         from ..executor import map_tasks
 

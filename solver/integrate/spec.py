@@ -103,9 +103,9 @@ class RunSpec:
     hoist : bool
         Compiled engine only: the parameters equal across the batch are compiled in (a
         library per set of them, hoisting what depends on them alone out of the point
-        loop); False: the library for any batch, one per model, for a small batch whose
-        parameters vary in a way no other batch's do (its own library would cost more
-        to compile than it saves).
+        loop) for one point and for a batch long enough to pay for the compile
+        (``native.engine.batch_shared``); False: the library for any batch, one per
+        model, always.
     """
 
     method: str = "dop853"

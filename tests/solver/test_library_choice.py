@@ -4,7 +4,10 @@
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
+import pytest
 from gearsym.resolve import module_for
 from gearsym.solver.integrate.native.build import level, single_point
 from gearsym.solver.integrate.native.engine import HOIST_FROM, batch_shared, shared_parameters
@@ -53,3 +56,37 @@ def test_optimisation_levels():
     assert level(dead, True, ()) == ()  # piecewise
     assert level(small, "monodromy") == ()
     assert level(large, "monodromy") == ("-O3",)
+
+
+@pytest.mark.parametrize(
+    ("rows", "identical"), [(1, True), (3, True), (40, False)], ids=["one", "copies", "batch"]
+)
+def test_the_library_checked_is_the_library_run(monkeypatch, rows, identical):
+    # decide_backend checks (and may compile) a library before the run; a run that then
+    # took another compiled one library for nothing and another in the middle of the run
+    from gearsym.solver.integrate import default_initial_state
+    from gearsym.solver.integrate.run import Batch, integrate
+    from gearsym.solver.system import System
+
+    build = sys.modules["gearsym.solver.integrate.native.build"]
+    engine = sys.modules["gearsym.solver.integrate.native.engine"]
+
+    module = module_for("reference-light")
+    P = np.repeat(_sweep(module, 1), rows, axis=0) if identical else _sweep(module, rows)
+    x0 = np.asarray(default_initial_state(System.load(module)), float)
+    asked = []
+
+    def recording(real):
+        def library(module, variational=False, shared=()):
+            asked.append((variational, tuple(shared)))
+            return real(module, variational, shared)
+
+        return library
+
+    monkeypatch.setattr(build, "library", recording(build.library))
+    monkeypatch.setattr(engine, "library", recording(engine.library))
+    spec = RunSpec(transient=2, periods=2, collect=("samples", "exponent"), lyapunov_periods=4)
+    integrate(Batch.of(module, P), np.repeat(x0[None, :], rows, axis=0), spec)
+    assert len(asked) >= 2 and len(set(asked)) == 1, asked
+    want = single_point(module) if identical else ()
+    assert asked[0] == (True, want)

@@ -50,7 +50,8 @@ __all__ = [
 ]
 
 _loaded: dict[str, ctypes.CDLL] = {}
-_paths: dict[tuple, Path] = {}  # (module file, inputs hash, variational, compiler) -> library
+# (module file, inputs hash, variational, flags and defines, compiler, cache) -> library
+_paths: dict[tuple, Path] = {}
 _failed: dict[str, str] = {}  # cache key -> why it could not be built (once per session)
 
 
@@ -248,7 +249,7 @@ def library(module, variational: bool | str = False, shared=()) -> tuple[ctypes.
     cc = compiler()
     if cc is None:
         raise NativeUnavailable(_no_compiler())
-    # only a model whose C reads GS_SHARED_<k> gets them (else one library serves all)
+    # only a model whose C reads GS_SHARED_<k> gets them (else one library per level)
     text = getattr(module, "C_SOURCE_VARIATIONAL" if variational is True else "C_SOURCE", "")
     # (the monodromy library runs its points one at a time: nothing to hoist)
     monodromy = variational == "monodromy"

@@ -18,9 +18,10 @@ differs between them is data in the job:
   seventh-order dense output instead of shortening steps to land on them (a point on its
   own steps always lands on them).
 
-``shared``: the parameters equal in every row of ``P`` are compiled in as such
-(``build.library(..., shared=...)``), so the generated C may hoist what depends only on
-them out of the point loop.
+``shared``: for one point, and for a batch long enough to pay for its own library
+(:func:`batch_shared`), the parameters equal in every row of ``P`` are compiled in as
+such (``build.library(..., shared=...)``), so the generated C may hoist what depends
+only on them out of the point loop; any other batch runs with the model's one library.
 """
 
 from __future__ import annotations
@@ -66,19 +67,21 @@ HOIST_FROM = 1_000_000  # points x periods of a batch that gets its own library
 
 def batch_shared(module, P: np.ndarray, spec) -> tuple[int, ...]:
     """The ``shared`` of the library a batch at the rows of ``P`` runs with
-    (``build.library``): every parameter for one point (the one-point library of a
-    sweep's runs); the parameters the rows share for a long batch of a smooth model
-    (:data:`HOIST_FROM`); else none, the model's one library for any batch (a
-    piecewise model runs its points one at a time: nothing to hoist)."""
+    (``build.library``): every parameter for one point or copies of one (the one-point
+    library of a sweep's runs, a monodromy's tangents as copies); the parameters the
+    rows share for a long batch of a smooth model (:data:`HOIST_FROM`); else none, the
+    model's one library for any batch (a piecewise model runs its points one at a time:
+    nothing to hoist)."""
     P = np.atleast_2d(P)
     if not spec.hoist:
         return ()
-    if P.shape[0] == 1:
-        return shared_parameters(P)
+    shared = shared_parameters(P)
+    if len(shared) == P.shape[1]:  # one point, or copies of one (its starts, tangents)
+        return shared
     work = P.shape[0] * (spec.transient + spec.periods)
     if work < HOIST_FROM or Contract.of(module).piecewise:
         return ()
-    return shared_parameters(P)
+    return shared
 
 
 def _tangent_start(n: int, seed: int) -> np.ndarray:
