@@ -31,7 +31,7 @@ from ._json import clean, dumps
 from ._matfile import _field, mat_bytes
 from .provenance import KEYS
 
-__all__ = ["FORMATS", "Document", "document", "save", "save_all"]
+__all__ = ["FORMATS", "Document", "document", "save", "save_all", "save_csv"]
 
 FORMATS = (".json", ".csv", ".mat")
 
@@ -88,6 +88,12 @@ def save_all(result, path, **extra) -> list[Path]:
     path = Path(path)
     write = getattr(result, "save", None) or (lambda p, **kw: save(result, p, **kw))
     return [write(path.with_suffix(suffix), **extra) for suffix in FORMATS]
+
+
+def save_csv(path, data: dict, columns, rows) -> Path:
+    """A table as a CSV file, opened by ``data``'s header block as :func:`save` writes it
+    (a second table of a result, such as a sweep's Poincare points)."""
+    return write_atomic(path, _csv(data, columns, rows))
 
 
 def write_atomic(path, content) -> Path:

@@ -234,3 +234,25 @@ def test_a_trajectory_file_carries_the_header_block(tmp_path):
     assert doc["model_hash"] == tr.system.model_hash and columns[0] == "tau"
     assert len(rows) == len(doc["t"]) == tr.t.size
     same(doc, loadmat(tmp_path / "run.mat", simplify_cells=True)["result"], "run")
+
+
+def test_a_sweeps_poincare_points_are_a_csv_table_of_the_jsons_values(tmp_path, capsys):
+    # the bifurcation diagram's data for pandas or MATLAB: one row per point and sampled
+    # period; the reference is the JSON's own points[i].poincare (files agree)
+    code = main([*COMMANDS["sweep"][1], "--out", str(tmp_path)])
+    capsys.readouterr()
+    assert code == 0
+    doc = json.loads((tmp_path / "sweep.json").read_text(encoding="utf-8"))
+    header, columns, rows = read_csv(tmp_path / "sweep_poincare.csv")
+    assert {k: header[k] for k in HEADER} == {k: doc[k] for k in HEADER}
+    states = list(doc["points"][0]["poincare"])
+    assert columns == [doc["parameter"], "point", "period", *states]
+    want = [
+        (i, k, point["values"][doc["parameter"]], [point["poincare"][s][k] for s in states])
+        for i, point in enumerate(doc["points"])
+        for k in range(len(point["poincare"][states[0]]))
+    ]
+    assert len(rows) == len(want) == 3 * 20
+    for row, (i, k, value, xs) in zip(rows, want, strict=True):
+        assert (int(row[1]), int(row[2])) == (i, k) and close(float(row[0]), value)
+        assert all(close(float(a), b) for a, b in zip(row[3:], xs, strict=True)), (i, k)

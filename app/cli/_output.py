@@ -83,6 +83,21 @@ def write_result(out, stem: str, result, args, **extra) -> list[Path]:
     return paths
 
 
+def write_poincare(out, result, args, **extra) -> list[Path]:
+    """A sweep's Poincare points as ``out/sweep_poincare.csv`` when ``--format`` has csv
+    (``SweepResult.poincare_table``: one row per point and sampled period, in the model's
+    units as the JSON holds them), with the header block of the sweep's files."""
+    from gearsym.solver.export import save_csv
+    from gearsym.solver.provenance import header
+
+    if "csv" not in result_formats(args):
+        return []
+    extra.setdefault("command", command_line(args))
+    extra = {k: v for k, v in extra.items() if v is not None}
+    data = header(result.model, result.model_hash, result.scales, result.base_values, **extra)
+    return [save_csv(Path(out) / "sweep_poincare.csv", data, *result.poincare_table())]
+
+
 def branches_document(system, branches):
     """The branches of ``continue`` as one result: the header block, the parameter, the
     state names and each branch's ``describe()`` under ``branches``; its table is the

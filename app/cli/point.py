@@ -19,7 +19,7 @@ from ._common import (
     require,
 )
 from ._notes import note_torques
-from ._output import format_option, units_option, write_result
+from ._output import format_option, units_option, write_poincare, write_result
 from ._start import resolve_start, start_options
 from ._system import system_of, unknown_names
 from ._verdict import verdict_lines
@@ -340,6 +340,7 @@ def _cmd_sweep(args) -> int:
     paths = write_result(
         out, "sweep", in_units(result, system, args.units) if physical else result, args
     )
+    paths += write_poincare(out, result, args)
     if figure:
         from gearsym.solver import plots
 

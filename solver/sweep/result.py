@@ -131,6 +131,20 @@ class SweepResult:
         ]
         return columns, rows
 
+    def poincare_table(self) -> tuple[list, list]:
+        """The Poincare points as one long table (the bifurcation diagram's data): one
+        row per point and sampled period, the parameter's value, the point's index in
+        ``values``, the period's index in its sampled window and every state, as
+        ``points[i].poincare`` holds them (a point that stopped early: the periods it ran)."""
+        states = list(self.points[0].poincare) if self.points else []
+        rows: list = []
+        for i, p in enumerate(self.points):
+            cols = [np.asarray(p.poincare[s], dtype=float) for s in states]
+            n = min((c.size for c in cols), default=0)
+            block = np.column_stack([c[:n] for c in cols]).tolist() if n else []
+            rows += [[float(p.value), i, k, *row] for k, row in enumerate(block)]
+        return [self.parameter, "point", "period", *states], rows
+
     def save(self, path: Path, **extra) -> Path:
         """Write the sweep (parameter values, scales and model hash included): ``.json``,
         ``.csv`` or ``.mat`` (see ``solver/export.py``); ``extra`` adds header keys."""
