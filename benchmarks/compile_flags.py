@@ -5,7 +5,7 @@ Markdown table; nothing is written).  Per model, a sweep of ``points`` points (t
 DI-SO over lambda in [0, 1], the others over the damping ratio 0.01 to 0.1) of
 200 + 100 periods in the compiled batched DOP853, the two levels alternating, the median
 of ``repeats`` each; and the compile of the model's plain library on an empty cache,
-the median of ``repeats``.  The choice it measures is ``native/build.level``'s: -O3 for a
+the median of ``repeats``.  The choice it measures is ``native/compiler.level``'s: -O3 for a
 smooth model's batch libraries (their lockstep loops vectorise), and for its one-point
 library from 12 states on; -O2 otherwise (``native/compiler.py`` says why).
 """
@@ -41,10 +41,10 @@ def measure(repeats: int, points: int) -> list[dict]:
     from gearsym.solver.system import System
 
     flags = sys.modules["gearsym.solver.integrate.native.compiler"]
-    base, smooth = flags._FLAGS[1:], build._SMOOTH_FLAGS
+    base, smooth = flags._FLAGS[1:], flags._SMOOTH_FLAGS
 
     def level_flags(level: str) -> None:  # every library at ``level``
-        flags._FLAGS, build._SMOOTH_FLAGS = (level, *base), (level,)
+        flags._FLAGS, flags._SMOOTH_FLAGS = (level, *base), (level,)
 
     rows = []
     try:
@@ -81,7 +81,7 @@ def measure(repeats: int, points: int) -> list[dict]:
                 }
             )
     finally:
-        flags._FLAGS, build._SMOOTH_FLAGS = ("-O2", *base), smooth
+        flags._FLAGS, flags._SMOOTH_FLAGS = ("-O2", *base), smooth
     return rows
 
 

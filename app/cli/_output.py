@@ -66,13 +66,19 @@ def command_line(args) -> str | None:
     return None if argv is None else shlex.join(["gearsym", *argv])
 
 
+def _header_keys(args, extra: dict) -> dict:
+    """The header keys a command adds to its result files: ``extra`` (those not None) and
+    the command line."""
+    extra = {"command": command_line(args), **extra}
+    return {k: v for k, v in extra.items() if v is not None}
+
+
 def write_result(out, stem: str, result, args, **extra) -> list[Path]:
     """Write ``result`` (a result type, or an ``export.Document``) as ``out/stem.<fmt>``
     for every format of ``--format``; ``extra`` adds header keys (``initial_state``)."""
     from gearsym.solver.export import save
 
-    extra.setdefault("command", command_line(args))
-    extra = {k: v for k, v in extra.items() if v is not None}
+    extra = _header_keys(args, extra)
     paths = []
     for fmt in result_formats(args):
         path = Path(out) / f"{stem}.{fmt}"
@@ -92,8 +98,7 @@ def write_poincare(out, result, args, **extra) -> list[Path]:
 
     if "csv" not in result_formats(args):
         return []
-    extra.setdefault("command", command_line(args))
-    extra = {k: v for k, v in extra.items() if v is not None}
+    extra = _header_keys(args, extra)
     data = header(result.model, result.model_hash, result.scales, result.base_values, **extra)
     return [save_csv(Path(out) / "sweep_poincare.csv", data, *result.poincare_table())]
 

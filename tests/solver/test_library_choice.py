@@ -1,5 +1,5 @@
 """Which compiled library a batch runs with, and at which optimisation level
-(``engine.batch_shared``, ``build.level``): the choices ``native/compiler.py`` and
+(``engine.batch_shared``, ``compiler.level``): the choices ``native/compiler.py`` and
 ``engine.HOIST_FROM`` state, each with the measurement behind it there."""
 
 from __future__ import annotations

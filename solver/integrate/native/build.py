@@ -25,18 +25,9 @@ from pathlib import Path
 import numpy as np
 
 from ...cache import cache_root, locked
-from ...contract import Contract
 from ..tableau import RK4, c_tables
 from . import abi
-from .compiler import (
-    _MONODROMY_FLAGS,
-    _MONODROMY_O3_FROM,
-    _SMOOTH_FLAGS,
-    _compiler_id,
-    _no_compiler,
-    compiler,
-    flags,
-)
+from .compiler import _compiler_id, _no_compiler, compiler, flags, level
 
 __all__ = [
     "NativeUnavailable",
@@ -219,20 +210,6 @@ def _prebuild_one(item: tuple) -> None:
         library(load_generated(source), variational=variational, shared=shared)
     except NativeUnavailable:
         pass
-
-
-def level(module, variational: bool | str = False, shared=()) -> tuple[str, ...]:
-    """The optimisation flag of ``library(module, variational, shared)`` beyond
-    ``compiler.flags``' -O2 (``compiler.py`` says what each choice measured): -O3 for a
-    large model's monodromy library, and for a smooth model's libraries of batches
-    (its one-point library only from 12 states on); none for a piecewise model."""
-    n_states = len(module.CONTRACT["states"])
-    if variational == "monodromy":
-        return _MONODROMY_FLAGS if n_states >= _MONODROMY_O3_FROM else ()
-    if Contract.of(module).piecewise:
-        return ()
-    one_point = len(set(shared)) == len(module.CONTRACT["parameters"])
-    return _SMOOTH_FLAGS if n_states >= _MONODROMY_O3_FROM or not one_point else ()
 
 
 def library(module, variational: bool | str = False, shared=()) -> tuple[ctypes.CDLL, dict]:

@@ -14,7 +14,9 @@ import shutil
 import subprocess
 from pathlib import Path
 
-__all__ = ["compiler", "flags"]
+from ...contract import Contract
+
+__all__ = ["compiler", "flags", "level"]
 
 # Every library: -O2 and this CPU's instructions; a smooth model's and a large
 # monodromy's at -O3 (below), which override the -O2
@@ -105,3 +107,17 @@ def flags(cc: str) -> tuple[str, ...]:
     """The flags ``cc`` builds every library with (a library's own, such as -O3 for a
     smooth model, come after and override)."""
     return _FLAGS
+
+
+def level(module, variational: bool | str = False, shared=()) -> tuple[str, ...]:
+    """The optimisation flag of ``library(module, variational, shared)`` beyond
+    ``flags``' -O2 (the comments above say what each choice measured): -O3 for a
+    large model's monodromy library, and for a smooth model's libraries of batches
+    (its one-point library only from 12 states on); none for a piecewise model."""
+    n_states = len(module.CONTRACT["states"])
+    if variational == "monodromy":
+        return _MONODROMY_FLAGS if n_states >= _MONODROMY_O3_FROM else ()
+    if Contract.of(module).piecewise:
+        return ()
+    one_point = len(set(shared)) == len(module.CONTRACT["parameters"])
+    return _SMOOTH_FLAGS if n_states >= _MONODROMY_O3_FROM or not one_point else ()
