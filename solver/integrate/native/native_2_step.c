@@ -114,15 +114,22 @@ static void gs_rhs_group(const gs_ctx *c, double t, int n, const double *Y, doub
 
 /* out = w_0 K_0 + ... + w_{m-1} K_{m-1} on S elements (K_r at K + r S), each sum fused in
  * order of r.  The loops run along the contiguous elements, so they vectorise (a sum
- * along r for each element would gather K with stride S). */
+ * along r for each element would gather K with stride S).  Zero weights are skipped: a
+ * third of DOP853's (24 of 66 in A, 4 of 12 in b, 5 of 13 in each error row), each a
+ * pass over S elements read from cache for nothing; for finite stages the sum is the
+ * same to the bit (fma(0, k, s) = s, and fma(w, k, 0) rounds w k as w * k does). */
 static inline __attribute__((always_inline)) void
 gs_weighted_any(double *restrict out, const double *restrict K, const double *restrict w,
                 int m, long S)
 {
-    const double w0 = w[0];
-    for (long e = 0; e < S; ++e) out[e] = w0 * K[e];
-    for (int r = 1; r < m; ++r) {
+    int r0 = 0;
+    while (r0 < m - 1 && w[r0] == 0.0) ++r0;
+    const double w0 = w[r0];
+    const double *restrict K0 = K + r0 * S;
+    for (long e = 0; e < S; ++e) out[e] = w0 * K0[e];
+    for (int r = r0 + 1; r < m; ++r) {
         const double wr = w[r];
+        if (wr == 0.0) continue;
         const double *restrict Kr = K + r * S;
         for (long e = 0; e < S; ++e) out[e] = fma(wr, Kr[e], out[e]);
     }
