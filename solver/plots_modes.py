@@ -42,13 +42,14 @@ def campbell_figure(
         ax.plot(n, [mode.frequency_hz] * 2, color=colour, ls=style, lw=1.2, label=label)
     for h in range(1, harmonics + 1):
         ax.plot(n, h * z * n / 60.0, color="black", lw=0.8 + 0.4 * (h == 1))
-        ax.annotate(
+        ax.annotate(  # inside the axes, above the line's end: the legend sits outside
             f"{h}× mesh",
             (n[1], h * z * n[1] / 60.0),
             fontsize=8,
-            xytext=(3, 0),
+            xytext=(-4, 2),
             textcoords="offset points",
-            va="center",
+            ha="right",
+            va="bottom",
         )
     for r in result.resonances(speeds_rpm, harmonics):
         f = r["harmonic"] * z * r["speed_rpm"] / 60.0
