@@ -4,6 +4,7 @@ instabilities of their meshes' stiffness variation (issue 26).
     import gearsym
 
     modal = gearsym.planetary.modes("lin-parker-1999-4")       # typed, with multiplicities
+    rig = gearsym.planetary.modes("back-to-back-rig")          # a train's, without dynamics too
     table = gearsym.planetary.parametric_instabilities("lin-parker-1999-3-phased")
     table["bands"][0]                                          # harmonic, type, band in Hz
     sweep = gearsym.planetary.carrier_sweep("lin-parker-1999-3", 0, 6000)  # vs carrier speed
@@ -32,6 +33,7 @@ __all__ = [
     "modes",
     "parametric_instabilities",
     "shaft_torques",
+    "train_modes",
 ]
 
 
@@ -50,11 +52,31 @@ def load(target):
 
 def modes(target):
     """The modes of a planetary set, typed rotational, translational or planet with their
-    multiplicities (``solver.analysis.modes.planetary_modes``)."""
+    multiplicities (``solver.analysis.modes.planetary_modes``); of a gear train's file (a
+    ``[train]`` table), :func:`train_modes`."""
+    from gearsym.derive.input.scene import resolve_target
+    from gearsym.derive.input.train import is_train, load_train
     from gearsym.solver.analysis.modes import planetary_modes as typed
 
+    if not hasattr(target, "as_structure"):
+        path = resolve_target(target)
+        if is_train(path):
+            return train_modes(load_train(path))
     st = target if hasattr(target, "as_structure") else load(target)
     return typed(st.as_structure(), st.planetary.name)
+
+
+def train_modes(train):
+    """The modes of a gear train's linear model (``derive.input.train.Train``: mean mesh
+    stiffness, no backlash, no damping) in its bodies' rotations, with each mode's share of
+    the strain energy in every mesh and shaft; compared to the first mesh's frequency where
+    ``[train.dynamics]`` states one.  No nonlinear model is derived, so a file without that
+    table has its modes too."""
+    from gearsym.derive.equations.train import derive_train
+    from gearsym.solver.analysis.modes import structure_modes
+
+    f = train.dynamics.mesh_frequency_hz if train.dynamics is not None else float("nan")
+    return structure_modes(derive_train(train).as_structure(), train.name, f)
 
 
 def parametric_instabilities(target, *, floquet: bool = False) -> dict:

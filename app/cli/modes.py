@@ -54,7 +54,7 @@ def register(sub) -> None:
     p.set_defaults(func=_cmd_modes)
 
 
-def _speeds(text: str | None, scene_rpm: float) -> tuple[float, float]:
+def _speeds(text: str | None, scene_rpm: float | None) -> tuple[float, float]:
     if text is None:
         return 0.0, 2.0 * scene_rpm
     try:
@@ -84,20 +84,48 @@ def _cmd_modes(args) -> int:
     if args.plot:
         figure_file(args.plot, "--plot")
     if is_train(path):  # a train with closed loops: its model in body coordinates
+        from gearsym.derive.input.train import load_train
+
+        train = load_train(path)
+        if train.dynamics is None:  # no operating point: the linear model's modes alone
+            from gearsym.planetary import train_modes
+
+            header = {"model": train.name, "source": str(path)}
+            return _report(train_modes(train), None, lambda: header, args, strain=True)
         from gearsym.resolve import planetary_system
 
         module = planetary_system(path).module
     else:
         module = module_for(args.target)
     result = modes(module)
-    scene_rpm = 60.0 * result.mesh_frequency_hz / result.reference_teeth
-    speeds = _speeds(args.speeds, scene_rpm)
-    if args.out:
-        from gearsym.solver.export import Document
+
+    def header():
         from gearsym.solver.provenance import provenance
         from gearsym.solver.system import System
 
-        data = provenance(System.load(module)) | result.to_dict(speeds)
+        return provenance(System.load(module))
+
+    scene_rpm = 60.0 * result.mesh_frequency_hz / result.reference_teeth
+    return _report(result, scene_rpm, header, args, strain=is_train(path))
+
+
+def _report(result, scene_rpm, header, args, *, strain: bool) -> int:
+    """Print, write and draw ``result`` (``Modes``); ``scene_rpm`` the reference driver's
+    speed at the scene's mesh frequency, None where the file states none (then the
+    resonance speeds need ``--speeds``); ``header()`` the result files' header block;
+    ``strain``: list where each mode strains (a train's bodies only turn) rather than where
+    its kinetic energy sits."""
+    if scene_rpm is None and args.plot and not args.speeds:
+        raise Fail(
+            f"--plot: {result.model} states no mesh frequency ([train.dynamics] "
+            "mesh_frequency_hz), so the resonance diagram needs its speed range: add --speeds "
+            "LO:HI (rpm of the first mesh's driver)"
+        )
+    speeds = None if scene_rpm is None and not args.speeds else _speeds(args.speeds, scene_rpm)
+    if args.out:
+        from gearsym.solver.export import Document
+
+        data = header() | result.to_dict(speeds)
         write_result(out_folder(args.out), "modes", Document(data, *result.to_table()), args)
     if args.plot:
         from gearsym.solver.plots_modes import campbell_figure
@@ -113,24 +141,27 @@ def _cmd_modes(args) -> int:
         )
         print(dumps(with_status(result.to_json(speeds), why), indent=1))
         return 0
-    print(
-        f"{result.model}: {len(result.modes)} modes of the linear, time-averaged model; "
-        f"mesh frequency {result.mesh_frequency_hz:.1f} Hz at the scene's speed "
-        f"({scene_rpm:.0f} rpm of gear {result.reference_driver}, the first mesh's driver)"
-    )
-    # a train's bodies only turn: where each mode strains (its meshes, its shafts) says more
-    strain = is_train(path)
+    if scene_rpm is None:
+        print(
+            f"{result.model}: {len(result.modes)} modes of the linear, time-averaged model; "
+            "its file states no mesh frequency ([train.dynamics]), so no ratio to it"
+        )
+    else:
+        print(
+            f"{result.model}: {len(result.modes)} modes of the linear, time-averaged model; "
+            f"mesh frequency {result.mesh_frequency_hz:.1f} Hz at the scene's speed "
+            f"({scene_rpm:.0f} rpm of gear {result.reference_driver}, the first mesh's driver)"
+        )
     what = "strain energy" if strain else "kinetic energy"
     print(f"  {'#':>2}  {'Hz':>10}  {'/ mesh':>7}  {'label':<13}  {what}")
     for m in result.modes:
         energy = m.strain_shares if strain else m.kinetic_shares
         top = sorted(energy.items(), key=lambda kv: -kv[1]) if strain else energy.items()
         shares = ", ".join(f"{k} {v:.2f}" for k, v in top if v >= 0.005)
-        print(
-            f"  {m.index:2d}  {m.frequency_hz:10.1f}  {result.over_mesh(m):7.3f}  "
-            f"{m.label:<13}  {shares}"
-        )
-    res = [r for r in result.resonances(speeds) if r["harmonic"] == 1]
+        ratio = result.over_mesh(m)
+        ratio = "—" if ratio is None else f"{ratio:.3f}"
+        print(f"  {m.index:2d}  {m.frequency_hz:10.1f}  {ratio:>7}  {m.label:<13}  {shares}")
+    res = [r for r in result.resonances(speeds) if r["harmonic"] == 1] if speeds else []
     if res:
         print(
             f"  the mesh frequency meets a mode between {speeds[0]:g} and {speeds[1]:g} rpm "

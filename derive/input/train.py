@@ -29,7 +29,7 @@ train) is not a tree and keeps each body's rotation as a coordinate.  Its file h
     [[train.torque]]                      # optional: must leave the train's rotation unforced
     body = "wheel_test"
     torque_Nm = 0
-    [train.dynamics]                      # the nonlinear model
+    [train.dynamics]                      # the nonlinear model (modes need none)
     mesh_frequency_hz = 400               # of the first mesh: the operating point
     damping_ratio = 0.03
 

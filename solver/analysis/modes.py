@@ -33,6 +33,7 @@ __all__ = [
     "eigenproblem",
     "modes",
     "planetary_modes",
+    "structure_modes",
 ]
 
 DOMINANT = 0.8  # kinetic-energy share of one group that names a mode
@@ -107,9 +108,9 @@ class Modes:
 
     def resonances(self, speeds_rpm: tuple[float, float], harmonics: int = 3) -> list[dict]:
         """Speeds of the reference driver where a mesh-frequency harmonic meets a mode:
-        ``h z n / 60 = f`` (none without a stated mesh frequency)."""
+        ``h z n / 60 = f`` (none without the reference driver's teeth: a planetary set's)."""
         out = []
-        for mode in self.modes if self.has_mesh_frequency else ():
+        for mode in self.modes if self.reference_teeth > 0 else ():
             if mode.label == "rigid-body":
                 continue
             for h in range(1, harmonics + 1):
@@ -119,9 +120,12 @@ class Modes:
         return sorted(out, key=lambda r: r["speed_rpm"])
 
     def to_json(self, speeds_rpm: tuple[float, float] | None) -> dict:
-        """The modes as JSON-ready values; without a mesh frequency (a planetary set) its
-        ratio, speed range and resonances are None and empty."""
+        """The modes as JSON-ready values; without a mesh frequency (a planetary set, a
+        train without its operating point) the ratio is None, and without speeds or the
+        driver's teeth (a planetary set) the speed range and resonances are None and
+        empty."""
         mesh = self.has_mesh_frequency
+        speeds = bool(speeds_rpm) and self.reference_teeth > 0
         return {
             "model": self.model,
             "mesh_frequency_hz": self.mesh_frequency_hz if mesh else None,
@@ -140,8 +144,8 @@ class Modes:
                 }
                 for m in self.modes
             ],
-            "speed_range_rpm": list(speeds_rpm) if mesh and speeds_rpm else None,
-            "resonances": self.resonances(speeds_rpm) if mesh and speeds_rpm else [],
+            "speed_range_rpm": list(speeds_rpm) if speeds else None,
+            "resonances": self.resonances(speeds_rpm) if speeds else [],
         }
 
     def to_dict(self, speeds_rpm: tuple[float, float] | None = None) -> dict:
@@ -181,11 +185,22 @@ def modes(model, omega: float | None = None) -> Modes:
     forcing = module.CONTRACT["forcing_frequency"]
     if omega is None and hasattr(model, "parameter"):
         omega = model.parameter(forcing)
+    if omega is None:
+        omega = module.DEFAULTS[module.PARAMETERS.index(forcing)]
     s = module.STRUCTURE
+    return structure_modes(s, module.NAME, omega * s["omega_n"] / (2 * math.pi))
+
+
+def structure_modes(s: dict, name: str, mesh_frequency_hz: float = float("nan")) -> Modes:
+    """The modes of a ``STRUCTURE`` mapping (``M``'s diagonal, ``R``, ``k``, the
+    coordinates' names and the reference mesh's driver and teeth): what :func:`modes`
+    computes of a generated module, without one, for a model whose file states no operating
+    point (a gear train without ``[train.dynamics]``: ``mesh_frequency_hz`` NaN, no ratio
+    to it; the resonance speeds still follow from the teeth)."""
     w2, vec, mass, R, k = eigenproblem(s)
     # The rigid-body mode is zero up to round-off of the largest eigenvalue.
     rigid = np.abs(w2) <= 1e-10 * np.max(np.abs(w2))
-    groups = [_GROUPS[name.split("_")[0]] for name in s["physical"]]
+    groups = [_GROUPS[n.split("_")[0]] for n in s["physical"]]
     out = []
     for i in range(len(w2)):
         v = vec[:, i]
@@ -219,13 +234,10 @@ def modes(model, omega: float | None = None) -> Modes:
                 shape={n: float(a / scale) for n, a in zip(s["physical"], v, strict=True)},
             )
         )
-    if omega is None:
-        omega = module.DEFAULTS[module.PARAMETERS.index(forcing)]
-    f_mesh = omega * s["omega_n"] / (2 * math.pi)
     return Modes(
-        module.NAME,
+        name,
         tuple(out),
-        f_mesh,
+        float(mesh_frequency_hz),
         int(s["reference_teeth"]),
         str(s.get("reference_driver", "")),
     )

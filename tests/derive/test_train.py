@@ -168,13 +168,75 @@ def test_linearised_it_has_the_hand_assemblys_frequencies(tmp_path):
     M, K = by_hand()
     w2 = np.sort(np.linalg.eigvals(np.linalg.solve(M, K)).real)
     assert abs(w2[0]) < 1e-9 * w2[-1]  # one rigid-body rotation
-    hand = np.sqrt(w2[1:]) / (2 * np.pi)
+    hand = hand_frequencies()
     x = system.module.static_state(system.p)
     lam = np.linalg.eigvals(system.module.jacobian(0.0, x, system.p))
     ours = np.sort(np.abs(lam.imag))[::2] * system.module.OMEGA_N / (2 * np.pi)
     assert np.max(np.abs(ours - hand) / hand) < 1e-9
     listed = [m.frequency_hz for m in modes(system).modes if m.label != "rigid-body"]
     assert np.max(np.abs(np.array(listed) - hand) / hand) < 1e-9
+
+
+def hand_frequencies() -> np.ndarray:
+    """The rig's elastic natural frequencies (Hz) from :func:`by_hand`."""
+    M, K = by_hand()
+    w2 = np.sort(np.linalg.eigvals(np.linalg.solve(M, K)).real)
+    return np.sqrt(w2[1:]) / (2 * np.pi)
+
+
+def test_a_train_without_its_dynamics_table_has_its_modes(tmp_path):
+    """``gearsym modes`` of the rig's file without ``[train.dynamics]`` (no operating
+    point, so no nonlinear model): the natural frequencies of M and K assembled by hand,
+    no ratio to a mesh frequency, and over ``--speeds`` the speeds where a harmonic h of
+    the mesh frequency z n / 60 (z = 16, the test pinion's) meets a mode, written out here
+    from those frequencies; ``--plot`` without ``--speeds`` is refused in one line."""
+    import gearsym
+
+    path = variant(tmp_path, "rig-modes", re.sub(r"\[train\.dynamics\][^\[]*$", "", TEXT))
+    run = subprocess.run(
+        [sys.executable, "-m", "gearsym", "modes", str(path), "--json", "--speeds", "0:30000"],
+        capture_output=True,
+        text=True,
+    )
+    assert run.returncode == 0, run.stderr
+    data = json.loads(run.stdout)
+    assert data["mesh_frequency_hz"] is None
+    freq = {m["index"]: m["frequency_hz"] for m in data["modes"] if m["label"] != "rigid-body"}
+    assert all(m["over_mesh_frequency"] is None for m in data["modes"])
+    hand = hand_frequencies()
+    assert np.max(np.abs(np.array(list(freq.values())) - hand) / hand) < 1e-9
+    expected = {
+        (i, h, round(60 * f / (16 * h), 6))
+        for i, f in zip(freq, hand, strict=True)
+        for h in (1, 2, 3)
+        if 60 * f / (16 * h) <= 30000
+    }
+    got = {(r["mode"], r["harmonic"], round(r["speed_rpm"], 6)) for r in data["resonances"]}
+    assert got == expected and len(got) > 3
+    api = gearsym.planetary.modes(path)
+    assert [m.frequency_hz for m in api.modes] == [m["frequency_hz"] for m in data["modes"]]
+    run = subprocess.run(
+        [sys.executable, "-m", "gearsym", "modes", str(path), "--plot", str(tmp_path / "c.png")],
+        capture_output=True,
+        text=True,
+    )
+    assert run.returncode == 2 and "--speeds LO:HI" in run.stderr
+    assert len(run.stderr.strip().splitlines()) == 1
+
+
+def test_a_trains_modes_are_the_same_with_and_without_its_nonlinear_model():
+    """The rig's modes from its file alone (``gearsym.planetary.modes``: the linear model
+    derived, no code generated) and from the generated nonlinear model's ``STRUCTURE``
+    (``gearsym.modes``): the same frequencies and the same mesh frequency (400 Hz)."""
+    import gearsym
+
+    alone = gearsym.planetary.modes("back-to-back-rig")
+    generated = gearsym.modes(planetary_system(RIG))
+    assert alone.mesh_frequency_hz == pytest.approx(generated.mesh_frequency_hz, rel=1e-12)
+    a = np.array([m.frequency_hz for m in alone.modes])
+    g = np.array([m.frequency_hz for m in generated.modes])
+    assert np.max(np.abs(a - g)) < 1e-9 * a.max()
+    assert [m.label for m in alone.modes] == [m.label for m in generated.modes]
 
 
 @pytest.mark.parametrize(
