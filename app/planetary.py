@@ -12,9 +12,10 @@ instabilities of their meshes' stiffness variation (issue 26).
     tr = gearsym.simulate(system, gearsym.planetary.loaded_state(system))
     gearsym.planetary.contact(tr)                              # each mesh's time apart
     resp = gearsym.planetary.mesh_response("lin-parker-1999-3-backlash", 500, 4000)
+    te = gearsym.planetary.te_excitation("lin-parker-1999-3-phased")  # each TE harmonic's modes
 
-The same as ``gearsym modes SET``, ``gearsym modes SET --parametric`` and ``gearsym modes SET
---speeds LO:HI``.
+The same as ``gearsym modes SET``, ``gearsym modes SET --parametric``, ``gearsym modes SET
+--speeds LO:HI`` and ``gearsym modes SET --te``.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from __future__ import annotations
 import math
 
 from .planetary_dynamics import contact, dynamics, loaded_state, mesh_response, shaft_torques
+from .planetary_te import te_excitation, te_response
 
 __all__ = [
     "carrier_sweep",
@@ -33,6 +35,8 @@ __all__ = [
     "modes",
     "parametric_instabilities",
     "shaft_torques",
+    "te_excitation",
+    "te_response",
     "train_modes",
 ]
 

@@ -66,3 +66,24 @@ def print_parametric(table: dict) -> None:
         pair = " + ".join(f"{f:.1f}" for f in c["natural_hz"])
         band = _band(c["lower_hz"], c["upper_hz"])
         print(f"  {c['harmonic']:2d}  {types:<27}  {pair:>19}  {band}")
+
+
+def print_te(table: dict) -> None:
+    """The mapping of :func:`gearsym.planetary.te_excitation`, for the terminal: per
+    harmonic, the natural frequencies (Hz) it excites and those the phasing suppresses,
+    by type."""
+    print(
+        f"transmission error ({table['errors']}): what each harmonic l excites; it meets a "
+        "mode at the mesh frequency natural / l"
+    )
+    n = table["planets"]
+    for h in table["harmonics"]:
+        print(f"  l = {h['harmonic']} (l x sun_teeth mod {n} = {h['residue']}):")
+        for word, keep in (("excites", True), ("suppressed", False)):
+            kinds: dict = {}
+            for g in h["groups"]:
+                if g["excited"] == keep:
+                    kinds.setdefault(g["type"], []).append(f"{g['natural_hz']:.0f}")
+            if kinds:
+                text = "; ".join(f"{t} {', '.join(f)} Hz" for t, f in kinds.items())
+                print(f"    {word}: {text}")

@@ -45,6 +45,14 @@ def register(sub) -> None:
         "frequency or marked suppressed by the phasing (default: off)",
     )
     p.add_argument(
+        "--te",
+        action="store_true",
+        help="a planetary set: which modes each harmonic of the meshes' transmission error "
+        "excites and which the planets' phasing suppresses (the file's errors, else 1 µm "
+        "in harmonics 1 to N on the sun and on the ring meshes apart; needs the tooth "
+        "counts)",
+    )
+    p.add_argument(
         "--floquet",
         action="store_true",
         help="with --parametric: each band's edges also by the Floquet multipliers (a second "
@@ -76,6 +84,11 @@ def _cmd_modes(args) -> int:
     path = resolve_target(args.target)
     if is_planetary(path):
         return _planetary(path, args)
+    if args.te:
+        raise Fail(
+            "--te: the transmission-error table is for planetary sets (a [planetary] file); "
+            "run without it"
+        )
     if args.parametric or args.floquet:
         raise Fail(
             "--parametric: the parametric-instability table is for planetary sets (a "
@@ -206,6 +219,17 @@ def _planetary(path, args) -> int:
         )
     if args.floquet and not args.parametric:
         raise Fail("--floquet: only with --parametric; add --parametric")
+    if args.te and ps.sun_teeth is None:
+        raise Fail(
+            f"--te: {path} has no sun_teeth and ring_teeth in [planetary], which the meshes' "
+            "phases need; add them"
+        )
+    if args.te and ps.carrier_speed_rpm:
+        raise Fail(
+            f"--te: {path} turns the carrier (carrier_speed_rpm = {ps.carrier_speed_rpm:g}); "
+            "the transmission-error analysis is of the fixed-carrier model: remove "
+            "carrier_speed_rpm for it"
+        )
     if args.parametric and ps.carrier_speed_rpm:
         raise Fail(
             f"--parametric: {path} turns the carrier (carrier_speed_rpm = "
@@ -248,6 +272,10 @@ def _planetary(path, args) -> int:
         if args.floquet:
             print("confirming each band by the Floquet multipliers", file=sys.stderr)
         data["parametric"] = parametric_instabilities(st, floquet=args.floquet)
+    if args.te:
+        from gearsym.planetary import te_excitation
+
+        data["transmission_error"] = te_excitation(st)
     if args.plot:
         from gearsym.solver.plots_modes import parametric_figure
         from gearsym.solver.plots_style import save_figure
@@ -295,6 +323,10 @@ def _planetary(path, args) -> int:
         from ._parametric import print_parametric
 
         print_parametric(data["parametric"])
+    if args.te:
+        from ._parametric import print_te
+
+        print_te(data["transmission_error"])
     if args.plot:
         print(f"  parametric-instability diagram: {args.plot}")
     return 0

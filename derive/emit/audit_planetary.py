@@ -92,9 +92,12 @@ def planetary_page(st: PlanetaryStructure, command: str, source: str) -> str:
         "--parametric`, with a `[planetary.variation]` table and the tooth counts; "
         "`docs/analysis.md`).\n",
         _nonlinear(st),
+        "The meshes' transmission errors, delayed by the same phases, enter the linear "
+        "analysis too: which modes each harmonic excites and which the phasing suppresses "
+        "(`gearsym modes --te`), and the meshes' dynamic forces over the mesh frequency "
+        "(`gearsym.planetary.te_response`).\n",
         "**Not modelled yet** (issue 26): the rotating frame's terms in the parametric "
-        "analysis and in the nonlinear model; a transmission error in the linear "
-        "analysis (the nonlinear model takes one from `[planetary.dynamics]`).\n",
+        "analysis and in the nonlinear model.\n",
         "## Kinematic graph\n",
         f"Bodies ({bodies}): carrier `c`, ring `r`, sun `s` and {n} planets, {spacing}, at "
         f"ψ = {angles} round the carrier. Each planet meshes with the sun (external) and "

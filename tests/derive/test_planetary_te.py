@@ -1,0 +1,157 @@
+"""A planetary set's transmission errors in its linear model (``gearsym modes SET --te``,
+``solver/analysis/forced.py``), against references of their own:
+
+* which modes each harmonic ``l`` of the mesh error excites, for 3, 4 and 5 equally spaced
+  planets: Parker's (2000) rule, with ``k = l Z_s mod N``, only rotational modes for
+  ``k = 0``, only translational ones for ``k = 1`` or ``N - 1``, only planet modes
+  otherwise (written out here from the tooth counts);
+* the meshes' dynamic forces from the frequency domain against the same linear equations
+  integrated in time (SciPy's DOP853 to the steady state, matrices assembled here from the
+  set's ``STRUCTURE``): two methods, one answer.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from gearsym.derive.input.scene import resolve_target
+
+FOUR = resolve_target("lin-parker-1999-4").read_text(encoding="utf-8")
+
+
+def variant(tmp_path, planets: int, sun: int, ring: int, extra: str = ""):
+    text = FOUR.replace('"lin-parker-1999-4"', f'"te-{planets}"').replace(
+        "planets = 4\n", f"planets = {planets}\nsun_teeth = {sun}\nring_teeth = {ring}\n"
+    )
+    path = tmp_path / f"te-{planets}.toml"
+    path.write_text(text + extra, encoding="utf-8")
+    return path
+
+
+def parker(kind: str, k: int, n: int) -> bool:
+    """Parker (2000): whether harmonic l with l Z_s mod N = k excites modes of ``kind``."""
+    if kind == "rotational":
+        return k == 0
+    if kind == "translational":
+        return k in (1, n - 1)
+    return k not in (0, 1, n - 1)  # planet modes
+
+
+@pytest.mark.parametrize("planets, sun, ring", [(3, 31, 89), (4, 25, 75), (5, 26, 74)])
+def test_each_harmonic_excites_the_modes_parkers_rule_gives(tmp_path, planets, sun, ring):
+    import gearsym
+
+    table = gearsym.planetary.te_excitation(variant(tmp_path, planets, sun, ring))
+    assert len(table["harmonics"]) == planets
+    kinds = set()
+    for h in table["harmonics"]:
+        k = h["harmonic"] * sun % planets
+        assert h["residue"] == k
+        for g in h["groups"]:
+            kinds.add(g["type"])
+            assert g["excited"] == parker(g["type"], k, planets), (h["harmonic"], g)
+    assert kinds == ({"rotational", "translational"} | ({"planet"} if planets > 3 else set()))
+
+
+def test_the_dynamic_forces_agree_with_the_equations_integrated_in_time(tmp_path):
+    """One mesh frequency near a translational mode of the 4-planet set (25 / 75 teeth,
+    2 µm at harmonic 1 and 0.5 µm at 45 deg at harmonic 2 on the sun meshes): the largest
+    dynamic force of each mesh over a period, from ``te_response``, against ``M q'' + C q'
+    + K q = -sum_j r_j^T (k_j e_j + c_j e_j')`` integrated in time over a period from the
+    periodic state that shooting finds (the linear equations' monodromy by expm)."""
+    import gearsym
+    from scipy.integrate import solve_ivp
+    from scipy.linalg import expm
+
+    extra = (
+        "\n[planetary.dynamics]\nsun_force_N = 2000\nsun_planet_half_backlash_um = 50\n"
+        "ring_planet_half_backlash_um = 50\nmesh_frequency_hz = 1000\ndamping_ratio = 0.05\n"
+        "sun_planet_transmission_error = { amplitude_um = [2.0, 0.5], phase_deg = [0.0, 45.0] }\n"
+    )
+    # the carrier held too (its support 1e8 N/m): no rigid-body rotation, so the shooting
+    # below has one periodic solution
+    path = variant(tmp_path, 4, 25, 75, extra)
+    path.write_text(path.read_text().replace("torsional_N_per_m = 0", "torsional_N_per_m = 1e8", 1))
+    st = gearsym.planetary.load(path)
+    s = st.as_structure()
+    f_mesh = 700.0
+    got = gearsym.planetary.te_response(path, f_mesh, 2 * f_mesh, 2)
+    mass, R, k = (np.asarray(s[key], float) for key in ("mass", "incidence", "stiffness"))
+    c = 2 * 0.05 * np.sqrt(k / np.einsum("ji,i,ji->j", R, 1 / mass, R))
+    M, K, C = np.diag(mass), R.T @ (k[:, None] * R), R.T @ (c[:, None] * R)
+    W = 2 * math.pi * f_mesh
+    sun_rows = [j for j, n in enumerate(st.springs) if n.startswith("s") and st.kinds[j] == "mesh"]
+    gamma = [st.phases[int(st.springs[j][2:]) - 1][0] for j in sun_rows]
+    amps = ((2e-6, 0.0), (0.5e-6, math.radians(45.0)))
+
+    rows, delay = np.array(sun_rows), np.array(gamma) / f_mesh
+
+    def error(t):  # e_j and e_j' of every sun mesh
+        e, de = np.zeros(len(R)), np.zeros(len(R))
+        for l, (a, phi) in enumerate(amps, start=1):  # noqa: E741
+            arg = l * W * (t - delay) + phi
+            e[rows] += a * np.cos(arg)
+            de[rows] -= a * l * W * np.sin(arg)
+        return e, de
+
+    n = len(mass)
+    Minv = np.linalg.inv(M)
+
+    def rhs(t, x):
+        e, de = error(t)
+        acc = Minv @ (-K @ x[:n] - C @ x[n:] - R.T @ (k * e + c * de))
+        return np.concatenate([x[n:], acc])
+
+    # (atol 1e-18 m: some coordinates stay at zero by the set's symmetry, and an atol far
+    # below their round-off makes the steps tiny)
+    # the periodic solution by shooting: x(T) = exp(A T) x0 + x_p(T), x_p the response to
+    # the error from rest over one period, so x0 = (I - exp(A T))^-1 x_p(T)
+    T = 1 / f_mesh
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
+    rest = solve_ivp(rhs, (0, T), np.zeros(2 * n), "DOP853", rtol=1e-12, atol=1e-18)
+    x0 = np.linalg.solve(np.eye(2 * n) - expm(A * T), rest.y[:, -1])
+    ts = np.arange(65) * T / 64
+    run = solve_ivp(rhs, (0, T), x0, "DOP853", rtol=1e-12, atol=1e-18, t_eval=ts)
+    force = np.array(
+        [
+            (k * (R @ x[:n] + error(t)[0]) + c * (R @ x[n:] + error(t)[1]))[rows]
+            for t, x in zip(run.t[:-1], run.y.T[:-1], strict=True)
+        ]
+    )
+    peak = np.abs(force).max()
+    assert np.abs(run.y[:, -1] - x0).max() < 1e-8 * np.abs(x0).max()  # periodic
+    assert got["sun_planet_N"][0] == pytest.approx(peak, rel=1e-5)
+    assert got["ring_planet_N"] is None  # no error stated on the ring meshes
+
+
+def test_the_command_prints_the_table_and_refuses_what_it_cannot_take(tmp_path):
+    """``gearsym modes SET --te``: the JSON's table is the API's; a set without tooth
+    counts and a tree model are refused in one line, exit code 2."""
+    import gearsym
+
+    run = subprocess.run(
+        [sys.executable, "-m", "gearsym", "modes", "lin-parker-1999-3-phased", "--te", "--json"],
+        capture_output=True,
+        text=True,
+    )
+    assert run.returncode == 0, run.stderr
+    table = json.loads(run.stdout)["transmission_error"]
+    assert table == json.loads(
+        json.dumps(gearsym.planetary.te_excitation("lin-parker-1999-3-phased"))
+    )
+    for target, words in (
+        ("lin-parker-1999-4", "sun_teeth and ring_teeth"),
+        ("reference-light", "for planetary sets"),
+    ):
+        run = subprocess.run(
+            [sys.executable, "-m", "gearsym", "modes", target, "--te"],
+            capture_output=True,
+            text=True,
+        )
+        assert run.returncode == 2 and words in run.stderr
+        assert len(run.stderr.strip().splitlines()) == 1
