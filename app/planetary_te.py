@@ -101,7 +101,8 @@ def te_excitation(target) -> dict:
         else {"sun-planet": te_errors(st, "s")[0], "ring-planet": te_errors(st, "r")[0]}
     )
     typed = planetary_modes(st.as_structure(), ps.name).modes
-    labels = [m.label for m in typed if m.label != "rigid-body"]
+    flexible = [m for m in typed if m.label != "rigid-body"]  # as forced.excitation counts
+    labels = [m.label for m in flexible]
     found = {name: excitation(st.as_structure(), e) for name, e in sources.items()}
     out = []
     for l in range(1, errors.harmonics + 1):  # noqa: E741
@@ -113,7 +114,7 @@ def te_excitation(target) -> dict:
             groups.append(
                 {
                     "type": labels[r["modes"][0]],
-                    "modes": [m + 1 for m in r["modes"]],
+                    "modes": [flexible[m].index for m in r["modes"]],  # as `modes` lists
                     "multiplicity": len(r["modes"]),
                     "natural_hz": r["natural_rad_s"] / (2 * math.pi),
                     "mesh_frequency_hz": r["natural_rad_s"] / (2 * math.pi * l),

@@ -35,10 +35,10 @@ def run_carrier_sweep(path, st, args) -> int:
     import gearsym
 
     lo, hi, num = carrier_speeds(args.speeds)
-    if args.parametric or args.floquet:
+    if args.parametric or args.floquet or getattr(args, "te", False):
+        which = "--te" if getattr(args, "te", False) else "--parametric"
         raise Fail(
-            "--speeds with --parametric: the parametric analysis is of the fixed carrier; "
-            "run them one at a time"
+            f"--speeds with {which}: that analysis is of the fixed carrier; run them one at a time"
         )
     if args.plot:
         figure_file(args.plot, "--plot")

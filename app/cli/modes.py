@@ -101,10 +101,12 @@ def _cmd_modes(args) -> int:
 
         train = load_train(path)
         if train.dynamics is None:  # no operating point: the linear model's modes alone
+            from gearsym.derive.emit.planetary_module import inputs_hash
             from gearsym.planetary import train_modes
+            from gearsym.solver.provenance import header
 
-            header = {"model": train.name, "source": str(path)}
-            return _report(train_modes(train), None, lambda: header, args, strain=True)
+            head = header(train.name, inputs_hash(path), {}, {}, source=str(path))
+            return _report(train_modes(train), None, lambda: head, args, strain=True)
         from gearsym.resolve import planetary_system
 
         module = planetary_system(path).module

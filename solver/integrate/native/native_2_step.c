@@ -117,7 +117,10 @@ static void gs_rhs_group(const gs_ctx *c, double t, int n, const double *Y, doub
  * along r for each element would gather K with stride S).  Zero weights are skipped: a
  * third of DOP853's (24 of 66 in A, 4 of 12 in b, 5 of 13 in each error row), each a
  * pass over S elements read from cache for nothing; for finite stages the sum is the
- * same to the bit (fma(0, k, s) = s, and fma(w, k, 0) rounds w k as w * k does). */
+ * same to the bit (fma(0, k, s) = s, and fma(w, k, 0) rounds w k as w * k does).  A stage
+ * that is not finite no longer reaches a sum that weights it zero: the error rows weight
+ * the slope at the new state zero, so a point whose slope alone fails there now stops one
+ * step later, at the next step's error norm, instead of at this one's. */
 static inline __attribute__((always_inline)) void
 gs_weighted_any(double *restrict out, const double *restrict K, const double *restrict w,
                 int m, long S)
