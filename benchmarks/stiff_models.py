@@ -295,12 +295,14 @@ def page(modes, meshes, two_stage, errors, cost, date, machine) -> str:
         "steps a period (its order is 4: the implementation converges as it should). At "
         f"its finest setting it reaches {etd[-1]['error']:.1e} with {etd[-1]['evals']:.0f} "
         f"evaluations a period, where DOP853 reaches {near['error']:.1e} with "
-        f"{near['evals']:.0f} ({near['setting']}), and each ETDRK4 step adds nine products "
+        f"{near['evals']:.0f} ({near['setting']}), and each ETDRK4 step adds ten products "
         "with matrices of the state's size. It integrates L exactly, but what is left, "
         "N = f − L x, holds the backlash law's curvature and the stiffness variation in the "
         "fastest mode's own coordinate, so N changes as fast as that mode. The integrating "
-        f"factor keeps DOP853's order and needs {law['evals'] / dop[law['setting']]['evals']:.2f} "
-        f"times DOP853's evaluations at {law['setting']}: the step is set by the mesh mode's "
+        f"factor keeps DOP853's order and at {law['setting']} needs {law['evals']:.0f} "
+        f"evaluations a period for {law['error']:.1e}, where DOP853 needs "
+        f"{dop[law['setting']]['evals']:.0f} for {dop[law['setting']]['error']:.1e}: the "
+        "step is set by the mesh mode's "
         "nonlinear motion, not by its linear part.",
         "",
         "## Accuracy on the attractor and cost per point, compiled engine",
