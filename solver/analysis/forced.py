@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .modes import eigenproblem
+from .parametric import frequency_groups, modal_basis
 
 __all__ = ["Errors", "excitation", "response"]
 
@@ -81,15 +81,8 @@ def excitation(structure: dict, errors: Errors, tolerance: float = 1e-7) -> list
     flexible modes), ``natural_rad_s``, ``force`` (the norm of the group's modal force,
     N/sqrt(kg), stiffness part) and ``excited`` (module text); in the order of ``l`` and
     then of the frequency."""
-    w2, vec, _, R, k = eigenproblem(structure)
-    flexible = w2 > 1e-10 * np.max(np.abs(w2))
-    omega, Phi = np.sqrt(w2[flexible]), vec[:, flexible]
-    groups: list[list[int]] = []
-    for i, w in enumerate(omega):
-        if groups and abs(w - omega[groups[-1][0]]) <= tolerance * omega[-1]:
-            groups[-1].append(i)
-        else:
-            groups.append([i])
+    omega, Phi, R, k = modal_basis(structure)
+    groups = frequency_groups(omega, tolerance)
     rows = np.asarray(errors.rows)
     out = []
     for l in range(1, errors.harmonics + 1):  # noqa: E741

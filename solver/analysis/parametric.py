@@ -53,6 +53,7 @@ __all__ = [
     "Meshes",
     "combination_instabilities",
     "floquet_band",
+    "frequency_groups",
     "modal_basis",
     "monodromy",
     "multipliers",
@@ -129,7 +130,7 @@ def _excitation(basis: tuple, meshes: Meshes, l: int) -> np.ndarray:  # noqa: E7
     return G
 
 
-def _groups(omega: np.ndarray, tolerance: float) -> list[list[int]]:
+def frequency_groups(omega: np.ndarray, tolerance: float) -> list[list[int]]:
     """Indices of the modes at one frequency (within ``tolerance`` of the largest)."""
     groups: list[list[int]] = []
     for i, w in enumerate(omega):
@@ -158,7 +159,7 @@ def primary_instabilities(
     out = []
     for h in range(1, harmonics + 1):
         G = _excitation(basis, meshes, h)
-        for g in _groups(omega, group_tolerance):
+        for g in frequency_groups(omega, group_tolerance):
             w = float(np.mean(omega[g]))
             s = _largest(G[np.ix_(g, g)], G)
             out.append(Instability(tuple(g), h, w, s, (2 * w - s / w) / h, (2 * w + s / w) / h))
@@ -180,7 +181,7 @@ def combination_instabilities(
     of ``l``, then of the first group, then of the second."""
     basis = modal_basis(structure)
     omega = basis[0]
-    groups = _groups(omega, group_tolerance)
+    groups = frequency_groups(omega, group_tolerance)
     out = []
     for h in range(1, harmonics + 1):
         G = _excitation(basis, meshes, h)
