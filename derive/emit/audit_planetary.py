@@ -97,7 +97,7 @@ def planetary_page(st: PlanetaryStructure, command: str, source: str) -> str:
         "(`gearsym modes --te`), and the meshes' dynamic forces over the mesh frequency "
         "(`gearsym.planetary.te_response`).\n",
         "**Not modelled yet** (issue 26): the rotating frame's terms in the parametric "
-        "analysis and in the nonlinear model.\n",
+        "and transmission-error analyses (a turning carrier is refused there).\n",
         "## Kinematic graph\n",
         f"Bodies ({bodies}): carrier `c`, ring `r`, sun `s` and {n} planets, {spacing}, at "
         f"ψ = {angles} round the carrier. Each planet meshes with the sun (external) and "
@@ -180,6 +180,15 @@ def _nonlinear(st: PlanetaryStructure) -> str:
         if s["pivot"]
         else "no rigid-body mode to remove"
     )
+    frame = (
+        f" The carrier turns at {ps.carrier_speed_rpm:g} rpm: the linear model's `G` and "
+        "`K_Ω` at that speed enter the forces, `−Ω_c G q' + Ω_c² K_Ω q`, and the rigid-body "
+        "rotation, its momentum zero, adds the stiffening `−Ω_c² g gᵀ / m_0` of its "
+        "Coriolis coupling to the planets' radial motion (`derive/equations/"
+        "body_dynamics.py`); the speed stays the file's while the mesh frequency moves."
+        if ps.carrier_speed_rpm
+        else ""
+    )
     return head + (
         f"Here: sun force {d.sun_force:g} N on its base circle, half backlashes "
         f"{d.backlash_sun * 1e6:g} µm (sun-planet) and {d.backlash_ring * 1e6:g} µm "
@@ -187,7 +196,7 @@ def _nonlinear(st: PlanetaryStructure) -> str:
         f"{s['length_m'] * 1e6:g} µm, time `τ = ω_n t` with ω_n = {s['omega_n']:.6g} rad/s "
         f"(`{s['reference']}`'s stiffness on the mass its deflection sees); operating point "
         f"{d.mesh_frequency_hz:g} Hz of mesh frequency, ω = {s['omega']:.6g}, and "
-        f"f_s = {s['f_s']:.6g}.\n"
+        f"f_s = {s['f_s']:.6g}.{frame}\n"
     )
 
 

@@ -31,6 +31,22 @@ m_j / m_ref)``, ``u_j = r_j T ybar / beta_j`` and ``e = A^-1 T^T F / (k_ref b)``
 (the caller gives ``F / (k_ref b)``).
 The variation ``v_j = sum_l c_l cos(h_l omega tau) + s_l sin(h_l omega tau)``, each term at
 its own multiple ``h_l`` of the forcing frequency ``omega``.
+
+**A rotating frame** (``Bodies.frame``: a planetary set's carrier turning at ``Omega``,
+``planetary.py``) adds ``- Omega G q' + Omega^2 K_Omega q`` to the forces, both linear and
+with ``K_Omega phi_0 = 0``.  ``G phi_0`` is not zero (a planet moving radially changes the
+set's moment of inertia), so the rigid coordinate ``s = phi_0^T M q`` is no longer at rest:
+``p = s' + Omega phi_0^T G q`` is conserved (``phi_0^T`` times the equations: every other
+term vanishes), and with ``p = 0`` (the frame turns with the set's momentum)
+``s' = - Omega phi_0^T G T y`` follows from ``y`` alone, ``s`` itself entering nowhere.  With
+``q = T y + phi_0 s / m_0`` (``m_0 = phi_0^T M phi_0``) the frame's force on ``y`` is
+
+    ``- Omega T^T G T y' + Omega^2 (T^T K_Omega T - g g^T / m_0) y``,  ``g = T^T G phi_0``,
+
+the last term the momentum's stiffening (``phi_0^T G T = -g^T``, ``G`` skew).  Scaled:
+``W = Omega / omega_n`` and both matrices over ``m_ref``.  ``y`` is measured from the
+static stretch of the planets' bearings under their centripetal load, which the meshes
+do not share (the loader refuses a set where they would).
 """
 
 from __future__ import annotations
@@ -40,7 +56,14 @@ from dataclasses import dataclass, field
 import numpy as np
 import sympy as sp
 
-__all__ = ["BodyDynamics", "Bodies", "build", "reduction", "structure_mapping"]
+__all__ = [
+    "BodyDynamics",
+    "Bodies",
+    "build",
+    "frame_rotation",
+    "reduction",
+    "structure_mapping",
+]
 
 
 @dataclass(frozen=True)
@@ -62,6 +85,8 @@ class Bodies:
     # mesh row index -> ((h, c, s), ...): its transmission error in m, sum_l c_l cos(h_l
     # omega tau) + s_l sin(h_l omega tau), added to its deflection (excess material)
     errors: dict = field(default_factory=dict)
+    # the carrier's rotating frame: (Omega rad/s, G, K_Omega) over q, or None (no frame)
+    frame: tuple | None = None
 
 
 @dataclass(frozen=True)
@@ -112,14 +137,15 @@ def structure_mapping(st, motions) -> dict:
     }
 
 
-def reduction(physical, mass, R, rigid: int):
+def reduction(physical, mass, R, rigid: int, phi=None):
     """(T, pivot name or None, phi_0): the reduction of the one rigid-body rotation
-    (module docstring); ``rigid`` 0: none, T the identity."""
+    (module docstring); ``rigid`` 0: none, T the identity.  ``phi``: the rotation where it
+    is not ``R``'s null vector (a rotating frame's, :func:`frame_rotation`)."""
     n = len(physical)
     if rigid == 0:
         return np.eye(n), None, None
-    _, _, vt = np.linalg.svd(R)
-    phi = vt[-1]
+    if phi is None:
+        phi = np.linalg.svd(R)[2][-1]
     m = np.asarray(mass)
     p = int(np.argmax(np.abs(m * phi)))
     keep = [i for i in range(n) if i != p]
@@ -130,11 +156,51 @@ def reduction(physical, mass, R, rigid: int):
     return T, physical[p], phi
 
 
+def frame_rotation(mass, R, k, frame) -> np.ndarray:
+    """The rigid-body rotation of a set in a rotating frame (``frame``: ``(Omega, G,
+    K_Omega)``): the null vector of ``K - Omega^2 K_Omega``, not of ``R``.  Turning with the
+    set, each planet sits at its bearing's static stretch ``d`` beyond ``r_c``, so it moves
+    by ``(1 + d / r_c)`` times the carrier's ``u_c``: the bearing's tangential "deflection"
+    in this mode is the spring turning with the set, which ``K_Omega``'s load term on
+    ``u_c`` balances (``planetary.py``), and the meshes' deflections stay zero."""
+    speed, _, K_omega = frame
+    K = R.T @ (np.asarray(k)[:, None] * R) - speed**2 * np.asarray(K_omega, dtype=float)
+    m = np.asarray(mass, dtype=float)
+    w2, V = np.linalg.eigh(K / np.sqrt(np.outer(m, m)))
+    return V[:, np.argmin(np.abs(w2))] / np.sqrt(m)
+
+
 def reference_scales(b: Bodies) -> tuple[float, float]:
     """(k_ref, omega_n) of the reference mesh."""
     R, k = b.incidence, np.asarray(b.stiffness)
     m_ref = 1.0 / float(np.sum(R[b.reference] ** 2 / np.asarray(b.mass)))
     return float(k[b.reference]), float(np.sqrt(k[b.reference] / m_ref))
+
+
+def _frame(b: Bodies, T, phi, M, m_ref: float, omega_n: float):
+    """``(W G_r, W^2 K_r)`` over ``y``, scaled by ``m_ref``: the rotating frame's forces
+    ``- W G_r ybar' + W^2 K_r ybar`` (module docstring); zeros without a frame."""
+    n_y = T.shape[1]
+    if b.frame is None:
+        return np.zeros((n_y, n_y)), np.zeros((n_y, n_y))
+    speed, G, K_omega = b.frame
+    G, K_omega = np.asarray(G, dtype=float), np.asarray(K_omega, dtype=float)
+    W = speed / omega_n
+    gyro = W * (T.T @ G @ T) / m_ref
+    centri = T.T @ K_omega @ T
+    if phi is not None:
+        g = T.T @ G @ phi
+        centri = centri - np.outer(g, g) / float(phi @ M @ phi)
+    centri = W**2 * centri / m_ref
+    return _rounding_dropped(gyro), _rounding_dropped(centri)
+
+
+def _rounding_dropped(a: np.ndarray) -> np.ndarray:
+    """``a`` with entries below 1e-15 of its largest set to zero: rounding of ``T``'s pivot
+    row and of ``A^-1``, which would otherwise put every coordinate in every equation."""
+    a = np.array(a, dtype=float)
+    a[np.abs(a) < 1e-15 * max(np.max(np.abs(a), initial=0.0), 1e-300)] = 0.0
+    return a
 
 
 def build(b: Bodies, symbols=("omega", "f", "zeta")) -> dict:
@@ -144,7 +210,13 @@ def build(b: Bodies, symbols=("omega", "f", "zeta")) -> dict:
     the names of the forcing frequency, the load and the damping ratio."""
     R, k, kinds = b.incidence, np.asarray(b.stiffness), b.kinds
     M = np.diag(b.mass)
-    T, pivot, _ = reduction(b.physical, b.mass, R, b.rigid_body_modes)
+    turning = b.frame if b.rigid_body_modes else None
+    phi = None if turning is None else frame_rotation(b.mass, R, k, turning)
+    T, pivot, phi = reduction(b.physical, b.mass, R, b.rigid_body_modes, phi)
+    if turning is not None:
+        moved = np.abs(R @ phi)[[j for j, kind in enumerate(kinds) if kind == "mesh"]]
+        if np.max(moved) > 1e-9 * np.max(np.abs(R @ phi), initial=1e-300) + 1e-12:
+            raise ValueError("the rigid-body rotation at this carrier speed moves a mesh")
     n_y = T.shape[1]
     m_j = 1.0 / np.einsum("ji,i,ji->j", R, 1.0 / np.asarray(b.mass), R)
     ref = b.reference
@@ -161,6 +233,8 @@ def build(b: Bodies, symbols=("omega", "f", "zeta")) -> dict:
     kappa = k / k_ref
     mu = np.sqrt(kappa * m_j / m_ref)  # c_j omega_n / k_ref over 2 zeta
 
+    gyro_r, centri_r = _frame(b, T, phi, M, m_ref, omega_n)
+    gyro, centri = _rounding_dropped(Ainv @ gyro_r), _rounding_dropped(Ainv @ centri_r)
     tau = sp.Symbol("tau")
     omega, f, zeta = sp.symbols(" ".join(symbols))
     coords = tuple(c for c in b.physical if c != pivot)
@@ -191,7 +265,13 @@ def build(b: Bodies, symbols=("omega", "f", "zeta")) -> dict:
     acc = []
     for i in range(n_y):
         terms = [float(G[i, j]) * forces[j] for j in range(len(k)) if abs(G[i, j]) > 1e-15]
-        acc.append(f * float(e[i]) - sp.Add(*terms))
+        # the rotating frame's forces through A^-1 (none without a frame)
+        frame = [
+            -float(gyro[i, c]) * dy[c] + float(centri[i, c]) * y[c]
+            for c in range(n_y)
+            if gyro[i, c] != 0.0 or centri[i, c] != 0.0
+        ]
+        acc.append(f * float(e[i]) - sp.Add(*terms) + sp.Add(*frame))
     rhs = tuple(dy) + tuple(acc)
     states = tuple(y) + dy
     jac = tuple(sp.diff(r, s) for r in rhs for s in states)
@@ -225,7 +305,8 @@ def build(b: Bodies, symbols=("omega", "f", "zeta")) -> dict:
         "transform": T,
         "length_m": float(length),
         "omega_n": omega_n,
-        "stiffness": rows.T @ np.diag(kappa) @ rows,  # every mesh's teeth touching
+        # every mesh's teeth touching, and the frame's centripetal and momentum terms
+        "stiffness": rows.T @ np.diag(kappa) @ rows - centri_r,
         "load_direction": load,
         "k_ref": float(k_ref),
     }

@@ -27,8 +27,13 @@ over ``omega_n``; ``f = F_s / (k_sp b)``.  The stiffness variation enters as
 ``v_j = sum_l a_l cos(l (omega tau - 2 pi gamma_j)) + b_l sin(l (omega tau - 2 pi gamma_j))``.
 A transmission error (``sun_planet_transmission_error``, ``ring_planet_transmission_error``)
 is excess material on the loaded flank (the sun's force makes every mesh's ``delta > 0``),
-delayed by each mesh's phase as its stiffness variation is (``_errors``).  The carrier's
-rotating frame is not modelled here (a turning carrier's set is refused).
+delayed by each mesh's phase as its stiffness variation is (``_errors``).
+
+**A turning carrier** (``carrier_speed_rpm``): the linear model's gyroscopic and centripetal
+terms at the file's speed (``planetary.py``), with the rigid-body rotation's momentum, as
+``body_dynamics.py`` states.  The speed is the file's, fixed: the forcing frequency moves
+without it (a frequency response holds the frame's terms, as Lin and Parker's equations
+hold ``Omega_c`` apart from the mesh frequency); another speed is another file.
 """
 
 from __future__ import annotations
@@ -40,7 +45,7 @@ import numpy as np
 
 from ..input.planetary import needs_dynamics  # re-exported: the derivation's check
 from ..input.reader import InputError
-from .body_dynamics import Bodies, BodyDynamics, build, reduction
+from .body_dynamics import Bodies, BodyDynamics, build, frame_rotation, reduction
 from .planetary import PlanetaryStructure, planetary_meshes
 
 __all__ = ["PlanetaryDynamics", "derive_dynamics", "needs_dynamics", "scales"]
@@ -59,7 +64,11 @@ def _pivot(st: PlanetaryStructure):
             f"{st.rigid_body_modes} rigid-body modes: the nonlinear model removes one (the "
             "set turning as a whole); hold another member (its torsional_N_per_m)",
         )
-    return reduction(st.physical, st.mass, st.incidence, st.rigid_body_modes)
+    phi = None
+    if st.carrier_speed_rad_s and st.rigid_body_modes:
+        frame = (st.carrier_speed_rad_s, st.gyroscopic, st.centripetal)
+        phi = frame_rotation(st.mass, st.incidence, st.stiffness, frame)
+    return reduction(st.physical, st.mass, st.incidence, st.rigid_body_modes, phi)
 
 
 def _variation(st: PlanetaryStructure) -> dict:
@@ -152,7 +161,7 @@ def _errors(st: PlanetaryStructure) -> dict:
 
 def derive_dynamics(st: PlanetaryStructure) -> PlanetaryDynamics:
     """The nonlinear model of ``st`` (module docstring); ``InputError`` where it cannot
-    be built (no ``[planetary.dynamics]``, a turning carrier, two rigid-body modes)."""
+    be built (no ``[planetary.dynamics]``, two rigid-body modes)."""
     ps = st.planetary
     needs_dynamics(ps)
     d = ps.dynamics
@@ -183,7 +192,10 @@ def derive_dynamics(st: PlanetaryStructure) -> PlanetaryDynamics:
         reference=ref,
     )
     scale = scales(st)
-    bodies = replace(bodies, errors=_errors(st))
+    frame = (
+        (st.carrier_speed_rad_s, st.gyroscopic, st.centripetal) if st.carrier_speed_rad_s else None
+    )
+    bodies = replace(bodies, errors=_errors(st), frame=frame)
     return BodyDynamics(
         structure=st,
         name=ps.name,

@@ -370,8 +370,8 @@ def load_planetary(path: Path | str) -> PlanetarySet:
 
 
 def needs_dynamics(ps) -> None:
-    """``InputError`` (one line) where the set's file cannot give the nonlinear model:
-    no ``[planetary.dynamics]`` table, or a turning carrier."""
+    """``InputError`` (one line) where the set's file cannot give the nonlinear model: no
+    ``[planetary.dynamics]`` table."""
     if ps.dynamics is None:
         raise InputError(
             ps.source,
@@ -380,11 +380,4 @@ def needs_dynamics(ps) -> None:
             "model, and it needs a [planetary.dynamics] table (sun_force_N, the half "
             "backlashes, mesh_frequency_hz); add one (docs/user-guide.md, Planetary sets), or "
             "run `gearsym modes` on the set",
-        )
-    if ps.carrier_speed_rpm:
-        raise InputError(
-            ps.source,
-            "planetary.carrier_speed_rpm",
-            "the nonlinear model is of the carrier's frame without its gyroscopic and "
-            "centripetal terms; leave the carrier speed out for it",
         )
