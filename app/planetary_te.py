@@ -36,12 +36,6 @@ def _set(target):
             raise ValueError(f"{target}: not a planetary set (a file with a [planetary] table)")
         target = derive_planetary(load_planetary(path))
     st = target
-    if st.planetary.carrier_speed_rpm:
-        raise ValueError(
-            f"{st.planetary.name}: the transmission-error analysis is of the fixed-carrier "
-            "model (no gyroscopic terms), and the set turns its carrier: remove "
-            "carrier_speed_rpm for it"
-        )
     if st.phases is None:
         raise ValueError(
             f"{st.planetary.source}: the meshes' phases need sun_teeth and ring_teeth in "
@@ -127,6 +121,7 @@ def te_excitation(target) -> dict:
     return {
         "model": ps.name,
         "planets": ps.planets,
+        "carrier_speed_rpm": ps.carrier_speed_rpm,
         "equally_spaced": ps.equally_spaced,
         "sun_teeth": ps.sun_teeth,
         "ring_teeth": ps.ring_teeth,

@@ -76,6 +76,12 @@ def print_te(table: dict) -> None:
         f"transmission error ({table['errors']}): what each harmonic l excites; it meets a "
         "mode at the mesh frequency natural / l"
     )
+    if table.get("carrier_speed_rpm"):
+        print(
+            f"  (carrier at {table['carrier_speed_rpm']:g} rpm: each translational pair is "
+            "split into two modes whirling in opposite senses, and a harmonic with l x "
+            "sun_teeth mod N = 1 meets one of each pair, N - 1 the other)"
+        )
     n = table["planets"]
     for h in table["harmonics"]:
         print(f"  l = {h['harmonic']} (l x sun_teeth mod {n} = {h['residue']}):")

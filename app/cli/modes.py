@@ -226,12 +226,6 @@ def _planetary(path, args) -> int:
             f"--te: {path} has no sun_teeth and ring_teeth in [planetary], which the meshes' "
             "phases need; add them"
         )
-    if args.te and ps.carrier_speed_rpm:
-        raise Fail(
-            f"--te: {path} turns the carrier (carrier_speed_rpm = {ps.carrier_speed_rpm:g}); "
-            "the transmission-error analysis is of the fixed-carrier model: remove "
-            "carrier_speed_rpm for it"
-        )
     if args.parametric and ps.carrier_speed_rpm:
         raise Fail(
             f"--parametric: {path} turns the carrier (carrier_speed_rpm = "

@@ -95,9 +95,10 @@ def planetary_page(st: PlanetaryStructure, command: str, source: str) -> str:
         "The meshes' transmission errors, delayed by the same phases, enter the linear "
         "analysis too: which modes each harmonic excites and which the phasing suppresses "
         "(`gearsym modes --te`), and the meshes' dynamic forces over the mesh frequency "
-        "(`gearsym.planetary.te_response`).\n",
+        "(`gearsym.planetary.te_response`); with the carrier turning, in the rotating "
+        "frame.\n",
         "**Not modelled yet** (issue 26): the rotating frame's terms in the parametric "
-        "and transmission-error analyses (a turning carrier is refused there).\n",
+        "analysis (a turning carrier is refused there).\n",
         "## Kinematic graph\n",
         f"Bodies ({bodies}): carrier `c`, ring `r`, sun `s` and {n} planets, {spacing}, at "
         f"ψ = {angles} round the carrier. Each planet meshes with the sun (external) and "

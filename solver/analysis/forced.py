@@ -26,6 +26,13 @@ effectiveness of planet phasing to suppress planetary gear vibration").
 **Response.**  ``Q_l = (K - (l Omega)^2 M + i l Omega C)^-1 F_l`` and each mesh's dynamic
 force about its static value, ``(k_j + i l Omega c_j)(r_j Q_l + E_jl)``; its largest
 magnitude over a mesh period from the harmonics summed on 64 samples.
+
+**A turning carrier** (the structure's ``carrier_speed_rad_s``, ``G`` and ``K_Omega``):
+``K`` becomes ``K - W^2 K_Omega`` and ``C`` becomes ``C + W G``.  The modes are then
+complex (``modes.rotating_modes``): for ``lambda = i w`` the pencil ``lambda^2 M + lambda W G +
+K'`` equals its own conjugate transpose at ``-i w`` (``G`` skew), so a mode's left
+eigenvector is its right one ``x`` and harmonic ``l`` forces it through ``x^H F_l``, ``x``
+normalised to ``x^H M x = 1``.
 """
 
 from __future__ import annotations
@@ -35,6 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .modes import rotating_modes
 from .parametric import frequency_groups, modal_basis
 
 __all__ = ["Errors", "excitation", "response"]
@@ -75,19 +83,41 @@ def _damping(structure: dict, zeta: float) -> np.ndarray:
     return 2.0 * zeta * np.sqrt(k * m_j)
 
 
+def _flexible(structure: dict):
+    """``(omega, X, R, k)``: the flexible modes (rad/s, ascending) and their shapes on
+    ``M`` (real without a turning carrier, complex with one: module text)."""
+    if not structure.get("carrier_speed_rad_s"):
+        return modal_basis(structure)
+    mass, R, k = (np.asarray(structure[key], float) for key in ("mass", "incidence", "stiffness"))
+    f, shapes, rigid = rotating_modes(structure, mass, R, k)
+    X = shapes[:, ~rigid]
+    X = X / np.sqrt(np.einsum("ij,i,ij->j", X.conj(), mass, X).real)
+    return 2 * math.pi * f[~rigid], X, R, k
+
+
+def _frame(structure: dict):
+    """``(W^2 K_Omega, W G)`` of a turning carrier (zeros without one)."""
+    n = len(structure["mass"])
+    W = float(structure.get("carrier_speed_rad_s") or 0.0)
+    if not W:
+        return np.zeros((n, n)), np.zeros((n, n))
+    G = np.asarray(structure["gyroscopic"], float)
+    return W**2 * np.asarray(structure["centripetal"], float), W * G
+
+
 def excitation(structure: dict, errors: Errors, tolerance: float = 1e-7) -> list[dict]:
     """Per harmonic ``l`` and group of modes at one natural frequency (within
     ``tolerance`` of the largest, relative): ``harmonic``, ``modes`` (indices into the
     flexible modes), ``natural_rad_s``, ``force`` (the norm of the group's modal force,
     N/sqrt(kg), stiffness part) and ``excited`` (module text); in the order of ``l`` and
     then of the frequency."""
-    omega, Phi, R, k = modal_basis(structure)
+    omega, Phi, R, k = _flexible(structure)
     groups = frequency_groups(omega, tolerance)
     rows = np.asarray(errors.rows)
     out = []
     for l in range(1, errors.harmonics + 1):  # noqa: E741
         force = -(R[rows].T * k[rows]) @ errors.amplitudes(l)
-        p = Phi.T @ force
+        p = Phi.conj().T @ force
         floor = 1e-12 * np.abs(p).max(initial=0.0)
         for g in groups:
             size = float(np.linalg.norm(p[g]))
@@ -109,6 +139,8 @@ def response(structure: dict, errors: Errors, zeta: float, Omegas) -> np.ndarray
     mass, R, k = (np.asarray(structure[key], float) for key in ("mass", "incidence", "stiffness"))
     c = _damping(structure, zeta)
     M, K, C = np.diag(mass), R.T @ (k[:, None] * R), R.T @ (c[:, None] * R)
+    centripetal, gyroscopic = _frame(structure)
+    K, C = K - centripetal, C + gyroscopic
     rows = np.asarray(errors.rows)
     phase = np.exp(2j * math.pi * np.arange(64) / 64)
     out = np.zeros((len(Omegas), len(rows)))

@@ -33,6 +33,7 @@ __all__ = [
     "eigenproblem",
     "modes",
     "planetary_modes",
+    "rotating_modes",
     "structure_modes",
 ]
 
@@ -260,13 +261,13 @@ def planetary_modes(structure: dict, name: str) -> Modes:
     tooth-pass speed): ``mesh_frequency_hz`` is NaN.
 
     With a carrier speed (``carrier_speed_rad_s`` in ``structure``) the modes are those of
-    ``M q'' + Omega_c G q' + (K - Omega_c^2 K_Omega) q = 0`` (:func:`_rotating`), their
+    ``M q'' + Omega_c G q' + (K - Omega_c^2 K_Omega) q = 0`` (:func:`rotating_modes`), their
     frequencies seen from the carrier and their shapes complex: ``shape`` then holds each
     coordinate's magnitude (the largest 1; a rigid-body mode, real, keeps its signs), the
     energies the magnitudes squared."""
     if structure.get("carrier_speed_rad_s"):
         mass, R, k = _arrays(structure)
-        f, vec, rigid = _rotating(structure, mass, R, k)
+        f, vec, rigid = rotating_modes(structure, mass, R, k)
     else:
         w2, vec, mass, R, k = eigenproblem(structure)
         rigid = np.abs(w2) <= 1e-10 * np.max(np.abs(w2))
@@ -327,7 +328,7 @@ class UnstableAtSpeed(ValueError):
     is refused too."""
 
 
-def _rotating(structure: dict, mass, R, k):
+def rotating_modes(structure: dict, mass, R, k):
     """``(f, shapes, rigid)`` of ``M q'' + W G q' + (K - W^2 K_W) q = 0`` (``W`` the carrier
     speed): the rigid-body modes (the null space of the stiffness, real) first, then the
     ``n - r`` eigenvalues ``i 2 pi f`` of the first-order form with ``f > 0``, ascending,
