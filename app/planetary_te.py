@@ -132,12 +132,14 @@ def te_excitation(target) -> dict:
     }
 
 
-def te_response(target, lo_hz: float, hi_hz: float, num: int = 200, damping_ratio=None) -> dict:
+def te_response(
+    target, lo_hz: float, hi_hz: float, num: int = 200, damping_ratio=None, *, log=False
+) -> dict:
     """The meshes' largest dynamic force (N, about the static force) over a mesh period
-    at ``num`` mesh frequencies from ``lo_hz`` to ``hi_hz``, JSON-ready: each kind of mesh's
-    largest over its meshes (``sun_planet_N``, ``ring_planet_N``).  ``damping_ratio``: of
-    every spring on its own mass (default: the file's ``[planetary.dynamics]``, else
-    0.03)."""
+    at ``num`` mesh frequencies from ``lo_hz`` to ``hi_hz`` (evenly spaced, or on a log
+    scale with ``log``), JSON-ready: each kind of mesh's largest over its meshes
+    (``sun_planet_N``, ``ring_planet_N``).  ``damping_ratio``: of every spring on its own
+    mass (default: the file's ``[planetary.dynamics]``, else 0.03)."""
     import numpy as np
     from gearsym.solver.analysis.forced import response
 
@@ -149,7 +151,7 @@ def te_response(target, lo_hz: float, hi_hz: float, num: int = 200, damping_rati
     d = st.planetary.dynamics
     zeta = damping_ratio if damping_ratio is not None else (d.damping_ratio if d else 0.03)
     errors, stated = te_errors(st)
-    freqs = np.linspace(lo_hz, hi_hz, int(num))
+    freqs = (np.geomspace if log else np.linspace)(lo_hz, hi_hz, int(num))
     force = response(st.as_structure(), errors, zeta, 2 * np.pi * freqs)
     sun = np.array([st.springs[j].startswith("s") for j in errors.rows])
     out = {"model": st.planetary.name, "damping_ratio": zeta, "mesh_frequency_hz": list(freqs)}

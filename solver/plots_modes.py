@@ -1,5 +1,6 @@
 """The resonance (Campbell) diagram of a model's modes against its mesh frequency, and a
-planetary set's parametric-instability diagram and its modes against the carrier's speed."""
+planetary set's parametric-instability diagram, its modes against the carrier's speed and
+its meshes' dynamic forces under their transmission errors."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ import numpy as np
 from .analysis.modes import Modes
 from .plots_style import legend_below, plt
 
-__all__ = ["campbell_figure", "carrier_figure", "parametric_figure"]
+__all__ = ["campbell_figure", "carrier_figure", "parametric_figure", "te_figure"]
 
 _STYLE = {
     "torsional": ("tab:blue", "-"),
@@ -222,4 +223,64 @@ def carrier_figure(sweep: dict, harmonics: int | None = None):
         else f"no mesh-frequency lines: {sweep['mesh_why_not']}"
     )
     legend_below(fig, [ax], caption)
+    return fig
+
+
+def te_figure(response: dict, table: dict):
+    """A planetary set's meshes' largest dynamic force over the mesh frequency under their
+    transmission errors (``response``: the mapping of ``gearsym.planetary.te_response``),
+    one curve for each kind of mesh, and a tick at the top for each mode a harmonic meets
+    (its natural frequency over ``l``, coloured by its type; ``table``: the mapping of
+    ``te_excitation``), the phasing's suppressed ones left out; returns the ``Figure``."""
+    fig, ax = plt.subplots(figsize=(9, 5))
+    f = np.asarray(response["mesh_frequency_hz"])
+    for key, label, colour in (
+        ("sun_planet_N", "sun-planet meshes", "black"),
+        ("ring_planet_N", "ring-planet meshes", "tab:purple"),
+    ):
+        if response.get(key) is not None:
+            ax.plot(f, response[key], color=colour, lw=1.4, label=label)
+    top = ax.get_xaxis_transform()
+    for h in table["harmonics"]:
+        for g in h["groups"]:
+            at = g["mesh_frequency_hz"]
+            if g["excited"] and f[0] <= at <= f[-1]:
+                colour = _TYPES.get(g["type"], "grey")
+                ax.plot(
+                    [at, at],
+                    [0.94, 1.0],
+                    transform=top,
+                    color=colour,
+                    lw=1.2,
+                    label=f"{g['type']} mode met (natural / l)",
+                )
+                ax.annotate(
+                    f"{h['harmonic']}",
+                    (at, 0.93),
+                    xycoords=top,
+                    fontsize=7,
+                    ha="center",
+                    va="top",
+                    color=colour,
+                )
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlim(f[0], f[-1])
+    peaks = [max(response[k]) for k in ("sun_planet_N", "ring_planet_N") if response.get(k)]
+    if peaks and max(peaks) > 0:
+        ax.set_ylim(top=8.0 * max(peaks))  # headroom for the ticks above the curves
+    ax.set_xlabel("mesh frequency (Hz)")
+    ax.set_ylabel("largest dynamic mesh force over a period (N)")
+    speed = table.get("carrier_speed_rpm") or 0.0
+    where = f"carrier at {speed:g} rpm" if speed else "carrier held"
+    ax.set_title(f"{response['model']}: response to the transmission errors ({where})")
+    legend_below(
+        fig,
+        [ax],
+        f"Errors: {response['errors']}; every mesh in contact (the linear model), damping "
+        f"ratio {response['damping_ratio']:g} on every spring. Each kind of mesh's largest "
+        "force over its meshes, about the static force. A tick marks a mode a harmonic l "
+        "of the error meets (the number under it: l); the modes the planets' phasing "
+        "suppresses get none.",
+    )
     return fig

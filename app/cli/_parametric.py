@@ -93,3 +93,13 @@ def print_te(table: dict) -> None:
             if kinds:
                 text = "; ".join(f"{t} {', '.join(f)} Hz" for t, f in kinds.items())
                 print(f"    {word}: {text}")
+
+
+def te_response_around(st, table: dict) -> dict:
+    """``te_response`` of the set ``st`` over the mesh frequencies where its harmonics meet
+    the modes they excite (``table``: ``te_excitation``'s), from half the lowest to one and
+    a half times the highest, 600 frequencies on a log scale."""
+    from gearsym.planetary import te_response
+
+    met = [g["mesh_frequency_hz"] for h in table["harmonics"] for g in h["groups"] if g["excited"]]
+    return te_response(st, 0.5 * min(met), 1.5 * max(met), 600, log=True)

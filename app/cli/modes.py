@@ -34,7 +34,8 @@ def register(sub) -> None:
         "--plot",
         metavar="FILE",
         help="write the resonance diagram (PNG, PDF, SVG); of a planetary set with "
-        "--parametric, its parametric-instability diagram, with --speeds its Campbell diagram",
+        "--parametric, its parametric-instability diagram, with --te its meshes' forces "
+        "under their transmission errors, with --speeds its Campbell diagram",
     )
     p.add_argument("--out", metavar="DIR", help="also write modes.json, .csv, .mat (--format)")
     p.add_argument(
@@ -205,10 +206,11 @@ def _planetary(path, args) -> int:
         except UnstableAtSpeed as err:
             raise Fail(f"{path}: {err}") from None
         return run_carrier_sweep(path, st, args)
-    if args.plot and not args.parametric:
+    if args.plot and args.parametric == args.te:
         raise Fail(
             "--plot: a planetary set's diagrams are of --parametric (its parametric "
-            "instabilities) or --speeds LO:HI (its modes against the carrier's speed); add one"
+            "instabilities), --te (its meshes' forces under their transmission errors) or "
+            "--speeds LO:HI (its modes against the carrier's speed); give one of them"
         )
     if args.plot:
         figure_file(args.plot, "--plot")
@@ -271,12 +273,20 @@ def _planetary(path, args) -> int:
     if args.te:
         from gearsym.planetary import te_excitation
 
+        from ._parametric import te_response_around
+
         data["transmission_error"] = te_excitation(st)
+        if args.plot:
+            data["transmission_error"]["response"] = te_response_around(
+                st, data["transmission_error"]
+            )
     if args.plot:
-        from gearsym.solver.plots_modes import parametric_figure
+        from gearsym.solver.plots_modes import parametric_figure, te_figure
         from gearsym.solver.plots_style import save_figure
 
-        save_figure(parametric_figure(data["parametric"]), args.plot)
+        te = data.get("transmission_error")
+        figure = te_figure(te["response"], te) if args.te else parametric_figure(data["parametric"])
+        save_figure(figure, args.plot)
     if args.out:
         from gearsym.solver.export import Document
 
@@ -324,5 +334,6 @@ def _planetary(path, args) -> int:
 
         print_te(data["transmission_error"])
     if args.plot:
-        print(f"  parametric-instability diagram: {args.plot}")
+        what = "transmission-error response" if args.te else "parametric-instability diagram"
+        print(f"  {what}: {args.plot}")
     return 0

@@ -219,3 +219,29 @@ def test_the_command_prints_the_table_and_refuses_what_it_cannot_take(tmp_path):
         )
         assert run.returncode == 2 and words in run.stderr
         assert len(run.stderr.strip().splitlines()) == 1
+
+
+def test_the_figure_draws_the_apis_response_over_the_modes_met(tmp_path):
+    """``gearsym modes SET --te --plot FILE``: the figure is written, the JSON carries the
+    response it draws, which is ``te_response`` over a range that holds every mode a
+    harmonic meets; ``--plot`` with both ``--te`` and ``--parametric`` is refused in one
+    line (one diagram a file)."""
+    import gearsym
+
+    figure = tmp_path / "te.png"
+    argv = [sys.executable, "-m", "gearsym", "modes", "lin-parker-1999-3-phased", "--te"]
+    run = subprocess.run([*argv, "--plot", str(figure), "--json"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert figure.stat().st_size > 10_000
+    table = json.loads(run.stdout)["transmission_error"]
+    response = table["response"]
+    f = response["mesh_frequency_hz"]
+    met = [g["mesh_frequency_hz"] for h in table["harmonics"] for g in h["groups"] if g["excited"]]
+    assert f[0] < min(met) and max(met) < f[-1]
+    api = gearsym.planetary.te_response("lin-parker-1999-3-phased", f[0], f[-1], len(f), log=True)
+    assert response == json.loads(json.dumps(api))
+    both = subprocess.run(
+        [*argv, "--parametric", "--plot", str(figure)], capture_output=True, text=True
+    )
+    assert both.returncode == 2 and len(both.stderr.strip().splitlines()) == 1
+    assert "give one of them" in both.stderr
