@@ -21,17 +21,13 @@ def run(capsys, *argv):
     return code, out.out, out.err
 
 
-def test_derive_check_is_clean_on_the_checkout(capsys):
-    code, out, err = run(capsys, "derive", "--check")
-    assert code == 0, err
-    assert "match a fresh regeneration" in out
-
-
 def test_check_names_a_stale_file(tmp_path):
-    # one regeneration for the three checks (each would make the same again: the code and
-    # the inputs do not change in between); test_derive_check_is_clean_on_the_checkout
-    # runs check's own
-    built = build_files(shipped_targets(), index=True)
+    # one regeneration of two targets for the three checks (each would make the same
+    # again: the code and the inputs do not change in between); the whole shipped set's
+    # `gearsym derive --check` is .ci/run's own step, after the tests
+    two = [p for p in shipped_targets() if p.stem in ("siso", "tiso")]
+    assert len(two) == 2
+    built = build_files(two, index=True)
     write_files(built.files, tmp_path)
     assert check(tmp_path, built) == ["docs/stiffness.png (missing)"]
     write_stiffness_figure(tmp_path)

@@ -111,6 +111,7 @@ def test_frequency_response_in_lambda_runs(capsys, tmp_path):
     assert out.startswith("hb: ")
 
 
+@pytest.mark.slow
 def test_a_wide_range_on_the_dead_zone_never_steps_below_zero_frequency(capsys, tmp_path):
     code, out, err = run(
         capsys,

@@ -42,6 +42,7 @@ def test_records_files_and_folds(capsys, tmp_path):
         assert e["hill_vs_monodromy"] < 10 * max(tail, 1e-12) ** 0.5
 
 
+@pytest.mark.slow
 def test_shooting_and_harmonic_balance_find_the_same_folds(capsys, tmp_path):
     # Reference: shooting continuation (monodromy, located by bisection on det(M - I)),
     # an independent method, over the first overhang of the light-load response.

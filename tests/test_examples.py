@@ -52,6 +52,7 @@ def test_every_example_is_tested_here():
     ]
 
 
+@pytest.mark.slow
 def test_planetary(tmp_path):
     # the marine stage's fixed-carrier modes: 1 rigid-body, 6 translational pairs, 5
     # rotational (Lin and Parker's structure for 3 planets: no planet modes)

@@ -32,6 +32,7 @@ def peak_mb(args: list[str], cwd) -> tuple[int, float]:
     return int(out[0]), int(out[1]) / 1024.0  # kB on Linux
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(sys.platform != "linux", reason="ru_maxrss is in kB on Linux only")
 @pytest.mark.parametrize(
     "scene,periods,limit_mb",

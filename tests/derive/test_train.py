@@ -501,6 +501,7 @@ def test_a_cached_trains_model_loads_without_sympy():
     assert done.stdout.strip() == "False"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "name, values",
     [("back-to-back-rig", {"mesh_frequency_hz": 5000.0}), ("lin-parker-1999-3-backlash", {})],

@@ -166,6 +166,7 @@ def test_gearsym_map_without_a_compiler_gives_the_compiled_verdicts(tmp_path):
         assert abs(a["lyapunov"] - b["lyapunov"]) <= 10 * RTOL / period
 
 
+@pytest.mark.slow
 def test_map_cli_without_a_compiler_is_one_warning_line(tmp_path):
     code, lines = _cli_map(tmp_path, "none")
     assert code == 0, lines
@@ -176,6 +177,7 @@ def test_map_cli_without_a_compiler_is_one_warning_line(tmp_path):
     assert (tmp_path / "map" / "map.json").exists()
 
 
+@pytest.mark.slow
 def test_a_compiler_that_fails_is_one_bug_report_line_and_still_a_map(tmp_path):
     code, lines = _cli_map(tmp_path, "false")
     assert code == 0, lines

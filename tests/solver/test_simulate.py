@@ -46,6 +46,7 @@ def test_linear_limit_matches_the_closed_form_steady_state(linear_system, method
     assert np.max(np.abs(tr.x - exact)) < 1e-6
 
 
+@pytest.mark.slow
 def test_all_methods_reach_the_steady_state(linear_system):
     for method in METHODS:
         tr = simulate(
