@@ -41,6 +41,14 @@ def _set(target):
             f"{st.planetary.source}: the meshes' phases need sun_teeth and ring_teeth in "
             "[planetary]; give them"
         )
+    if st.carrier_speed_rad_s:  # UnstableAtSpeed (a ValueError) where the set cannot run
+        import numpy as np
+        from gearsym.solver.analysis.modes import rotating_modes
+
+        s = st.as_structure()
+        rotating_modes(
+            s, *(np.asarray(s[key], float) for key in ("mass", "incidence", "stiffness"))
+        )
     return st
 
 

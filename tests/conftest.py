@@ -19,8 +19,11 @@ def diso_model(root):
 
 
 def pytest_collection_modifyitems(items):
-    """The tests marked ``slow`` first, each in its collection order: pytest-xdist deals
-    the first quarter of the items round-robin to its workers, so the long tests start at
-    once on every core instead of leaving one of them running alone at the end (the
-    whole suite's time on two cores is then close to half its summed time)."""
+    """The tests marked ``slow`` first, each in its collection order.  pytest-xdist
+    (``--dist load``) sends each worker a block of consecutive items at the start and then
+    refills whichever worker frees up from the items left, so the long tests all start
+    early, the short ones fill in round them, and no long test is left running alone at
+    the end (measured: the suite's time on two cores 961 -> 805 s with the trims of the
+    same change; ``--dist loadscope`` 925 s).  The order is the same on every worker, as
+    xdist requires."""
     items.sort(key=lambda item: item.get_closest_marker("slow") is None)

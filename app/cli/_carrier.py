@@ -36,9 +36,14 @@ def run_carrier_sweep(path, st, args) -> int:
 
     lo, hi, num = carrier_speeds(args.speeds)
     if args.parametric or args.floquet or getattr(args, "te", False):
-        which = "--te" if getattr(args, "te", False) else "--parametric"
+        if getattr(args, "te", False):
+            raise Fail(
+                "--speeds with --te: the transmission-error analysis is at the file's carrier "
+                "speed, not over a range of them; run them one at a time"
+            )
         raise Fail(
-            f"--speeds with {which}: that analysis is of the fixed carrier; run them one at a time"
+            "--speeds with --parametric: that analysis is of the fixed carrier; run them one "
+            "at a time"
         )
     if args.plot:
         figure_file(args.plot, "--plot")

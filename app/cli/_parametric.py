@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["print_parametric"]
+__all__ = ["print_parametric", "print_te", "te_response_around"]
 
 SHOWN = 10  # combination bands printed (the widest, relative to their centre)
 
@@ -76,7 +76,7 @@ def print_te(table: dict) -> None:
         f"transmission error ({table['errors']}): what each harmonic l excites; it meets a "
         "mode at the mesh frequency natural / l"
     )
-    if table.get("carrier_speed_rpm"):
+    if table.get("carrier_speed_rpm") and table["equally_spaced"] and table["planets"] >= 3:
         print(
             f"  (carrier at {table['carrier_speed_rpm']:g} rpm: each translational pair is "
             "split into two modes whirling in opposite senses, and a harmonic with l x "
@@ -101,5 +101,13 @@ def te_response_around(st, table: dict) -> dict:
     a half times the highest, 600 frequencies on a log scale."""
     from gearsym.planetary import te_response
 
+    from ._common import Fail
+
     met = [g["mesh_frequency_hz"] for h in table["harmonics"] for g in h["groups"] if g["excited"]]
+    if not met:
+        raise Fail(
+            f"--te --plot: the errors of {table['model']} excite no mode (every harmonic's "
+            "pattern cancels), so there is no resonance to draw; give the errors another "
+            "phase or leave --plot out"
+        )
     return te_response(st, 0.5 * min(met), 1.5 * max(met), 600, log=True)

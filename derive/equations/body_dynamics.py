@@ -33,12 +33,18 @@ The variation ``v_j = sum_l c_l cos(h_l omega tau) + s_l sin(h_l omega tau)``, e
 its own multiple ``h_l`` of the forcing frequency ``omega``.
 
 **A rotating frame** (``Bodies.frame``: a planetary set's carrier turning at ``Omega``,
-``planetary.py``) adds ``- Omega G q' + Omega^2 K_Omega q`` to the forces, both linear and
-with ``K_Omega phi_0 = 0``.  ``G phi_0`` is not zero (a planet moving radially changes the
-set's moment of inertia), so the rigid coordinate ``s = phi_0^T M q`` is no longer at rest:
-``p = s' + Omega phi_0^T G q`` is conserved (``phi_0^T`` times the equations: every other
-term vanishes), and with ``p = 0`` (the frame turns with the set's momentum)
-``s' = - Omega phi_0^T G T y`` follows from ``y`` alone, ``s`` itself entering nowhere.  With
+``planetary.py``) adds ``- Omega G q' + Omega^2 K_Omega q`` to the forces, both linear.  The
+rigid-body rotation ``phi_0`` is then the null vector of ``K - Omega^2 K_Omega``
+(:func:`frame_rotation`), not of ``R``: its meshes' rows of ``R phi_0`` are zero, its
+planets' bearings' tangential rows are not (``d / r_c``, the spring turning with the set at
+its static stretch ``d``).  The dampers act on ``R T y'`` only: they are taken not to see
+that turning, which is no stretch.  ``G phi_0`` is not zero (a planet moving radially
+changes the set's moment of inertia), so the rigid coordinate ``s = phi_0^T M q`` is no
+longer at rest: ``p = s' + Omega phi_0^T G q`` is conserved (``phi_0^T`` times the
+equations: the stiffness terms vanish with ``(K - Omega^2 K_Omega) phi_0 = 0``, the meshes'
+with their rows, the load by the carrier's reaction, the dampers as just said), and with
+``p = 0`` (the frame turns with the set's momentum) ``s' = - Omega phi_0^T G T y`` follows
+from ``y`` alone, ``s`` itself entering nowhere.  With
 ``q = T y + phi_0 s / m_0`` (``m_0 = phi_0^T M phi_0``) the frame's force on ``y`` is
 
     ``- Omega T^T G T y' + Omega^2 (T^T K_Omega T - g g^T / m_0) y``,  ``g = T^T G phi_0``,

@@ -128,6 +128,25 @@ def scales(st: PlanetaryStructure) -> dict:
     }
 
 
+def _definite(st: PlanetaryStructure) -> None:
+    """``InputError`` where the carrier's speed makes the stiffness ``K - Omega^2 K_Omega``
+    indefinite (as ``gearsym modes`` refuses it): the set diverges there, or is held at
+    best by its gyroscopic terms, which damping turning with the carrier undoes."""
+    R, k, m = st.incidence, np.asarray(st.stiffness), np.asarray(st.mass)
+    K = R.T @ (k[:, None] * R) - st.carrier_speed_rad_s**2 * st.centripetal
+    w2 = np.linalg.eigvalsh(K / np.sqrt(np.outer(m, m)))
+    count = int(np.sum(w2 < -1e-10 * np.max(np.abs(w2))))
+    if count:
+        raise InputError(
+            st.planetary.source,
+            "planetary.carrier_speed_rpm",
+            f"at {st.planetary.carrier_speed_rpm:g} rpm the centripetal terms make the "
+            f"stiffness indefinite ({count} negative direction{'s' if count > 1 else ''}): "
+            "the set diverges, or is held at best by its gyroscopic terms, which the "
+            "dampers undo; lower the speed",
+        )
+
+
 def _errors(st: PlanetaryStructure) -> dict:
     """mesh row index -> ((l, c_l, s_l), ...): each mesh's transmission error in m (its
     kind's harmonics, delayed by the mesh's phase as its stiffness is); excess material on
@@ -195,6 +214,8 @@ def derive_dynamics(st: PlanetaryStructure) -> PlanetaryDynamics:
     frame = (
         (st.carrier_speed_rad_s, st.gyroscopic, st.centripetal) if st.carrier_speed_rad_s else None
     )
+    if frame is not None:
+        _definite(st)
     bodies = replace(bodies, errors=_errors(st), frame=frame)
     return BodyDynamics(
         structure=st,

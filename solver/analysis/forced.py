@@ -30,7 +30,7 @@ magnitude over a mesh period from the harmonics summed on 64 samples.
 **A turning carrier** (the structure's ``carrier_speed_rad_s``, ``G`` and ``K_Omega``):
 ``K`` becomes ``K - W^2 K_Omega`` and ``C`` becomes ``C + W G``.  The modes are then
 complex (``modes.rotating_modes``): for ``lambda = i w`` the pencil ``lambda^2 M + lambda W G +
-K'`` equals its own conjugate transpose at ``-i w`` (``G`` skew), so a mode's left
+K' = K' - w^2 M + i w W G`` is Hermitian (``G`` real and skew), so a mode's left
 eigenvector is its right one ``x`` and harmonic ``l`` forces it through ``x^H F_l``, ``x``
 normalised to ``x^H M x = 1``.
 """

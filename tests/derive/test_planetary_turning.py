@@ -144,3 +144,25 @@ def test_it_follows_the_full_equations_through_tooth_separation(turning):
     # and by 6e-6 even with every tooth in contact (both tried)
     err = np.max(np.abs(reduced - delta_full))
     assert math.isfinite(err) and err < 1e-5 * np.max(np.abs(delta_full)), err
+
+
+def test_a_speed_that_makes_the_stiffness_indefinite_is_refused_and_the_audit_says_the_frame():
+    """At 50,000 rpm (below the bearings' limit) the four-planet set's stiffness ``K -
+    W^2 K_Omega`` has negative directions, as ``gearsym modes`` finds: the nonlinear model
+    and the transmission-error response refuse it too, in one line each.  At 3000 rpm the
+    audit page states the frame's terms of the nonlinear model."""
+    from gearsym.derive.emit.audit_planetary import planetary_page
+    from gearsym.derive.equations.planetary_dynamics import derive_dynamics
+    from gearsym.derive.input.reader import InputError
+    from gearsym.planetary import te_response
+    from gearsym.solver.analysis.modes import UnstableAtSpeed
+
+    fast = derive_planetary(replace(example(4), dynamics=DYN, carrier_speed_rpm=50000.0))
+    with pytest.raises(InputError, match="indefinite") as err:
+        derive_dynamics(fast)
+    assert "\n" not in str(err.value)
+    with pytest.raises(UnstableAtSpeed, match="indefinite"):
+        te_response(replace(fast, phases=((0.0, 0.0),) * 4), 100.0, 200.0)
+    st = derive_planetary(replace(example(3), dynamics=DYN, carrier_speed_rpm=RPM))
+    page = planetary_page(st, "gearsym derive x", "x.toml")
+    assert f"The carrier turns at {RPM:g} rpm" in page and "momentum zero" in page
