@@ -103,7 +103,7 @@ def build_files(
     """Derive every target in ``paths``; return the models and the files' text.
     ``overrides`` set scene parameters, or open values (``derive.open_values``), which
     give each target's variant."""
-    from .input.open_values import is_open_value, with_open_values
+    from .input.open_values import is_open_value
     from .input.planetary import is_planetary
     from .input.train import is_train
 
@@ -120,14 +120,20 @@ def build_files(
             "--set to the command that runs it)",
         )
     derived: dict = {}
+    jobs = [(p, rest, opened) for p in paths if p not in planetary and p not in trains]
+    pool = _pool(len(jobs))
+    pending = pool.map(_derive_one, jobs) if pool else None  # runs while the sets derive
     files.update(planetary_files(planetary + (shipped_planetary() if index else []), derived))
     files.update(train_files(trains + (shipped_trains() if index else []), derived))
-    for path in [p for p in paths if p not in planetary and p not in trains]:
-        scene = with_open_values(load_target(path, rest or None), **opened)
-        model = derive_model(scene)
-        command = f"gearsym derive {display_path(path)}"
-        files[f"generated/{model.name}.py"] = emit_module(model, command)
-        files[f"docs/derivation/{model.name}.md"] = audit_page(model, command)
+    done = list(pending) if pool else [None] * len(jobs)
+    if pool:
+        pool.shutdown()
+    for job, result in zip(jobs, done, strict=True):
+        # a target a worker could not derive (or no workers) is derived here, where its
+        # error is raised as the user should see it
+        model, module, page = result or _derive_one(job, quiet=False)
+        files[f"generated/{model.name}.py"] = module
+        files[f"docs/derivation/{model.name}.md"] = page
         models.append(model)
     names = [m.name for m in models]
     if len(set(names)) != len(names):
@@ -152,6 +158,36 @@ def build_files(
             load_topology(_reference_topology()), "gearsym derive", Path(STIFFNESS_FIGURE).name
         )
     return Built(tuple(models), files)
+
+
+def _derive_one(job, quiet: bool = True):
+    """``(model, module text, audit page)`` of one target; ``quiet``: None on any error (a
+    worker's exception need not survive pickling; the caller derives it again)."""
+    from .input.open_values import with_open_values
+
+    path, rest, opened = job
+    try:
+        scene = with_open_values(load_target(path, rest or None), **opened)
+        model = derive_model(scene)
+        command = f"gearsym derive {display_path(path)}"
+        return model, emit_module(model, command), audit_page(model, command)
+    except Exception:
+        if quiet:
+            return None
+        raise
+
+
+def _pool(jobs: int):
+    """Worker processes for ``jobs`` derivations (each a few seconds of SymPy, independent
+    of the others), or None where one process is as quick: fewer than four targets (a
+    user's own), one core, or ``GEARSYM_DERIVE_WORKERS=1``."""
+    import os
+    from concurrent.futures import ProcessPoolExecutor
+
+    workers = int(os.environ.get("GEARSYM_DERIVE_WORKERS", os.cpu_count() or 1))
+    if jobs < 4 or workers < 2:
+        return None
+    return ProcessPoolExecutor(max_workers=min(workers, jobs))
 
 
 STIFFNESS_PAGE = "docs/stiffness.md"
