@@ -125,9 +125,11 @@ def build_files(
     pending = pool.map(_derive_one, jobs) if pool else None  # runs while the sets derive
     files.update(planetary_files(planetary + (shipped_planetary() if index else []), derived))
     files.update(train_files(trains + (shipped_trains() if index else []), derived))
-    done = list(pending) if pool else [None] * len(jobs)
-    if pool:
-        pool.shutdown()
+    try:
+        done = list(pending) if pool else [None] * len(jobs)
+    finally:  # Ctrl-C: the workers (which ignore it) finish their target and stop
+        if pool:
+            pool.shutdown(wait=False, cancel_futures=True)
     for job, result in zip(jobs, done, strict=True):
         # a target a worker could not derive (or no workers) is derived here, where its
         # error is raised as the user should see it
@@ -187,7 +189,14 @@ def _pool(jobs: int):
     workers = int(os.environ.get("GEARSYM_DERIVE_WORKERS", os.cpu_count() or 1))
     if jobs < 4 or workers < 2:
         return None
-    return ProcessPoolExecutor(max_workers=min(workers, jobs))
+    return ProcessPoolExecutor(max_workers=min(workers, jobs), initializer=_ignore_interrupt)
+
+
+def _ignore_interrupt() -> None:
+    """A worker leaves Ctrl-C to the command, which stops and says so in one line."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 STIFFNESS_PAGE = "docs/stiffness.md"
