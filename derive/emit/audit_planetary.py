@@ -187,6 +187,7 @@ def _nonlinear(st: PlanetaryStructure) -> str:
         "rotation, its momentum zero, adds the stiffening `−Ω_c² g gᵀ / m_0` of its "
         "Coriolis coupling to the planets' radial motion (`derive/equations/"
         "body_dynamics.py`); the speed stays the file's while the mesh frequency moves."
+        + _meshing_at_speed(ps)
         if ps.carrier_speed_rpm
         else ""
     )
@@ -198,6 +199,27 @@ def _nonlinear(st: PlanetaryStructure) -> str:
         f"(`{s['reference']}`'s stiffness on the mass its deflection sees); operating point "
         f"{d.mesh_frequency_hz:g} Hz of mesh frequency, ω = {s['omega']:.6g}, and "
         f"f_s = {s['f_s']:.6g}.{frame}\n"
+    )
+
+
+def _meshing_at_speed(ps) -> str:
+    """What the carrier's speed makes of the mesh frequency where the ring alone is held
+    and its teeth are known (``Z_r n_c / 60``), beside the file's operating point."""
+    held = [j for j in ("carrier", "ring", "sun") if ps.members[j].torsional > 0]
+    if ps.ring_teeth is None or held != ["ring"]:
+        return ""
+    turning = ps.ring_teeth * abs(ps.carrier_speed_rpm) / 60.0
+    said = ps.dynamics.mesh_frequency_hz
+    agree = abs(said - turning) <= 1e-3 * turning
+    return (
+        f" With the ring held, {abs(ps.carrier_speed_rpm):g} rpm turns the meshes at Z_r n_c "
+        f"/ 60 = {turning:.6g} Hz"
+        + (
+            ", the file's operating point."
+            if agree
+            else f"; the file's operating point is {said:g} Hz, so there the mesh excitation "
+            "and the frame's terms belong to two different speeds."
+        )
     )
 
 

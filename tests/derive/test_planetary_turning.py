@@ -166,3 +166,21 @@ def test_a_speed_that_makes_the_stiffness_indefinite_is_refused_and_the_audit_sa
     st = derive_planetary(replace(example(3), dynamics=DYN, carrier_speed_rpm=RPM))
     page = planetary_page(st, "gearsym derive x", "x.toml")
     assert f"The carrier turns at {RPM:g} rpm" in page and "momentum zero" in page
+
+
+def test_the_audit_says_which_mesh_frequency_the_speed_gives():
+    """The shipped turning set with backlash: its ring alone held, 89 teeth at 3000 rpm
+    turn the meshes at 89 x 3000 / 60 = 4450 Hz, its operating point; the same set with an
+    operating point of 1000 Hz is told that its excitation and frame belong to two
+    speeds."""
+    from gearsym.derive.emit.audit_planetary import planetary_page
+    from gearsym.derive.input.planetary import load_planetary
+    from gearsym.derive.input.scene import resolve_target
+
+    ps = load_planetary(resolve_target("lin-parker-1999-3-turning-backlash"))
+    assert ps.carrier_speed_rpm == RPM and ps.ring_teeth == 89
+    page = planetary_page(derive_planetary(ps), "gearsym derive x", "x.toml")
+    assert "Z_r n_c / 60 = 4450 Hz, the file's operating point." in page
+    other = replace(ps, dynamics=replace(ps.dynamics, mesh_frequency_hz=1000.0))
+    page = planetary_page(derive_planetary(other), "gearsym derive x", "x.toml")
+    assert "the file's operating point is 1000 Hz" in page and "two different speeds" in page
