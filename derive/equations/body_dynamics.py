@@ -67,6 +67,7 @@ __all__ = [
     "Bodies",
     "build",
     "frame_rotation",
+    "frame_stiffness",
     "reduction",
     "structure_mapping",
 ]
@@ -162,6 +163,13 @@ def reduction(physical, mass, R, rigid: int, phi=None):
     return T, physical[p], phi
 
 
+def frame_stiffness(R, k, frame) -> np.ndarray:
+    """``K - Omega^2 K_Omega`` over ``q``: the springs' stiffness and the rotating frame's
+    centripetal terms (``frame``: ``(Omega, G, K_Omega)``)."""
+    speed, _, K_omega = frame
+    return R.T @ (np.asarray(k)[:, None] * R) - speed**2 * np.asarray(K_omega, dtype=float)
+
+
 def frame_rotation(mass, R, k, frame) -> np.ndarray:
     """The rigid-body rotation of a set in a rotating frame (``frame``: ``(Omega, G,
     K_Omega)``): the null vector of ``K - Omega^2 K_Omega``, not of ``R``.  Turning with the
@@ -169,8 +177,7 @@ def frame_rotation(mass, R, k, frame) -> np.ndarray:
     by ``(1 + d / r_c)`` times the carrier's ``u_c``: the bearing's tangential "deflection"
     in this mode is the spring turning with the set, which ``K_Omega``'s load term on
     ``u_c`` balances (``planetary.py``), and the meshes' deflections stay zero."""
-    speed, _, K_omega = frame
-    K = R.T @ (np.asarray(k)[:, None] * R) - speed**2 * np.asarray(K_omega, dtype=float)
+    K = frame_stiffness(R, k, frame)
     m = np.asarray(mass, dtype=float)
     w2, V = np.linalg.eigh(K / np.sqrt(np.outer(m, m)))
     return V[:, np.argmin(np.abs(w2))] / np.sqrt(m)

@@ -45,7 +45,14 @@ import numpy as np
 
 from ..input.planetary import needs_dynamics  # re-exported: the derivation's check
 from ..input.reader import InputError
-from .body_dynamics import Bodies, BodyDynamics, build, frame_rotation, reduction
+from .body_dynamics import (
+    Bodies,
+    BodyDynamics,
+    build,
+    frame_rotation,
+    frame_stiffness,
+    reduction,
+)
 from .planetary import PlanetaryStructure, planetary_meshes
 
 __all__ = ["PlanetaryDynamics", "derive_dynamics", "needs_dynamics", "scales"]
@@ -66,8 +73,7 @@ def _pivot(st: PlanetaryStructure):
         )
     phi = None
     if st.carrier_speed_rad_s and st.rigid_body_modes:
-        frame = (st.carrier_speed_rad_s, st.gyroscopic, st.centripetal)
-        phi = frame_rotation(st.mass, st.incidence, st.stiffness, frame)
+        phi = frame_rotation(st.mass, st.incidence, st.stiffness, _frame(st))
     return reduction(st.physical, st.mass, st.incidence, st.rigid_body_modes, phi)
 
 
@@ -128,12 +134,19 @@ def scales(st: PlanetaryStructure) -> dict:
     }
 
 
+def _frame(st: PlanetaryStructure):
+    """``(Omega, G, K_Omega)`` of a turning carrier, or None."""
+    if not st.carrier_speed_rad_s:
+        return None
+    return st.carrier_speed_rad_s, st.gyroscopic, st.centripetal
+
+
 def _definite(st: PlanetaryStructure) -> None:
     """``InputError`` where the carrier's speed makes the stiffness ``K - Omega^2 K_Omega``
     indefinite (as ``gearsym modes`` refuses it): the set diverges there, or is held at
     best by its gyroscopic terms, which damping turning with the carrier undoes."""
-    R, k, m = st.incidence, np.asarray(st.stiffness), np.asarray(st.mass)
-    K = R.T @ (k[:, None] * R) - st.carrier_speed_rad_s**2 * st.centripetal
+    m = np.asarray(st.mass)
+    K = frame_stiffness(st.incidence, st.stiffness, _frame(st))
     w2 = np.linalg.eigvalsh(K / np.sqrt(np.outer(m, m)))
     count = int(np.sum(w2 < -1e-10 * np.max(np.abs(w2))))
     if count:
@@ -211,9 +224,7 @@ def derive_dynamics(st: PlanetaryStructure) -> PlanetaryDynamics:
         reference=ref,
     )
     scale = scales(st)
-    frame = (
-        (st.carrier_speed_rad_s, st.gyroscopic, st.centripetal) if st.carrier_speed_rad_s else None
-    )
+    frame = _frame(st)
     if frame is not None:
         _definite(st)
     bodies = replace(bodies, errors=_errors(st), frame=frame)
