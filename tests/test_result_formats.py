@@ -221,6 +221,32 @@ def test_long_arrays_are_written_in_blocks_as_the_same_text(tmp_path):
         assert np.allclose(got[export._BLOCK + 2 :], x[export._BLOCK + 2 :], rtol=0, atol=0)
 
 
+def test_a_table_of_plain_numbers_is_the_text_csv_writer_writes(tmp_path):
+    """Rows of finite floats and ints take the fast path (``repr`` joined by commas); the
+    reference is the standard library's ``csv.writer`` on the same rows, with blocks that
+    fall back to it (a NaN, a bool, a NumPy scalar, a text) mixed in."""
+    import io
+
+    from gearsym.solver import export
+
+    rng = np.random.default_rng(7)
+    rows = [
+        [float(v), i, -0.0, 1e-300 * v, *rng.standard_normal(5).tolist(), 10**20 + i]
+        for i, v in enumerate(rng.standard_normal(2 * export._BLOCK + 3).tolist())
+    ]
+    odd = [list(r) for r in rows[:4]]
+    odd[0][2], odd[1][1], odd[2][3], odd[3][4] = math.nan, True, np.float64(2.5), "a,b"
+    columns = ["p", "point", "z", "tiny", *"abcde", "big"]
+    for table in (rows, odd, rows[:3] + odd + rows[3:]):
+        export.save_csv(tmp_path / "t.csv", {}, columns, table)
+        expected = io.StringIO()
+        writer = csv.writer(expected, lineterminator="\n")
+        writer.writerow(columns)
+        writer.writerows([export._cell(v) for v in r] for r in table)
+        assert (tmp_path / "t.csv").read_text(encoding="utf-8") == expected.getvalue()
+    assert export._plain(rows) and not any(export._plain([r]) for r in odd)
+
+
 def test_a_trajectory_file_carries_the_header_block(tmp_path):
     import gearsym
 
