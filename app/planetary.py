@@ -91,24 +91,22 @@ def parametric_instabilities(target, *, floquet: bool = False) -> dict:
     ``floquet``, each primary band's edges also by the Floquet multipliers, and for a
     suppressed one whether they stay on the unit circle at its centre
     (``solver.analysis.parametric``).
-    Raises ``ValueError`` for a set without a variation or with a carrier speed."""
+    With a turning carrier, the bands of the set's modes at its speed (gyroscopic and
+    centripetal terms: each translational pair split in two).
+    Raises ``ValueError`` for a set without a variation, ``UnstableAtSpeed`` (a
+    ``ValueError``) for one that cannot run at its carrier's speed."""
     from gearsym.derive.equations.planetary import planetary_meshes
     from gearsym.solver.analysis.parametric import (
         Meshes,
         combination_instabilities,
         floquet_band,
+        holding,
         multipliers,
         primary_instabilities,
         unstable,
     )
 
     st = target if hasattr(target, "as_structure") else load(target)
-    if st.planetary.carrier_speed_rpm:
-        raise ValueError(
-            f"{st.planetary.name}: the parametric analysis is of the fixed-carrier model "
-            "(no gyroscopic terms), and the set turns its carrier: remove carrier_speed_rpm "
-            "for it"
-        )
     v = st.planetary.variation
     if v is None or st.phases is None:
         raise ValueError(
@@ -122,8 +120,20 @@ def parametric_instabilities(target, *, floquet: bool = False) -> dict:
     def hz(w: float) -> float:
         return w / (2 * math.pi)
 
+    primaries = primary_instabilities(structure, meshes, v.harmonics)
+    pairs = combination_instabilities(structure, meshes, v.harmonics)
+
+    def inside(Omega: float) -> list[str]:
+        """The first-order bands kept by the phasing that hold ``Omega``, in words."""
+        out = []
+        for other in holding(primaries + pairs, Omega):
+            modes = " + ".join(str(i[0] + 1) for i in (other.modes, other.partner) if i)
+            freqs = " + ".join(f"{hz(w):.1f}" for w in (other.omega, other.omega_partner) if w)
+            out.append(f"the l = {other.l} band of mode {modes} ({freqs} Hz)")
+        return out
+
     bands = []
-    for ins in primary_instabilities(structure, meshes, v.harmonics):
+    for ins in primaries:
         band = {
             "harmonic": ins.l,
             "modes": [i + 1 for i in ins.modes],
@@ -139,6 +149,9 @@ def parametric_instabilities(target, *, floquet: bool = False) -> dict:
             band["floquet_stable_at_centre"] = not unstable(
                 multipliers(structure, meshes, ins.centre)
             )
+            # unstable there: inside another mode's band (at speed a split pair's bands
+            # overlap), else a band of higher order
+            band["floquet_inside"] = [] if band["floquet_stable_at_centre"] else inside(ins.centre)
         elif floquet:
             try:
                 band["floquet_hz"] = [hz(e) for e in floquet_band(structure, meshes, ins)]
@@ -158,10 +171,11 @@ def parametric_instabilities(target, *, floquet: bool = False) -> dict:
             "upper_hz": hz(ins.upper),
             "suppressed": ins.suppressed,
         }
-        for ins in combination_instabilities(structure, meshes, v.harmonics)
+        for ins in pairs
     ]
     return {
         "model": st.planetary.name,
+        "carrier_speed_rpm": st.planetary.carrier_speed_rpm or 0.0,
         "method": "first order (multiple scales): primary instabilities l Omega = 2 omega "
         "and combination instabilities l Omega = omega_1 + omega_2",
         "sun_planet": {"contact_ratio": v.sun[0], "amplitude": v.sun[1]},

@@ -42,8 +42,8 @@ def run_carrier_sweep(path, st, args) -> int:
                 "speed, not over a range of them; run them one at a time"
             )
         raise Fail(
-            "--speeds with --parametric: that analysis is of the fixed carrier; run them one "
-            "at a time"
+            "--speeds with --parametric: that analysis is at the file's carrier speed, not "
+            "over a range of them; run them one at a time"
         )
     if args.plot:
         figure_file(args.plot, "--plot")

@@ -32,17 +32,23 @@ def print_parametric(table: dict) -> None:
         f"{r['amplitude']:g}; ring meshes {table['ring_sun_phase']:g} mesh periods after "
         "their sun meshes"
     )
+    if table.get("carrier_speed_rpm"):
+        print(
+            f"  carrier at {table['carrier_speed_rpm']:g} rpm: the bands of the modes at that "
+            "speed (gyroscopic and centripetal terms; each translational pair split in two)"
+        )
     print(f"  {'l':>2}  {'type':<13}  {'natural Hz':>10}  mesh frequency band (Hz)")
     for b in table["bands"]:
         head = f"  {b['harmonic']:2d}  {b['type']:<13}  {b['natural_hz']:10.1f}  "
         if b["suppressed"]:
             line = head + "suppressed by the phasing (first order)"
             if "floquet_stable_at_centre" in b:
-                line += (
-                    "; Floquet: stable at its centre"
-                    if b["floquet_stable_at_centre"]
-                    else "; Floquet: unstable at its centre (a higher-order band)"
-                )
+                if b["floquet_stable_at_centre"]:
+                    line += "; Floquet: stable at its centre"
+                elif b["floquet_inside"]:
+                    line += f"; Floquet: unstable at its centre, inside {b['floquet_inside'][0]}"
+                else:
+                    line += "; Floquet: unstable at its centre (a higher-order band)"
             print(line)
             continue
         if "floquet_hz" in b and b["floquet_hz"] is None:

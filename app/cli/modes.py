@@ -228,12 +228,6 @@ def _planetary(path, args) -> int:
             f"--te: {path} has no sun_teeth and ring_teeth in [planetary], which the meshes' "
             "phases need; add them"
         )
-    if args.parametric and ps.carrier_speed_rpm:
-        raise Fail(
-            f"--parametric: {path} turns the carrier (carrier_speed_rpm = "
-            f"{ps.carrier_speed_rpm:g}); the parametric analysis is of the fixed-carrier "
-            "model, without gyroscopic terms: remove carrier_speed_rpm for it"
-        )
     st = derive_planetary(ps)
     try:
         result = planetary_modes(st.as_structure(), ps.name)

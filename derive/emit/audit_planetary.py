@@ -90,15 +90,16 @@ def planetary_page(st: PlanetaryStructure, command: str, source: str) -> str:
         "The meshes' stiffness variation, each mesh delayed by its phase round the carrier, "
         "enters the linear analysis of parametric instability (`gearsym modes "
         "--parametric`, with a `[planetary.variation]` table and the tooth counts; "
-        "`docs/analysis.md`).\n",
+        "`docs/analysis.md`); with the carrier turning, in the rotating frame.\n",
         _nonlinear(st),
         "The meshes' transmission errors, delayed by the same phases, enter the linear "
         "analysis too: which modes each harmonic excites and which the phasing suppresses "
         "(`gearsym modes --te`), and the meshes' dynamic forces over the mesh frequency "
         "(`gearsym.planetary.te_response`); with the carrier turning, in the rotating "
         "frame.\n",
-        "**Not modelled yet** (issue 26): the rotating frame's terms in the parametric "
-        "analysis (a turning carrier is refused there).\n",
+        "**Not modelled yet** (issue 26): a carrier speed that follows the mesh "
+        "frequency: the nonlinear model's frame terms are at the file's speed whatever "
+        "mesh frequency a sweep or response sets.\n",
         "## Kinematic graph\n",
         f"Bodies ({bodies}): carrier `c`, ring `r`, sun `s` and {n} planets, {spacing}, at "
         f"ψ = {angles} round the carrier. Each planet meshes with the sun (external) and "

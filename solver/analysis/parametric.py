@@ -36,6 +36,23 @@ a rotational mode's ``r_j . phi`` is the same at every planet, so ``G_l`` carrie
 **Floquet.**  :func:`multipliers` integrates the same equations over one mesh period in the
 flexible modal coordinates (``scipy``'s DOP853 on the monodromy matrix) and returns its
 eigenvalues; undamped, a stable set has them all on the unit circle.
+
+**A turning carrier** (the structure's ``carrier_speed_rad_s``, ``gyroscopic`` ``G`` and
+``centripetal`` ``K_W``): ``M q'' + W G q' + (K_0 - W^2 K_W + sum_j k_j v_j r_j r_j^T) q =
+0``.  The modes are complex (``modes.rotating_modes``: ``(K' - w^2 M + i w W G) x = 0``);
+``G`` skew makes ``x``'s conjugate the left eigenvector of the pencil, so the same multiple
+scales (our derivation) project onto ``x^H`` and give the same bands with
+
+    ``G_l = sum_j k_j c_jl (X^H r_j)(X^H r_j)^T``,  ``x^H (M - i W G / (2 w)) x = 1``,
+
+the normalisation that makes the slow equations' ``x^H (2 w M - i W G) x`` equal to ``2 w``,
+as ``Phi^T M Phi = 1`` does without the frame (``x^H G x`` is imaginary, so the norm is real;
+it is positive for a positive definite ``K'``, and refused otherwise).  The turning splits
+each translational pair, so its primary band becomes two, and their sum resonance a
+combination band.  The Floquet multipliers come from the equations in the body
+coordinates' first-order form over one mesh period, restricted to the flexible modes'
+invariant subspace (the rigid-body rotation, a Jordan block at 1, is not driven: the mesh
+rows do not move it).
 """
 
 from __future__ import annotations
@@ -46,7 +63,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.integrate
 
-from .modes import eigenproblem
+from .modes import UnstableAtSpeed, eigenproblem, rotating_modes
 
 __all__ = [
     "Instability",
@@ -54,6 +71,7 @@ __all__ = [
     "combination_instabilities",
     "floquet_band",
     "frequency_groups",
+    "holding",
     "modal_basis",
     "monodromy",
     "multipliers",
@@ -110,10 +128,26 @@ class Instability:
 
 def modal_basis(structure: dict, rigid_tolerance: float = 1e-10):
     """``(omega, Phi, R, k)``: the flexible modes' frequencies (rad/s, ascending) and
-    shapes normalised on ``M`` (``modes.eigenproblem``), ``R`` and ``k``."""
-    w2, vec, _, R, k = eigenproblem(structure)
-    flexible = w2 > rigid_tolerance * np.max(np.abs(w2))
-    return np.sqrt(w2[flexible]), vec[:, flexible], R, k
+    shapes normalised on ``M`` (``modes.eigenproblem``), ``R`` and ``k``; with a turning
+    carrier the complex shapes of ``modes.rotating_modes`` normalised as the module text
+    says (``UnstableAtSpeed`` where the set cannot run at its speed)."""
+    if not structure.get("carrier_speed_rad_s"):
+        w2, vec, _, R, k = eigenproblem(structure)
+        flexible = w2 > rigid_tolerance * np.max(np.abs(w2))
+        return np.sqrt(w2[flexible]), vec[:, flexible], R, k
+    mass, R, k = (np.asarray(structure[key], float) for key in ("mass", "incidence", "stiffness"))
+    f, shapes, rigid = rotating_modes(structure, mass, R, k)
+    omega, X = 2 * math.pi * f[~rigid], shapes[:, ~rigid]
+    WG = float(structure["carrier_speed_rad_s"]) * np.asarray(structure["gyroscopic"], float)
+    norm = np.einsum("ij,i,ij->j", X.conj(), mass, X) - 0.5j / omega * np.einsum(
+        "ij,ik,kj->j", X.conj(), WG, X
+    )
+    if np.any(norm.real <= 0.0):
+        raise UnstableAtSpeed(
+            "a mode's x^H (M - i W G / (2 w)) x is not positive at this carrier speed: the "
+            "first-order bands do not hold there"
+        )
+    return omega, X / np.sqrt(norm.real), R, k
 
 
 def _excitation(basis: tuple, meshes: Meshes, l: int) -> np.ndarray:  # noqa: E741
@@ -125,7 +159,7 @@ def _excitation(basis: tuple, meshes: Meshes, l: int) -> np.ndarray:  # noqa: E7
             continue
         a, b = wave[l - 1]
         c = 0.5 * (a - 1j * b) * np.exp(-2j * math.pi * l * gamma)
-        p = Phi.T @ R[row]
+        p = Phi.conj().T @ R[row]
         G += k[row] * c * np.outer(p, p)
     return G
 
@@ -209,14 +243,57 @@ def monodromy(structure: dict, meshes: Meshes, Omega: float, *, rtol: float = 1e
     """The monodromy matrix over one mesh period at the mesh frequency ``Omega`` (rad/s),
     ``(2n, 2n)`` in the flexible modal coordinates ``(eta, d eta / d(Omega t))``, by DOP853
     at ``rtol``; the energy ``(|eta'|^2 Omega^2 + sum omega_i^2 eta_i^2) / 2`` of the
-    undamped set with constant stiffness is its invariant."""
+    undamped set with constant stiffness is its invariant.  With a turning carrier, the
+    map on the flexible modes' invariant subspace (module text), in the coordinates of
+    their first-order eigenvectors (complex)."""
+    if structure.get("carrier_speed_rad_s"):
+        return _turning_monodromy(structure, meshes, Omega, rtol)
     omega, Phi, R, k = modal_basis(structure)
     n = omega.size
     P = np.array([Phi.T @ R[row] for row in meshes.rows])  # (meshes, n)
     weights = np.array([k[row] for row in meshes.rows])
 
+    v = _waves(meshes)
+
     # in the mesh's angle s = Omega t (one period is 2 pi), so that eta and its
     # derivative are of one size
+    def rhs(s: float, y: np.ndarray) -> np.ndarray:
+        X = y.reshape(2 * n, 2 * n)
+        stiff = (np.diag(omega**2) + P.T @ ((weights * v(s))[:, None] * P)) / Omega**2
+        return np.vstack([X[n:], -stiff @ X[:n]]).ravel()
+
+    return _integrated(rhs, 2 * n, rtol)
+
+
+def _turning_monodromy(structure: dict, meshes: Meshes, Omega: float, rtol: float) -> np.ndarray:
+    """:func:`monodromy` of a set with a turning carrier: the body coordinates ``q`` and
+    ``dq / d(Omega t)`` over one mesh period, then the flexible subspace's map ``A`` with
+    ``Phi V = V A`` (``V`` its first-order eigenvectors; exact, the subspace being invariant)."""
+    mass, R, k = (np.asarray(structure[key], float) for key in ("mass", "incidence", "stiffness"))
+    n = mass.size
+    W = float(structure["carrier_speed_rad_s"])
+    WG = W * np.asarray(structure["gyroscopic"], float)
+    K = R.T @ (k[:, None] * R) - W**2 * np.asarray(structure["centripetal"], float)
+    f, shapes, rigid = rotating_modes(structure, mass, R, k)
+    X, lam = shapes[:, ~rigid], 2j * math.pi * f[~rigid] / Omega
+    V = np.block([[X, X.conj()], [X * lam, (X * lam).conj()]])
+    rows = np.array([R[row] for row in meshes.rows])
+    weights = np.array([k[row] for row in meshes.rows])
+    wave = _waves(meshes)
+
+    def rhs(s: float, y: np.ndarray) -> np.ndarray:
+        Y = y.reshape(2 * n, 2 * n)
+        stiff = K + rows.T @ ((weights * wave(s))[:, None] * rows)
+        accel = -(stiff @ Y[:n] / Omega + WG @ Y[n:]) / (Omega * mass[:, None])
+        return np.vstack([Y[n:], accel]).ravel()
+
+    Phi = _integrated(rhs, 2 * n, rtol)
+    return np.linalg.lstsq(V, Phi @ V, rcond=None)[0]
+
+
+def _waves(meshes: Meshes):
+    """``v(s)``: every mesh's relative stiffness variation at the mesh angle ``s``."""
+
     def v(s: float) -> np.ndarray:
         out = np.zeros(len(meshes.rows))
         for j, (gamma, wave) in enumerate(zip(meshes.phases, meshes.waveform, strict=True)):
@@ -225,22 +302,30 @@ def monodromy(structure: dict, meshes: Meshes, Omega: float, *, rtol: float = 1e
                 out[j] += a * math.cos(phase) + b * math.sin(phase)
         return out
 
-    def rhs(s: float, y: np.ndarray) -> np.ndarray:
-        X = y.reshape(2 * n, 2 * n)
-        stiff = (np.diag(omega**2) + P.T @ ((weights * v(s))[:, None] * P)) / Omega**2
-        return np.vstack([X[n:], -stiff @ X[:n]]).ravel()
+    return v
 
+
+def _integrated(rhs, size: int, rtol: float) -> np.ndarray:
+    """The fundamental matrix of ``rhs`` over one mesh angle ``0 .. 2 pi`` by DOP853."""
     sol = scipy.integrate.solve_ivp(
         rhs,
         (0.0, 2.0 * math.pi),
-        np.eye(2 * n).ravel(),
+        np.eye(size).ravel(),
         method="DOP853",
         rtol=rtol,
         atol=rtol * 1e-2,
     )
     if not sol.success:
         raise RuntimeError(f"the monodromy matrix could not be integrated: {sol.message}")
-    return sol.y[:, -1].reshape(2 * n, 2 * n)
+    return sol.y[:, -1].reshape(size, size)
+
+
+def holding(found: list[Instability], Omega: float) -> list[Instability]:
+    """The bands of ``found`` the phasing keeps (first order) that hold the mesh frequency
+    ``Omega``: where a suppressed band's centre is unstable by the multipliers, whether it
+    lies in another band (at speed a split pair's bands overlap) or is a band of higher
+    order."""
+    return [i for i in found if not i.suppressed and i.lower <= Omega <= i.upper]
 
 
 def unstable(mu: np.ndarray, threshold: float = 1e-7) -> bool:

@@ -213,23 +213,6 @@ def test_cli_and_refusals(tmp_path):
     refused(run("modes", str(fast)), "keep it below")
 
 
-def test_parametric_analysis_refuses_a_turning_carrier(tmp_path):
-    """The parametric analysis is of the fixed-carrier model: with a speed it refuses,
-    in the API and in one line of the CLI, rather than drop the gyroscopic terms."""
-    import gearsym.planetary
-
-    path = variant(
-        tmp_path,
-        "phased-turning",
-        "lin-parker-1999-3-phased",
-        "[planetary]\n",
-        "[planetary]\ncarrier_speed_rpm = 3000\n",
-    )
-    with pytest.raises(ValueError, match="fixed-carrier"):
-        gearsym.planetary.parametric_instabilities(str(path))
-    refused(run("modes", str(path), "--parametric"), "remove carrier_speed_rpm")
-
-
 def test_speeds_the_set_cannot_run_at_are_refused():
     """At 50,000 and 80,000 rpm Lin and Parker's three-planet set's stiffness is
     indefinite (held at best by its gyroscopic terms): refused, saying so."""
