@@ -11,7 +11,7 @@ failed numerically) with one line that says so; no traceback; no file is created
 statement would create a file, which the file check catches).
 
 The seed is fixed (``derandomize``) and the examples bounded, so CI runs the same cases
-every time: 16 draws of anything and 8 of models that can be made (some 17 s each: derive,
+every time: 12 draws of anything and 6 of models that can be made (some 17 s each: derive,
 compile, simulate, map, respond), within CI's time; ``GEARSYM_FUZZ_EXAMPLES`` raises the
 count for a longer local run.
 """
@@ -33,7 +33,7 @@ hypothesis = pytest.importorskip("hypothesis")
 from hypothesis import HealthCheck, Phase, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
-EXAMPLES = int(os.environ.get("GEARSYM_FUZZ_EXAMPLES", "16"))
+EXAMPLES = int(os.environ.get("GEARSYM_FUZZ_EXAMPLES", "12"))
 
 # Words of C, of the C host file, of the generated Python, and of Python itself.
 WORDS = "int q NAN restrict n j X P DX th0 double np ca x p tau print self INFINITY main prep w0"
