@@ -237,12 +237,15 @@ def test_a_table_of_plain_numbers_is_the_text_csv_writer_writes(tmp_path):
     odd = [list(r) for r in rows[:4]]
     odd[0][2], odd[1][1], odd[2][3], odd[3][4] = math.nan, True, np.float64(2.5), "a,b"
     columns = ["p", "point", "z", "tiny", *"abcde", "big"]
-    for table in (rows, odd, rows[:3] + odd + rows[3:]):
+    # rows that can be read once, and rows that are not lists
+    once = [iter(r) for r in rows[:5]] + [range(3), (1.5, 2)]
+    tables = [(t, t) for t in (rows, odd, rows[:3] + odd + rows[3:])]
+    for table, same in [*tables, (once, [*rows[:5], [0, 1, 2], [1.5, 2]])]:
         export.save_csv(tmp_path / "t.csv", {}, columns, table)
         expected = io.StringIO()
         writer = csv.writer(expected, lineterminator="\n")
         writer.writerow(columns)
-        writer.writerows([export._cell(v) for v in r] for r in table)
+        writer.writerows([export._cell(v) for v in r] for r in same)
         assert (tmp_path / "t.csv").read_text(encoding="utf-8") == expected.getvalue()
     assert export._plain(rows) and not any(export._plain([r]) for r in odd)
 
