@@ -115,7 +115,12 @@ def parametric_instabilities(target, *, floquet: bool = False) -> dict:
         )
     structure = st.as_structure()
     meshes = Meshes(*planetary_meshes(st))
-    labels = [m.label for m in modes(st).modes if m.label != "rigid-body"]
+    flexible = [m for m in modes(st).modes if m.label != "rigid-body"]
+    labels = [m.label for m in flexible]
+
+    def numbers(group) -> list[int]:
+        """The modes of ``group`` (flexible indices) as ``gearsym modes`` numbers them."""
+        return [flexible[i].index for i in group]
 
     def hz(w: float) -> float:
         return w / (2 * math.pi)
@@ -127,16 +132,18 @@ def parametric_instabilities(target, *, floquet: bool = False) -> dict:
         """The first-order bands kept by the phasing that hold ``Omega``, in words."""
         out = []
         for other in holding(primaries + pairs, Omega):
-            modes = " + ".join(str(i[0] + 1) for i in (other.modes, other.partner) if i)
+            sides = [numbers(g) for g in (other.modes, other.partner) if g]
+            modes = " + ".join(", ".join(map(str, side)) for side in sides)
+            plural = "s" if len(sides) > 1 or len(sides[0]) > 1 else ""
             freqs = " + ".join(f"{hz(w):.1f}" for w in (other.omega, other.omega_partner) if w)
-            out.append(f"the l = {other.l} band of mode {modes} ({freqs} Hz)")
+            out.append(f"the l = {other.l} band of mode{plural} {modes} ({freqs} Hz)")
         return out
 
     bands = []
     for ins in primaries:
         band = {
             "harmonic": ins.l,
-            "modes": [i + 1 for i in ins.modes],
+            "modes": numbers(ins.modes),
             "type": labels[ins.modes[0]],
             "natural_hz": hz(ins.omega),
             "centre_hz": hz(ins.centre),
@@ -162,8 +169,8 @@ def parametric_instabilities(target, *, floquet: bool = False) -> dict:
     combinations = [
         {
             "harmonic": ins.l,
-            "modes": [i + 1 for i in ins.modes],
-            "partner": [i + 1 for i in ins.partner],
+            "modes": numbers(ins.modes),
+            "partner": numbers(ins.partner),
             "types": [labels[ins.modes[0]], labels[ins.partner[0]]],
             "natural_hz": [hz(ins.omega), hz(ins.omega_partner)],
             "centre_hz": hz(ins.centre),

@@ -48,7 +48,10 @@ def print_parametric(table: dict) -> None:
                 elif b["floquet_inside"]:
                     line += f"; Floquet: unstable at its centre, inside {b['floquet_inside'][0]}"
                 else:
-                    line += "; Floquet: unstable at its centre (a higher-order band)"
+                    line += (
+                        "; Floquet: unstable at its centre, in no first-order band (a band "
+                        "of higher order, or a kept band wider than first order says)"
+                    )
             print(line)
             continue
         if "floquet_hz" in b and b["floquet_hz"] is None:

@@ -37,12 +37,19 @@ from .test_planetary_speed import refused, run, variant
 RPM = 3000.0
 
 
-def _set(eps: float, rpm: float = RPM):
+def _set(eps: float, rpm: float = RPM, harmonics: int = 1, planets: int = 3):
+    """Lin and Parker's set (three or five equally spaced planets) at ``rpm``, every mesh
+    varying by ``eps`` in each of ``harmonics`` harmonics, delayed by its phase."""
     ps = load_planetary(resolve_target("lin-parker-1999-3"))
-    st = derive_planetary(replace(ps, sun_teeth=31, ring_teeth=89, carrier_speed_rpm=rpm))
+    ps = replace(ps, sun_teeth=31, ring_teeth=89, carrier_speed_rpm=rpm)
+    if planets != 3:
+        angles = tuple(360.0 * n / planets for n in range(planets))
+        ps = replace(ps, angles_deg=angles, equally_spaced=True)
+    st = derive_planetary(ps)
     rows = [i for i, kind in enumerate(st.kinds) if kind == "mesh"]
     phases = [st.phases[int(st.springs[i][2:]) - 1][st.springs[i][0] != "s"] for i in rows]
-    meshes = Meshes(tuple(rows), tuple(phases), tuple(((eps, 0.0),) for _ in rows))
+    wave = ((eps, 0.0),) * harmonics
+    meshes = Meshes(tuple(rows), tuple(phases), tuple(wave for _ in rows))
     return st.as_structure(), meshes
 
 
@@ -60,7 +67,11 @@ def _own_multipliers(S: dict, meshes: Meshes, Omega: float) -> np.ndarray:
         Y = y.reshape(2 * n, 2 * n)
         Kt = K.copy()
         for row, gamma, wave in zip(meshes.rows, meshes.phases, meshes.waveform, strict=True):
-            v = wave[0][0] * math.cos(Omega * t - 2 * math.pi * gamma)
+            v = sum(
+                a * math.cos(h * (Omega * t - 2 * math.pi * gamma))
+                + b * math.sin(h * (Omega * t - 2 * math.pi * gamma))
+                for h, (a, b) in enumerate(wave, start=1)
+            )
             Kt += k[row] * v * np.outer(R[row], R[row])
         return np.vstack([Y[n:], -Minv @ (Kt @ Y[:n] + C @ Y[n:])]).ravel()
 
@@ -135,20 +146,36 @@ def test_first_order_bands_at_speed_against_the_independent_floquet_band():
 
 
 def test_the_split_pair_has_a_sum_band_where_the_phasing_keeps_it():
-    """The whirls' sum resonance l Omega = w_- + w_+ (a combination band at speed, part of
-    the pair's primary band at rest): where first order keeps it, the test's multipliers
-    grow at its centre; where it cuts it, they do not."""
-    S, meshes = _set(0.05)
-    for ins in combination_instabilities(S, meshes, 1):
-        if ins.modes != (0,) or ins.partner != (1,):
-            continue
-        if ins.suppressed:
-            assert _growth(S, meshes, ins.centre) < 1e-7
-        else:
-            assert _growth(S, meshes, ins.centre) > 1e-5
-        break
-    else:
-        raise AssertionError("no combination band of the split pair")
+    """The whirls' sum resonance l Omega = w_- + w_+ (a combination band at speed; at rest
+    part of the pair's own primary band): for the lowest pair (696.5 + 789.3 Hz) the
+    phasing cuts it at l = 1 and 2, and the test's multipliers do not grow at those
+    centres; it keeps it at l = 3 (Z_s l = 93, a multiple of 3), and they grow at its
+    centre at the first-order rate s / (2 sqrt(w_1 w_2)) per unit time, within 10 %."""
+    S, meshes = _set(0.05, harmonics=3)
+    found = combination_instabilities(S, meshes, 3)
+    lowest = [i for i in found if i.modes == (0,) and i.partner == (1,)]
+    assert [(i.l, i.suppressed) for i in lowest] == [(1, True), (2, True), (3, False)]
+    for ins in lowest[:2]:
+        assert _growth(S, meshes, ins.centre) < 1e-7
+    kept = lowest[2]
+    rate = kept.s / (2 * math.sqrt(kept.omega * kept.omega_partner)) * 2 * math.pi / kept.centre
+    assert math.log1p(_growth(S, meshes, kept.centre)) == pytest.approx(rate, rel=0.1)
+
+
+def test_a_multiple_mode_at_speed_is_one_band_whatever_its_basis():
+    """Five equally spaced planets: a planet mode stays double at speed, and the
+    eigensolver's basis of it is not orthonormal in the slow equations' form (its
+    off-diagonal entries reached 0.55: the band came out half as wide).  The first-order
+    band of the lowest planet mode at l = 1 against the test's own multipliers at amplitude
+    0.02: unstable at 0.8 of its half-width from the centre, stable at 1.25."""
+    S, meshes = _set(0.02, planets=5)
+    (ins,) = [
+        i for i in primary_instabilities(S, meshes, 1) if len(i.modes) == 2 and not i.suppressed
+    ][:1]
+    half = 0.5 * (ins.upper - ins.lower)
+    for side in (-1, 1):
+        assert _growth(S, meshes, ins.centre + side * 0.8 * half) > 1e-7
+        assert _growth(S, meshes, ins.centre + side * 1.25 * half) < 1e-7
 
 
 def test_a_slow_carrier_has_the_fixed_carriers_bands():
@@ -211,3 +238,32 @@ def test_a_cut_band_inside_its_partners_band_is_said_to_be_there():
     (kept,) = [i for i in holding(found, cut.centre) if not i.partner]
     assert kept.modes == (cut.modes[0] + 1,) and kept.l == 1
     assert kept.omega / (2 * math.pi) == pytest.approx(6996.1, abs=0.1)
+
+
+def test_the_tables_mode_numbers_are_those_gearsym_modes_prints(tmp_path):
+    """Cooley and Parker's set has no rigid-body mode (every member held or on a bearing
+    that holds it): the bands' mode numbers are the rows of ``gearsym modes`` (0 the
+    lowest), not the flexible modes counted from 1, at rest and at speed."""
+    import gearsym
+
+    for rpm in ("", "carrier_speed_rpm = 3000\n"):
+        path = variant(
+            tmp_path,
+            f"cp4-{len(rpm)}",
+            "cooley-parker-2012-4",
+            "[planetary]\n",
+            f"[planetary]\nsun_teeth = 31\nring_teeth = 89\n{rpm}",
+        )
+        path.write_text(
+            path.read_text(encoding="utf-8")
+            + "\n[planetary.variation]\nsun_planet = { contact_ratio = 1.6, amplitude = 0.2 }\n"
+            "ring_planet = { contact_ratio = 1.8, amplitude = 0.2 }\nharmonics = 1\n",
+            encoding="utf-8",
+        )
+        listed = gearsym.planetary.modes(str(path)).modes
+        assert listed[0].label != "rigid-body"
+        table = gearsym.planetary.parametric_instabilities(str(path))
+        for band in table["bands"] + table["combinations"]:
+            hz = band["natural_hz"] if "partner" not in band else band["natural_hz"][0]
+            assert listed[band["modes"][0]].frequency_hz == pytest.approx(hz, rel=1e-9)
+        assert min(b["modes"][0] for b in table["bands"]) == 0
