@@ -128,9 +128,11 @@ def parametric_figure(table: dict):
     ax.set_xlabel("mesh frequency (Hz)")
     ax.set_ylabel("stiffness variation / the stated one")
     s, r = table["sun_planet"], table["ring_planet"]
+    speed = table.get("carrier_speed_rpm")
     ax.set_title(
         f"{table['model']}: parametric instability, first order "
         f"(harmonics 1 to {table['harmonics']})"
+        + (f"\ncarrier at {speed:g} rpm: the modes at that speed" if speed else "")
     )
     legend_below(
         fig,
