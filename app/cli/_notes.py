@@ -8,9 +8,10 @@ notes while it loads its models and says them when it has run to its end
 
 from __future__ import annotations
 
+import math
 import sys
 
-__all__ = ["forget", "note_backlash", "note_torques", "say"]
+__all__ = ["forget", "note_backlash", "note_frame", "note_run", "note_torques", "say"]
 
 _PENDING: dict[str, str] = {}  # model name -> note of the command under way
 
@@ -43,6 +44,46 @@ def note_torques(system, swept: dict | None = None):
     if note:
         _PENDING.setdefault(f"{system.name} torques", note)
     return system
+
+
+def note_frame(system, swept: dict | None = None):
+    """For a model whose carrier turns (its module's ``FRAME``): note once that the
+    frame's terms stay at the file's speed at the run's mesh frequencies (``system``'s,
+    or those at the ends of ``swept``) where that speed does not give them; return
+    ``system``."""
+    frame = getattr(system.module, "FRAME", None)
+    if not frame:
+        return system
+    ends = [{k: float(v[i]) for k, v in swept.items()} for i in (0, -1)] if swept else [{}]
+    scale = system.module.OMEGA_N / (2 * math.pi)
+    try:
+        hz = sorted({system.with_values(**e).omega * scale for e in ends})
+    except (KeyError, ValueError):  # a value the command itself refuses, in its words
+        return system
+    own = frame["mesh_frequency_of_speed_hz"]
+    if own is None:  # which mesh frequency the speed gives is not known: the file's
+        parameters = system.module.PARAMETERS
+        own = system.module.DEFAULTS[parameters.index("omega")] * scale
+        gives = "the file's operating point is"
+    else:
+        gives = "with the ring held, that speed turns the meshes at"
+    if all(abs(h - own) <= 1e-3 * own for h in hz):
+        return system
+    at = f"{hz[0]:.6g} Hz" if len(hz) == 1 else f"{hz[0]:.6g} to {hz[-1]:.6g} Hz"
+    _PENDING.setdefault(
+        f"{system.name} frame",
+        f"{system.name}: the carrier turns at {frame['carrier_speed_rpm']:g} rpm, the file's "
+        f"speed, at every mesh frequency ({gives} {own:.6g} Hz), so at {at} the mesh "
+        "excitation and the rotating frame's terms belong to two different speeds; another "
+        "speed is another file",
+    )
+    return system
+
+
+def note_run(system, swept: dict):
+    """The notes of a run over ``swept`` (``{name: values}``, the ends count): the torques'
+    balance and a turning carrier's frame (:func:`note_torques`, :func:`note_frame`)."""
+    return note_frame(note_torques(system, swept), swept)
 
 
 def say() -> None:

@@ -11,7 +11,7 @@ __all__ = ["system_of", "unknown_names"]
 def system_of(scene_arg: str, sets: dict[str, float]):
     """The System of a scene (name or path) with ``--set`` values (``gearsym.resolve``),
     a polynomial backlash noted once (``_notes``); a bad scene raises its own InputError."""
-    from gearsym.cli._notes import note_backlash, note_torques
+    from gearsym.cli._notes import note_backlash, note_frame, note_torques
     from gearsym.derive.input.reader import InputError
     from gearsym.resolve import module_for, planetary_path, planetary_system, split_open_values
     from gearsym.solver.system import System
@@ -19,7 +19,7 @@ def system_of(scene_arg: str, sets: dict[str, float]):
     planetary = planetary_path(scene_arg)
     if planetary is not None:  # its nonlinear model (gearsym.planetary.dynamics)
         try:
-            return planetary_system(planetary, **sets)
+            return note_frame(planetary_system(planetary, **sets))
         except KeyError as err:
             said = unknown_names(planetary_system(planetary).module, sets)
             raise Fail(said or f"--set: {err.args[0]}") from None

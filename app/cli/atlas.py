@@ -17,7 +17,7 @@ from ._common import (
     refuse_conflicts,
     require,
 )
-from ._notes import note_torques
+from ._notes import note_run
 from ._output import format_option, units_option, write_result
 from ._system import system_of, unknown_names
 
@@ -244,7 +244,7 @@ def _cmd_map(args) -> int:
         except ValueError as err:
             raise Fail(f"{flag} {name}: {err}") from None
     if resolve is None:  # (an open value's models are derived per value)
-        note_torques(system, {xn: [xv[0], xv[-1]], yn: [yv[0], yv[-1]]})
+        note_run(system, {xn: [xv[0], xv[-1]], yn: [yv[0], yv[-1]]})
     out = out_folder(args.out or f"map_{system.name}_{xn}_{yn}")
     try:
         result = regime_map(

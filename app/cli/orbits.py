@@ -18,7 +18,7 @@ from ._common import (
     require,
 )
 from ._limits import MAX_PERIOD, MAX_SEGMENTS, MAX_SETTLED, MAX_TRIES, MIN_STEP, bounded_shoot
-from ._notes import note_torques
+from ._notes import note_run
 from ._output import branches_document, format_option, units_option, write_result
 from ._start import resolve_start, start_options
 from ._system import system_of, unknown_names
@@ -329,7 +329,7 @@ def _cmd_continue(args) -> int:
         except (KeyError, ValueError) as err:
             said = unknown_names(system.module, [args.param], "--param")
             raise Fail(said or f"{option} {value:g}: {args.param} = {value:g}: {err}") from None
-    note_torques(system, {args.param: [args.from_, args.to]})
+    note_run(system, {args.param: [args.from_, args.to]})
     out = out_folder(args.out or f"continue_{system.name}_{args.param}")
     guess = orbit_guess(start, args.period, args.settle)
     try:

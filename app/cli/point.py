@@ -18,7 +18,7 @@ from ._common import (
     refuse_restated,
     require,
 )
-from ._notes import note_torques
+from ._notes import note_run
 from ._output import format_option, units_option, write_poincare, write_result
 from ._start import resolve_start, start_options
 from ._system import system_of, unknown_names
@@ -312,7 +312,7 @@ def _cmd_sweep(args) -> int:
     except ValueError as err:
         said = unknown_names(system.module, [args.param], "--param")
         raise Fail(said or f"--param {args.param} --range {args.range}: {err}") from None
-    note_torques(system, {args.param: values})
+    note_run(system, {args.param: values})
     out = out_folder(args.out or f"sweep_{system.name}_{args.param}")
     bar = _Bar(len(values), f"{args.param}", enabled=not args.quiet)
     try:

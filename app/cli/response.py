@@ -17,7 +17,7 @@ from ._common import (
     require,
 )
 from ._limits import MAX_PERIOD
-from ._notes import note_torques
+from ._notes import note_run
 from ._output import format_option, units_option, write_result
 from ._system import system_of, unknown_names
 
@@ -225,7 +225,7 @@ def _cmd_response(args) -> int:
             raise Fail(said or f"--param {name}: {err.args[0]}") from None
         except ValueError as err:
             raise Fail(f"--param {args.param}: {name} = {value:g}: {err}") from None
-    note_torques(system, {name: [start, stop]})
+    note_run(system, {name: [start, stop]})
     # the harmonic balance's Jacobian and Hill's matrix: (n (2H + 1))^2 numbers, a few times
     size = system.n * (2 * max(args.harmonics, 8 * args.period) + 1)
     require(32.0 * size**2, f"--harmonics {args.harmonics}", "use fewer harmonics")

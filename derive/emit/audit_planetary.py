@@ -7,6 +7,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..equations.planetary import PlanetaryStructure, rectangular_wave
+from ..equations.planetary_dynamics import mesh_frequency_of_speed
 from ..escape import markdown
 
 __all__ = ["planetary_index", "planetary_name", "planetary_page"]
@@ -206,10 +207,9 @@ def _nonlinear(st: PlanetaryStructure) -> str:
 def _meshing_at_speed(ps) -> str:
     """What the carrier's speed makes of the mesh frequency where the ring alone is held
     and its teeth are known (``Z_r n_c / 60``), beside the file's operating point."""
-    held = [j for j in ("carrier", "ring", "sun") if ps.members[j].torsional > 0]
-    if ps.ring_teeth is None or held != ["ring"]:
+    turning = mesh_frequency_of_speed(ps)
+    if turning is None:
         return ""
-    turning = ps.ring_teeth * abs(ps.carrier_speed_rpm) / 60.0
     said = ps.dynamics.mesh_frequency_hz
     agree = abs(said - turning) <= 1e-3 * turning
     return (

@@ -27,7 +27,7 @@ if TYPE_CHECKING:  # SymPy only to derive: asking for a cached module's hash nee
 
 __all__ = ["FORMAT", "inputs_hash", "planetary_module"]
 
-FORMAT = 9  # of this module's text: a new one derives the cached files again
+FORMAT = 10  # of this module's text: a new one derives the cached files again
 
 
 def inputs_hash(path) -> str:

@@ -33,7 +33,9 @@ delayed by each mesh's phase as its stiffness variation is (``_errors``).
 terms at the file's speed (``planetary.py``), with the rigid-body rotation's momentum, as
 ``body_dynamics.py`` states.  The speed is the file's, fixed: the forcing frequency moves
 without it (a frequency response holds the frame's terms, as Lin and Parker's equations
-hold ``Omega_c`` apart from the mesh frequency); another speed is another file.
+hold ``Omega_c`` apart from the mesh frequency); another speed is another file.  The
+module states the speed and the mesh frequency it gives (``FRAME``), so that a command run
+at another mesh frequency says so.
 """
 
 from __future__ import annotations
@@ -55,7 +57,13 @@ from .body_dynamics import (
 )
 from .planetary import PlanetaryStructure, planetary_meshes
 
-__all__ = ["PlanetaryDynamics", "derive_dynamics", "needs_dynamics", "scales"]
+__all__ = [
+    "PlanetaryDynamics",
+    "derive_dynamics",
+    "mesh_frequency_of_speed",
+    "needs_dynamics",
+    "scales",
+]
 
 
 # the model's record: the same for every model in body coordinates
@@ -191,6 +199,16 @@ def _errors(st: PlanetaryStructure) -> dict:
     return out
 
 
+def mesh_frequency_of_speed(ps) -> float | None:
+    """The mesh frequency (Hz) the carrier's speed gives where the ring alone is held and
+    its teeth are known, ``Z_r n_c / 60`` (the tooth-pass frequency seen from the carrier);
+    else None."""
+    held = [j for j in ("carrier", "ring", "sun") if ps.members[j].torsional > 0]
+    if ps.ring_teeth is None or held != ["ring"]:
+        return None
+    return ps.ring_teeth * abs(ps.carrier_speed_rpm) / 60.0
+
+
 def derive_dynamics(st: PlanetaryStructure) -> PlanetaryDynamics:
     """The nonlinear model of ``st`` (module docstring); ``InputError`` where it cannot
     be built (no ``[planetary.dynamics]``, two rigid-body modes)."""
@@ -240,5 +258,16 @@ def derive_dynamics(st: PlanetaryStructure) -> PlanetaryDynamics:
             ("sun_force_N", "f_s", "force", "positive", "the sun's force on its base circle in N"),
             ("damping_ratio", "zeta", 1.0, "unit", "the damping ratio"),
         ),
+        # a turning carrier's speed, which the frame's terms keep whatever mesh frequency
+        # a run sets, and the mesh frequency it gives itself (numbers only: commands note
+        # runs at other mesh frequencies)
+        data={
+            "frame": {
+                "carrier_speed_rpm": float(ps.carrier_speed_rpm),
+                "mesh_frequency_of_speed_hz": mesh_frequency_of_speed(ps),
+            }
+        }
+        if frame is not None
+        else {},
         **build(bodies, ("omega", "f_s", "zeta")),
     )

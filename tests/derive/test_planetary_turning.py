@@ -184,3 +184,49 @@ def test_the_audit_says_which_mesh_frequency_the_speed_gives():
     other = replace(ps, dynamics=replace(ps.dynamics, mesh_frequency_hz=1000.0))
     page = planetary_page(derive_planetary(other), "gearsym derive x", "x.toml")
     assert "the file's operating point is 1000 Hz" in page and "two different speeds" in page
+
+
+def test_a_run_at_another_mesh_frequency_is_told_the_frame_stays_at_the_files_speed():
+    """The shipped turning set states FRAME (3000 rpm; 89 x 3000 / 60 = 4450 Hz with the
+    ring held) in its generated module.  simulate at its own operating point says nothing;
+    with --set mesh_frequency_hz=2000, and a sweep from 4000 to 4500 Hz, one note line
+    says that the frame's terms stay at 3000 rpm and at which mesh frequencies they and the
+    excitation belong to two speeds.  The same set without a speed has no FRAME and no
+    note."""
+    import subprocess
+    import sys
+
+    import gearsym
+
+    system = gearsym.load("lin-parker-1999-3-turning-backlash")
+    assert system.module.FRAME == {
+        "carrier_speed_rpm": RPM,
+        "mesh_frequency_of_speed_hz": pytest.approx(89 * RPM / 60, rel=1e-12),
+    }
+    assert getattr(gearsym.load("lin-parker-1999-3-backlash").module, "FRAME", None) is None
+
+    def notes(*args) -> list[str]:
+        done = subprocess.run(
+            [sys.executable, "-m", "gearsym", *args], capture_output=True, text=True, timeout=600
+        )
+        assert done.returncode == 0, done.stderr
+        return [line for line in done.stderr.splitlines() if "gearsym: note:" in line]
+
+    short = ("--transient", "2", "--periods", "2")
+    assert notes("simulate", "lin-parker-1999-3-turning-backlash", *short) == []
+    (note,) = notes(
+        "simulate", "lin-parker-1999-3-turning-backlash", "--set", "mesh_frequency_hz=2000", *short
+    )
+    assert "3000 rpm" in note and "4450 Hz" in note and "at 2000 Hz" in note
+    assert "two different speeds" in note
+    assert (
+        notes("simulate", "lin-parker-1999-3-backlash", "--set", "mesh_frequency_hz=2000", *short)
+        == []
+    )
+    from gearsym.cli._notes import _PENDING, forget, note_frame
+
+    forget()
+    note_frame(system, {"mesh_frequency_hz": [4000.0, 4500.0]})
+    (swept,) = _PENDING.values()
+    assert "at 4000 to 4500 Hz" in swept
+    forget()
