@@ -42,6 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .frame import frame_terms, springs
 from .modes import rotating_modes
 from .parametric import frequency_groups, modal_basis
 
@@ -78,7 +79,7 @@ class Errors:
 
 def _damping(structure: dict, zeta: float) -> np.ndarray:
     """``c_j = 2 zeta sqrt(k_j m_j)`` of every spring."""
-    mass, R, k = (np.asarray(structure[key], float) for key in ("mass", "incidence", "stiffness"))
+    mass, R, k = springs(structure)
     m_j = 1.0 / np.einsum("ji,i,ji->j", R, 1.0 / mass, R)
     return 2.0 * zeta * np.sqrt(k * m_j)
 
@@ -88,21 +89,11 @@ def _flexible(structure: dict):
     ``M`` (real without a turning carrier, complex with one: module text)."""
     if not structure.get("carrier_speed_rad_s"):
         return modal_basis(structure)
-    mass, R, k = (np.asarray(structure[key], float) for key in ("mass", "incidence", "stiffness"))
+    mass, R, k = springs(structure)
     f, shapes, rigid = rotating_modes(structure, mass, R, k)
     X = shapes[:, ~rigid]
     X = X / np.sqrt(np.einsum("ij,i,ij->j", X.conj(), mass, X).real)
     return 2 * math.pi * f[~rigid], X, R, k
-
-
-def _frame(structure: dict):
-    """``(W^2 K_Omega, W G)`` of a turning carrier (zeros without one)."""
-    n = len(structure["mass"])
-    W = float(structure.get("carrier_speed_rad_s") or 0.0)
-    if not W:
-        return np.zeros((n, n)), np.zeros((n, n))
-    G = np.asarray(structure["gyroscopic"], float)
-    return W**2 * np.asarray(structure["centripetal"], float), W * G
 
 
 def excitation(structure: dict, errors: Errors, tolerance: float = 1e-7) -> list[dict]:
@@ -136,10 +127,10 @@ def excitation(structure: dict, errors: Errors, tolerance: float = 1e-7) -> list
 def response(structure: dict, errors: Errors, zeta: float, Omegas) -> np.ndarray:
     """Each mesh's largest dynamic force (N, about its static value) over a mesh period at
     each mesh frequency of ``Omegas`` (rad/s): shape ``(len(Omegas), len(errors.rows))``."""
-    mass, R, k = (np.asarray(structure[key], float) for key in ("mass", "incidence", "stiffness"))
+    mass, R, k = springs(structure)
     c = _damping(structure, zeta)
     M, K, C = np.diag(mass), R.T @ (k[:, None] * R), R.T @ (c[:, None] * R)
-    centripetal, gyroscopic = _frame(structure)
+    centripetal, gyroscopic = frame_terms(structure)
     K, C = K - centripetal, C + gyroscopic
     rows = np.asarray(errors.rows)
     phase = np.exp(2j * math.pi * np.arange(64) / 64)

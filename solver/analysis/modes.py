@@ -25,6 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
+from .frame import frame_terms
+
 __all__ = [
     "DOMINANT",
     "Mode",
@@ -337,8 +339,8 @@ def rotating_modes(structure: dict, mass, R, k):
     the rigid-body pairs, a Jordan block each, scatter by about 5e-9 and are set aside
     first)."""
     W = float(structure["carrier_speed_rad_s"])
-    G = np.asarray(structure["gyroscopic"], dtype=float)
-    K = R.T @ (k[:, None] * R) - W**2 * np.asarray(structure["centripetal"], dtype=float)
+    centripetal, WG = frame_terms(structure)
+    K = R.T @ (k[:, None] * R) - centripetal
     n = mass.size
     w2, static = scipy.linalg.eigh(K, np.diag(mass))
     scale = np.max(np.abs(w2))
@@ -360,7 +362,7 @@ def rotating_modes(structure: dict, mass, R, k):
     A = np.zeros((2 * n, 2 * n))
     A[:n, n:] = np.eye(n)
     A[n:, :n] = -K / mass[:, None]
-    A[n:, n:] = -W * G / mass[:, None]
+    A[n:, n:] = -WG / mass[:, None]
     lam, V = scipy.linalg.eig(A)
     size = np.max(np.abs(lam))
     # the 2 r eigenvalues nearest 0 are the rigid-body modes' (a Jordan block, scattered

@@ -67,6 +67,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.integrate
 
+from .frame import frame_terms, springs
 from .modes import eigenproblem, rotating_modes
 
 __all__ = [
@@ -143,10 +144,10 @@ def modal_basis(structure: dict, rigid_tolerance: float = 1e-10):
         w2, vec, _, R, k = eigenproblem(structure)
         flexible = w2 > rigid_tolerance * np.max(np.abs(w2))
         return np.sqrt(w2[flexible]), vec[:, flexible], R, k
-    mass, R, k = (np.asarray(structure[key], float) for key in ("mass", "incidence", "stiffness"))
+    mass, R, k = springs(structure)
     f, shapes, rigid = rotating_modes(structure, mass, R, k)
     omega, X = 2 * math.pi * f[~rigid], shapes[:, ~rigid].copy()
-    WG = float(structure["carrier_speed_rad_s"]) * np.asarray(structure["gyroscopic"], float)
+    WG = frame_terms(structure)[1]
     # Within a group of modes at one frequency (a planet mode of five planets stays double
     # at speed) the eigensolver's basis is any: orthonormal in N = M - i W G / (2 w), as
     # the slow equations take it, by N's Cholesky factor.  N is Hermitian and, on the
@@ -278,11 +279,10 @@ def _turning_monodromy(structure: dict, meshes: Meshes, Omega: float, rtol: floa
     """:func:`monodromy` of a set with a turning carrier: the body coordinates ``q`` and
     ``dq / d(Omega t)`` over one mesh period, then the flexible subspace's map ``A`` with
     ``Phi V = V A`` (``V`` its first-order eigenvectors; exact, the subspace being invariant)."""
-    mass, R, k = (np.asarray(structure[key], float) for key in ("mass", "incidence", "stiffness"))
+    mass, R, k = springs(structure)
     n = mass.size
-    W = float(structure["carrier_speed_rad_s"])
-    WG = W * np.asarray(structure["gyroscopic"], float)
-    K = R.T @ (k[:, None] * R) - W**2 * np.asarray(structure["centripetal"], float)
+    centripetal, WG = frame_terms(structure)
+    K = R.T @ (k[:, None] * R) - centripetal
     f, shapes, rigid = rotating_modes(structure, mass, R, k)
     X, lam = shapes[:, ~rigid], 2j * math.pi * f[~rigid] / Omega
     V = np.block([[X, X.conj()], [X * lam, (X * lam).conj()]])
