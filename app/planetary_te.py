@@ -42,13 +42,11 @@ def _set(target):
             "[planetary]; give them"
         )
     if st.carrier_speed_rad_s:  # UnstableAtSpeed (a ValueError) where the set cannot run
-        import numpy as np
+        from gearsym.solver.analysis.frame import springs
         from gearsym.solver.analysis.modes import rotating_modes
 
         s = st.as_structure()
-        rotating_modes(
-            s, *(np.asarray(s[key], float) for key in ("mass", "incidence", "stiffness"))
-        )
+        rotating_modes(s, *springs(s))
     return st
 
 

@@ -46,44 +46,55 @@ def note_torques(system, swept: dict | None = None):
     return system
 
 
-def note_frame(system, swept: dict | None = None):
+def note_frame(system, swept: dict | None = None, *, run: bool = False):
     """For a model whose carrier turns (its module's ``FRAME``): note once that the
     frame's terms stay at the file's speed at the run's mesh frequencies (``system``'s,
-    or those at the ends of ``swept``) where that speed does not give them; return
-    ``system``."""
+    or those at the ends of ``swept``) where that speed does not give them; ``run``: the
+    command's run over ``swept``, whose note replaces one said of its starting point.
+    Return ``system``."""
     frame = getattr(system.module, "FRAME", None)
     if not frame:
         return system
+    key = f"{system.name} frame"
+    if run:
+        _PENDING.pop(key, None)
     ends = [{k: float(v[i]) for k, v in swept.items()} for i in (0, -1)] if swept else [{}]
     scale = system.module.OMEGA_N / (2 * math.pi)
     try:
         hz = sorted({system.with_values(**e).omega * scale for e in ends})
     except (KeyError, ValueError):  # a value the command itself refuses, in its words
         return system
-    own = frame["mesh_frequency_of_speed_hz"]
-    if own is None:  # which mesh frequency the speed gives is not known: the file's
-        parameters = system.module.PARAMETERS
-        own = system.module.DEFAULTS[parameters.index("omega")] * scale
-        gives = "the file's operating point is"
-    else:
-        gives = "with the ring held, that speed turns the meshes at"
-    if all(abs(h - own) <= 1e-3 * own for h in hz):
-        return system
+    rpm = abs(frame["carrier_speed_rpm"])
     at = f"{hz[0]:.6g} Hz" if len(hz) == 1 else f"{hz[0]:.6g} to {hz[-1]:.6g} Hz"
-    _PENDING.setdefault(
-        f"{system.name} frame",
-        f"{system.name}: the carrier turns at {frame['carrier_speed_rpm']:g} rpm, the file's "
-        f"speed, at every mesh frequency ({gives} {own:.6g} Hz), so at {at} the mesh "
-        "excitation and the rotating frame's terms belong to two different speeds; another "
-        "speed is another file",
-    )
+    own = frame["mesh_frequency_of_speed_hz"]
+    if own is None:  # which mesh frequency the speed gives is not known (the ring not held)
+        parameters, w = system.module.PARAMETERS, system.contract.forcing_frequency
+        point = system.module.DEFAULTS[parameters.index(w)] * scale
+        if all(abs(h - point) <= 1e-3 * point for h in hz):
+            return system
+        note = (
+            f"{system.name}: the carrier turns at {rpm:g} rpm, the file's speed, at every mesh "
+            f"frequency: at {at} the rotating frame's terms are those of the file's operating "
+            f"point ({point:.6g} Hz), not of a speed that follows the mesh frequency"
+        )
+    elif all(abs(h - own) <= 1e-3 * own for h in hz):
+        return system
+    else:
+        but = f", except at {own:.6g} Hz itself," if hz[0] < own < hz[-1] else ""
+        note = (
+            f"{system.name}: the carrier turns at {rpm:g} rpm, the file's speed, at every mesh "
+            f"frequency (with the ring held, that speed turns the meshes at {own:.6g} Hz), so "
+            f"at {at}{but} the mesh excitation and the rotating frame's terms belong to two "
+            "different speeds; another speed is another file"
+        )
+    _PENDING.setdefault(key, note)
     return system
 
 
 def note_run(system, swept: dict):
     """The notes of a run over ``swept`` (``{name: values}``, the ends count): the torques'
     balance and a turning carrier's frame (:func:`note_torques`, :func:`note_frame`)."""
-    return note_frame(note_torques(system, swept), swept)
+    return note_frame(note_torques(system, swept), swept, run=True)
 
 
 def say() -> None:

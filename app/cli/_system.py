@@ -19,7 +19,7 @@ def system_of(scene_arg: str, sets: dict[str, float]):
     planetary = planetary_path(scene_arg)
     if planetary is not None:  # its nonlinear model (gearsym.planetary.dynamics)
         try:
-            return note_frame(planetary_system(planetary, **sets))
+            system = planetary_system(planetary, **sets)
         except KeyError as err:
             said = unknown_names(planetary_system(planetary).module, sets)
             raise Fail(said or f"--set: {err.args[0]}") from None
@@ -28,6 +28,7 @@ def system_of(scene_arg: str, sets: dict[str, float]):
                 raise
             given = " ".join(f"{k}={v}" for k, v in sets.items())
             raise Fail(f"--set {given}: {err}") from None
+        return note_frame(system)
     module = module_for(scene_arg)
     opened, rest = split_open_values(sets, module)
     module = module_for(scene_arg, opened) if opened else module

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from .frame import frame_terms
+from .frame import frame_terms, springs
 
 __all__ = [
     "DOMINANT",
@@ -168,16 +168,9 @@ def eigenproblem(structure: dict):
     """``(w2, vec, mass, R, k)``: the squared natural frequencies (ascending) and the mode
     shapes normalised on ``M`` of ``K v = w^2 M v``, ``K = R^T diag(k) R``, from a
     ``STRUCTURE`` mapping, with its ``M`` diagonal, ``R`` and ``k`` as arrays."""
-    mass, R, k = _arrays(structure)
+    mass, R, k = springs(structure)
     w2, vec = scipy.linalg.eigh(R.T @ (k[:, None] * R), np.diag(mass))
     return w2, vec, mass, R, k
-
-
-def _arrays(structure: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``M``'s diagonal, ``R`` and ``k`` of a ``STRUCTURE`` mapping as arrays."""
-    return tuple(
-        np.asarray(structure[key], dtype=float) for key in ("mass", "incidence", "stiffness")
-    )
 
 
 def modes(model, omega: float | None = None) -> Modes:
@@ -268,7 +261,7 @@ def planetary_modes(structure: dict, name: str) -> Modes:
     coordinate's magnitude (the largest 1; a rigid-body mode, real, keeps its signs), the
     energies the magnitudes squared."""
     if structure.get("carrier_speed_rad_s"):
-        mass, R, k = _arrays(structure)
+        mass, R, k = springs(structure)
         f, vec, rigid = rotating_modes(structure, mass, R, k)
     else:
         w2, vec, mass, R, k = eigenproblem(structure)

@@ -223,10 +223,29 @@ def test_a_run_at_another_mesh_frequency_is_told_the_frame_stays_at_the_files_sp
         notes("simulate", "lin-parker-1999-3-backlash", "--set", "mesh_frequency_hz=2000", *short)
         == []
     )
-    from gearsym.cli._notes import _PENDING, forget, note_frame
 
+
+def test_a_runs_note_names_the_runs_mesh_frequencies(tmp_path):
+    """A copy of the turning set whose operating point is 1000 Hz (not its speed's 4450):
+    loading it notes 1000 Hz, and a sweep over 4000 to 4500 Hz replaces that with its own
+    range, 4450 Hz itself excepted; a sweep over 4450 Hz alone says nothing."""
+    from gearsym.cli._notes import _PENDING, forget, note_run
+    from gearsym.cli._system import system_of
+    from gearsym.derive.input.scene import resolve_target
+
+    text = resolve_target("lin-parker-1999-3-turning-backlash").read_text(encoding="utf-8")
+    path = tmp_path / "turning-1000.toml"
+    path.write_text(text.replace("mesh_frequency_hz = 4450", "mesh_frequency_hz = 1000"))
     forget()
-    note_frame(system, {"mesh_frequency_hz": [4000.0, 4500.0]})
-    (swept,) = _PENDING.values()
-    assert "at 4000 to 4500 Hz" in swept
-    forget()
+    try:
+        system = system_of(str(path), {})
+        (loaded,) = _PENDING.values()
+        assert "at 1000 Hz" in loaded and "4450 Hz" in loaded
+        note_run(system, {"mesh_frequency_hz": [4000.0, 4500.0]})
+        (swept,) = _PENDING.values()
+        assert "at 4000 to 4500 Hz, except at 4450 Hz itself," in swept
+        assert "1000" not in swept
+        note_run(system, {"mesh_frequency_hz": [4450.0, 4450.0]})
+        assert not _PENDING
+    finally:
+        forget()
