@@ -225,20 +225,17 @@ def test_a_run_at_another_mesh_frequency_is_told_the_frame_stays_at_the_files_sp
     )
 
 
-def test_a_runs_note_names_the_runs_mesh_frequencies(tmp_path):
-    """A copy of the turning set whose operating point is 1000 Hz (not its speed's 4450):
-    loading it notes 1000 Hz, and a sweep over 4000 to 4500 Hz replaces that with its own
-    range, 4450 Hz itself excepted; a sweep over 4450 Hz alone says nothing."""
-    from gearsym.cli._notes import _PENDING, forget, note_run
-    from gearsym.cli._system import system_of
-    from gearsym.derive.input.scene import resolve_target
+def test_a_runs_note_names_the_runs_mesh_frequencies():
+    """The turning set at an operating point of 1000 Hz (not its speed's 4450): its
+    starting point is noted at 1000 Hz, and a sweep over 4000 to 4500 Hz replaces that
+    with its own range, 4450 Hz itself excepted; a sweep over 4450 Hz alone says nothing."""
+    import gearsym
+    from gearsym.cli._notes import _PENDING, forget, note_frame, note_run
 
-    text = resolve_target("lin-parker-1999-3-turning-backlash").read_text(encoding="utf-8")
-    path = tmp_path / "turning-1000.toml"
-    path.write_text(text.replace("mesh_frequency_hz = 4450", "mesh_frequency_hz = 1000"))
+    system = gearsym.load("lin-parker-1999-3-turning-backlash", mesh_frequency_hz=1000.0)
     forget()
     try:
-        system = system_of(str(path), {})
+        note_frame(system)  # as gearsym.cli._system.system_of notes a loaded set
         (loaded,) = _PENDING.values()
         assert "at 1000 Hz" in loaded and "4450 Hz" in loaded
         note_run(system, {"mesh_frequency_hz": [4000.0, 4500.0]})
