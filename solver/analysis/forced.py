@@ -42,7 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .frame import frame_terms, springs
+from .frame import frame_terms, springs, stiffness
 from .modes import rotating_modes
 from .parametric import frequency_groups, modal_basis
 
@@ -129,9 +129,8 @@ def response(structure: dict, errors: Errors, zeta: float, Omegas) -> np.ndarray
     each mesh frequency of ``Omegas`` (rad/s): shape ``(len(Omegas), len(errors.rows))``."""
     mass, R, k = springs(structure)
     c = _damping(structure, zeta)
-    M, K, C = np.diag(mass), R.T @ (k[:, None] * R), R.T @ (c[:, None] * R)
-    centripetal, gyroscopic = frame_terms(structure)
-    K, C = K - centripetal, C + gyroscopic
+    M, K = np.diag(mass), stiffness(structure)
+    C = R.T @ (c[:, None] * R) + frame_terms(structure)[1]
     rows = np.asarray(errors.rows)
     phase = np.exp(2j * math.pi * np.arange(64) / 64)
     out = np.zeros((len(Omegas), len(rows)))

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["frame_terms", "springs"]
+__all__ = ["frame_terms", "springs", "stiffness"]
 
 
 def springs(structure: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -26,3 +26,10 @@ def frame_terms(structure: dict) -> tuple[np.ndarray, np.ndarray]:
         return np.zeros((n, n)), np.zeros((n, n))
     G = np.asarray(structure["gyroscopic"], float)
     return W**2 * np.asarray(structure["centripetal"], float), W * G
+
+
+def stiffness(structure: dict) -> np.ndarray:
+    """``K - W^2 K_Omega``: the springs' stiffness ``R^T diag(k) R`` less a turning
+    carrier's centripetal terms (the stiffness itself without one)."""
+    _, R, k = springs(structure)
+    return R.T @ (k[:, None] * R) - frame_terms(structure)[0]

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from .frame import frame_terms, springs
+from .frame import frame_terms, springs, stiffness
 
 __all__ = [
     "DOMINANT",
@@ -332,8 +332,8 @@ def rotating_modes(structure: dict, mass, R, k):
     the rigid-body pairs, a Jordan block each, scatter by about 5e-9 and are set aside
     first)."""
     W = float(structure["carrier_speed_rad_s"])
-    centripetal, WG = frame_terms(structure)
-    K = R.T @ (k[:, None] * R) - centripetal
+    WG = frame_terms(structure)[1]
+    K = stiffness(structure)
     n = mass.size
     w2, static = scipy.linalg.eigh(K, np.diag(mass))
     scale = np.max(np.abs(w2))

@@ -67,7 +67,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.integrate
 
-from .frame import frame_terms, springs
+from .frame import frame_terms, springs, stiffness
 from .modes import eigenproblem, rotating_modes
 
 __all__ = [
@@ -281,8 +281,8 @@ def _turning_monodromy(structure: dict, meshes: Meshes, Omega: float, rtol: floa
     ``Phi V = V A`` (``V`` its first-order eigenvectors; exact, the subspace being invariant)."""
     mass, R, k = springs(structure)
     n = mass.size
-    centripetal, WG = frame_terms(structure)
-    K = R.T @ (k[:, None] * R) - centripetal
+    WG = frame_terms(structure)[1]
+    K = stiffness(structure)
     f, shapes, rigid = rotating_modes(structure, mass, R, k)
     X, lam = shapes[:, ~rigid], 2j * math.pi * f[~rigid] / Omega
     V = np.block([[X, X.conj()], [X * lam, (X * lam).conj()]])
