@@ -254,6 +254,9 @@ def analysis_settings(args) -> dict:
             f"--rtol {args.rtol:g}: a relative tolerance above 0.1 controls nothing; "
             "give 1e-3 or less"
         )
+    if (loose := args.transient_rtol) is not None and not 0 < loose <= 0.1:  # NaN too
+        why = "give a positive relative tolerance <= 0.1 (1e-6, say), or leave it out"
+        raise Fail(f"--transient-rtol {loose:g}: {why}")
     from gearsym.solver.integrate.simulate import check_samples, samples_for
 
     spp = samples_for(args.periods)
@@ -284,6 +287,7 @@ def analysis_settings(args) -> dict:
         lyapunov_periods=args.lyapunov_periods,
         on_invalid=args.on_invalid,
         budget=args.budget,
+        **({} if loose is None else {"transient_rtol": loose}),
     )
 
 
@@ -320,6 +324,13 @@ def analysis_options(sub) -> None:
         type=int,
         default=300,
         help=f"periods discarded (at most {LIMITS['transient']:,})",
+    )
+    sub.add_argument(
+        "--transient-rtol",
+        type=float,
+        metavar="RTOL",
+        help="a looser relative tolerance for the discarded periods alone (atol scaled "
+        "with it; the sampled ones keep --rtol): faster, measured in docs/body-models.md",
     )
     sub.add_argument(
         "--periods",

@@ -170,7 +170,7 @@ def _cmd_simulate(args) -> int:
     ran = f"{run:,} periods run" if tr.status == "ok" else f"{asked:,} periods asked"
     kept = "" if run == asked or tr.status != "ok" else f", the last {tr.periods} kept"
     print(
-        f"{system.name}: {tr.method}, rtol {tr.rtol:g}, {ran}{kept}, "
+        f"{system.name}: {tr.method}, {tr.tolerance}, {ran}{kept}, "
         f"{time.perf_counter() - started:.2f} s, status {tr.status}"
     )
     if start.x0 is not None:

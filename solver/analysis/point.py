@@ -108,7 +108,7 @@ class PointResult:
             [
                 f"{tr.system!r}",
                 textwrap.fill(verdict_line(self), 100, subsequent_indent="  "),
-                f"run: {tr.method} rtol {tr.rtol:g}, {tr.transient} + {tr.periods} periods, "
+                f"run: {tr.method} {tr.tolerance}, {tr.transient} + {tr.periods} periods, "
                 f"status {tr.status}, {tr.wall_time:.2f} s",
                 "extremes: "
                 + ", ".join(
@@ -184,6 +184,7 @@ def analyse_point(
     steps_per_period: int = 512,
     on_invalid: str = "warn",
     budget: int = BUDGET,
+    transient_rtol: float | None = None,
 ) -> PointResult:
     """Simulate, then judge the attractor (see the module text).
 
@@ -191,6 +192,7 @@ def analyse_point(
     ``lyapunov_periods``: the first continued window, over which the exponent runs (each
     next window twice as long; 0: no exponent, so only periodic verdicts can settle).
     ``budget``: periods the verdict may take in all, counted from the run's start.
+    ``transient_rtol``: a looser tolerance for the transient alone (:func:`simulate`).
     """
     tr = simulate(
         system,
@@ -203,6 +205,7 @@ def analyse_point(
         samples_per_period=samples_per_period,
         steps_per_period=steps_per_period,
         on_invalid=on_invalid,
+        transient_rtol=transient_rtol,
     )
     return analyse_trajectory(
         tr,

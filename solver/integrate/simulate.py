@@ -116,6 +116,7 @@ def simulate(
     max_step: float | None = None,
     bound: float = 1e3,
     on_invalid: str = "warn",
+    transient_rtol: float | None = None,
 ) -> Trajectory:
     """Integrate ``system`` from ``x0`` and sample the response after a transient.
 
@@ -140,7 +141,34 @@ def simulate(
         polynomial fit, say): ``warn`` records the first exit (time, coordinate, value)
         and goes on; ``error`` stops there with status ``invalid`` (samples after the exit
         are not computed).
+    transient_rtol : float, optional
+        A looser relative tolerance for the transient alone (``atol`` scaled with it):
+        the discarded periods only carry the state to the attractor, the sampled window
+        is integrated at ``rtol`` from where they end.  A trade of speed for accuracy
+        whose cost is measured in ``docs/body-models.md``; default: ``rtol`` throughout.
     """
+    if transient_rtol is not None and transient > 0:
+        from .two_tolerances import two_tolerances
+
+        return two_tolerances(
+            simulate,
+            system,
+            x0,
+            dict(
+                method=method or fastest_method(rtol),
+                rtol=rtol,
+                atol=atol,
+                transient=transient,
+                periods=periods,
+                samples_per_period=samples_per_period,
+                t0=t0,
+                steps_per_period=steps_per_period,
+                max_step=max_step,
+                bound=bound,
+                on_invalid=on_invalid,
+            ),
+            transient_rtol,
+        )
     started = time.perf_counter()
     req = _request(
         system,
@@ -178,6 +206,12 @@ def simulate_many(systems, x0s=None, *, workers: int = 1, **options) -> list[Tra
     method = options.get("method") or fastest_method(options.get("rtol", 1e-8))
     if get_method(method).family != "native" or len({s.module for s in systems}) != 1:
         return [simulate(s, x, **options) for s, x in zip(systems, x0s, strict=True)]
+    transient_rtol = options.pop("transient_rtol", None)
+    if transient_rtol is not None and options.get("transient", 300) > 0:
+        from .two_tolerances import two_tolerances_many
+
+        options = dict(options, method=method)
+        return two_tolerances_many(simulate_many, systems, x0s, workers, options, transient_rtol)
     started = time.perf_counter()
     keys = (
         "rtol",

@@ -64,6 +64,12 @@ class Trajectory:
         """The time derivative of mesh coordinate ``coordinate``."""
         return self.x[self.system.velocity_index(coordinate)]
 
+    @property
+    def tolerance(self) -> str:
+        """``rtol 1e-08``, with the transient's own when it had one (``transient_rtol``)."""
+        loose = self.options.get("transient_rtol")
+        return f"rtol {self.rtol:g}" + ("" if loose is None else f" (transient {loose:g})")
+
     def __repr__(self) -> str:
         return (
             f"Trajectory({self.system!r}: {self.method}, {self.transient} + {self.periods} "
@@ -76,7 +82,7 @@ class Trajectory:
         return "\n".join(
             [
                 repr(self.system),
-                f"{self.method} rtol {self.rtol:g} atol {self.atol:g}: {self.transient} "
+                f"{self.method} {self.tolerance} atol {self.atol:g}: {self.transient} "
                 f"periods discarded, {self.periods} sampled ({self.samples_per_period} per "
                 f"period, τ {self.t[0]:.6g} to {self.t[-1]:.6g})"
                 if self.t.size

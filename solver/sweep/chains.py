@@ -33,7 +33,7 @@ _FAILURES = (SimulationError, ValueError, FloatingPointError)
 # the settings that go to the integration, and those that go to the analysis
 _SIMULATE = (
     *("method", "rtol", "atol", "transient", "periods", "samples_per_period"),
-    *("steps_per_period", "on_invalid"),
+    *("steps_per_period", "on_invalid", "transient_rtol"),
 )
 _ANALYSE = ("rtol", "atol", "lyapunov_periods", "steps_per_period", "on_invalid")
 _ANALYSE += ("budget",)
