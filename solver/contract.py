@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import importlib
+import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
@@ -79,6 +80,8 @@ class ForceSign:
 
 
 _REQUIRED = ("NAME", "CONTRACT", "parameters", "rhs", "jacobian", "casadi_functions")
+# module -> (its CONTRACT object, the Contract read from it): Contract.of
+_READ: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 @dataclass(frozen=True)
@@ -137,7 +140,25 @@ class Contract:
 
     @classmethod
     def of(cls, module: ModuleType) -> Contract:
-        """The checked contract of a generated module (``ValueError`` names what is wrong)."""
+        """The checked contract of a generated module (``ValueError`` names what is wrong),
+        read once per module and CONTRACT object (a sweep point asks for it some fourteen
+        times, a third of a millisecond each; a module given another CONTRACT is read
+        again, and a CONTRACT is never changed in place)."""
+        try:
+            stated, known = _READ[module]
+        except (KeyError, TypeError):
+            stated = known = None
+        if known is not None and stated is module.CONTRACT:
+            return known
+        c = cls._read(module)
+        try:
+            _READ[module] = (module.CONTRACT, c)
+        except TypeError:  # an object that cannot be weakly referred to: read each time
+            pass
+        return c
+
+    @classmethod
+    def _read(cls, module: ModuleType) -> Contract:
         data = dict(module.CONTRACT)
         name = getattr(module, "NAME", module.__name__)
         fmt = data.get("format")
