@@ -254,8 +254,8 @@ def analysis_settings(args) -> dict:
             f"--rtol {args.rtol:g}: a relative tolerance above 0.1 controls nothing; "
             "give 1e-3 or less"
         )
-    if (loose := args.transient_rtol) is not None and not 0 < loose <= 0.1:  # NaN too
-        why = "give a positive relative tolerance <= 0.1 (1e-6, say), or leave it out"
+    if (loose := args.transient_rtol) is not None and not 1e-13 <= loose <= 0.1:  # NaN too
+        why = "give a relative tolerance from 1e-13 to 0.1 (1e-6, say), or leave it out"
         raise Fail(f"--transient-rtol {loose:g}: {why}")
     from gearsym.solver.integrate.simulate import check_samples, samples_for
 

@@ -13,7 +13,7 @@ spread (the extent of its Poincare cloud and its share of the widest).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -290,7 +290,8 @@ def _closing_sample(tr, st: Settled, rtol: float, atol: float, steps_per_period:
             t0=st.t_final,
             steps_per_period=steps_per_period,
         )
-    return again if again.status == "ok" else tr
+    # the run's options (the transient's own tolerances, say) are still the run's
+    return replace(again, options={**tr.options, **again.options}) if again.status == "ok" else tr
 
 
 def verdict_line(point) -> str:

@@ -32,6 +32,7 @@ class Request:
     max_step: float | None
     bound: float
     on_invalid: str
+    transient_rtol: float | None = None  # the transient's own (two_tolerances.py)
 
 
 @dataclass

@@ -99,6 +99,10 @@ def _check(system: System, req: Request) -> None:
         )
     if not (rtol > 0 and atol > 0):
         raise ValueError(f"tolerances must be > 0, got rtol={rtol}, atol={atol}")
+    if req.transient_rtol is not None:
+        from .two_tolerances import check_transient_rtol
+
+        check_transient_rtol(req.transient_rtol, record)
 
 
 def simulate(
@@ -147,28 +151,6 @@ def simulate(
         is integrated at ``rtol`` from where they end.  A trade of speed for accuracy
         whose cost is measured in ``docs/body-models.md``; default: ``rtol`` throughout.
     """
-    if transient_rtol is not None and transient > 0:
-        from .two_tolerances import two_tolerances
-
-        return two_tolerances(
-            simulate,
-            system,
-            x0,
-            dict(
-                method=method or fastest_method(rtol),
-                rtol=rtol,
-                atol=atol,
-                transient=transient,
-                periods=periods,
-                samples_per_period=samples_per_period,
-                t0=t0,
-                steps_per_period=steps_per_period,
-                max_step=max_step,
-                bound=bound,
-                on_invalid=on_invalid,
-            ),
-            transient_rtol,
-        )
     started = time.perf_counter()
     req = _request(
         system,
@@ -184,9 +166,14 @@ def simulate(
         max_step,
         bound,
         on_invalid,
+        transient_rtol,
     )
-    run = _backend(get_method(req.method).family)(system, req)
-    return _trajectory(system, req, run, started)
+    backend = _backend(get_method(req.method).family)
+    if req.transient_rtol is not None and req.transient > 0:
+        from .two_tolerances import two_runs
+
+        return _trajectory(system, req, two_runs(backend, system, req), started)
+    return _trajectory(system, req, backend(system, req), started)
 
 
 def simulate_many(systems, x0s=None, *, workers: int = 1, **options) -> list[Trajectory]:
@@ -206,12 +193,6 @@ def simulate_many(systems, x0s=None, *, workers: int = 1, **options) -> list[Tra
     method = options.get("method") or fastest_method(options.get("rtol", 1e-8))
     if get_method(method).family != "native" or len({s.module for s in systems}) != 1:
         return [simulate(s, x, **options) for s, x in zip(systems, x0s, strict=True)]
-    transient_rtol = options.pop("transient_rtol", None)
-    if transient_rtol is not None and options.get("transient", 300) > 0:
-        from .two_tolerances import two_tolerances_many
-
-        options = dict(options, method=method)
-        return two_tolerances_many(simulate_many, systems, x0s, workers, options, transient_rtol)
     started = time.perf_counter()
     keys = (
         "rtol",
@@ -224,8 +205,9 @@ def simulate_many(systems, x0s=None, *, workers: int = 1, **options) -> list[Tra
         "max_step",
         "bound",
         "on_invalid",
+        "transient_rtol",
     )
-    defaults = (1e-8, 1e-10, 300, 100, 64, 0.0, 512, None, 1e3, "warn")
+    defaults = (1e-8, 1e-10, 300, 100, 64, 0.0, 512, None, 1e3, "warn", None)
     unknown = set(options) - set(keys) - {"method"}
     if unknown:
         raise TypeError(f"unknown option(s) {sorted(unknown)}")
@@ -233,7 +215,12 @@ def simulate_many(systems, x0s=None, *, workers: int = 1, **options) -> list[Tra
     reqs = [_request(s, x, method, *args) for s, x in zip(systems, x0s, strict=True)]
     from .native import run_many
 
-    runs = run_many(systems, reqs, workers=workers)
+    if reqs[0].transient_rtol is not None and reqs[0].transient > 0:
+        from .two_tolerances import two_runs_many
+
+        runs = two_runs_many(run_many, systems, reqs, workers)
+    else:
+        runs = run_many(systems, reqs, workers=workers)
     return [_trajectory(s, q, r, started) for s, q, r in zip(systems, reqs, runs, strict=True)]
 
 
@@ -251,6 +238,7 @@ def _request(
     max_step,
     bound,
     on_invalid,
+    transient_rtol=None,
 ) -> Request:
     """The checked request of one run, with its initial state and sample grid."""
     if method is None:
@@ -269,6 +257,7 @@ def _request(
         max_step=max_step,
         bound=bound,
         on_invalid=on_invalid,
+        transient_rtol=transient_rtol,
     )
     _check(system, req)
     if x0 is None:
@@ -306,6 +295,10 @@ def _trajectory(system, req: Request, run, started: float) -> Trajectory:
     if status != "invalid":
         status, message = _check_bound(t_out, x_out, status, message, bound)
     fixed = not get_method(method).adaptive
+    said = {}  # the transient's own tolerances, when it had them (two_tolerances.py)
+    if req.transient_rtol is not None and req.transient > 0:
+        loose = req.transient_rtol
+        said = {"transient_rtol": loose, "transient_atol": req.atol * loose / req.rtol}
     return Trajectory(
         system=system,
         method=method,
@@ -325,7 +318,7 @@ def _trajectory(system, req: Request, run, started: float) -> Trajectory:
         wall_time=time.perf_counter() - started,
         boundary_crossings=run.crossings,
         left_valid_range=exit_,
-        options={"steps_per_period": req.steps_per_period} if fixed else {},
+        options={"steps_per_period": req.steps_per_period} if fixed else said,
     )
 
 

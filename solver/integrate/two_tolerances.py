@@ -1,116 +1,111 @@
 """A looser tolerance for the transient (``simulate(..., transient_rtol=...)``).
 
-The transient only carries the state to the attractor: it is run as a window of its own,
-sampled once a period at the looser tolerance (``atol`` scaled with it), and the sampled
-window from where it ended at ``rtol``.  The result is one trajectory whose work counts
-both runs and whose ``options`` say the transient's tolerances.  What the trade buys and
-costs is measured in ``benchmarks/body_models.py`` (``docs/body-models.md``).
+The transient only carries the state to the attractor.  With ``transient_rtol`` the back
+end runs twice on one checked request: the transient at ``transient_rtol`` (``atol``
+scaled with it), sampled only at the start and the end of its last period, and then the
+window from where it ended, at ``rtol``, on the request's own sample grid.  The two make
+one :class:`~.result.Run`: the work of both, the first exit from the valid range, and a
+transient that fails (or leaves the valid range with ``on_invalid="error"``) fails the run,
+its window NaN.  ``simulate`` checks the user's start only, never the transient's end.
+What the trade buys and costs: ``benchmarks/body_models.py`` (``docs/body-models.md``).
 """
 
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import replace
 
 import numpy as np
 
-from .trajectory import Trajectory
+from .result import Request, Run
 
-__all__ = ["two_tolerances", "two_tolerances_many"]
+__all__ = ["check_transient_rtol", "two_runs", "two_runs_many"]
+
+_EPS = 100 * np.finfo(float).eps  # what SciPy-style step control honours (simulate._check)
 
 
-def _transient_options(options: dict, transient_rtol) -> dict:
-    """The options of the transient's own run (checked ``transient_rtol``); ``options``
-    name the method."""
-    rtol = options.get("rtol", 1e-8)
+def check_transient_rtol(value, record) -> None:
+    """``ValueError`` naming ``transient_rtol`` when it cannot be used with ``record``
+    (the method's registry record)."""
     try:
-        value = float(transient_rtol)
+        loose = float(value)
     except (TypeError, ValueError):
-        value = math.nan
-    if not (0 < value <= 0.1 and math.isfinite(value)):
-        raise ValueError(f"transient_rtol must be a positive number <= 0.1, got {transient_rtol!r}")
-    return dict(
-        options,
-        rtol=value,
-        atol=options.get("atol", 1e-10) * value / rtol,
-        transient=0,
-        periods=options.get("transient", 300),
-        samples_per_period=1,
-    )
-
-
-def two_tolerances(simulate, system, x0, options: dict, transient_rtol) -> Trajectory:
-    """``simulate(system, x0, **options)`` with the transient at ``transient_rtol``
-    (``simulate`` passed in: this module is below the front door it serves)."""
-    started = time.perf_counter()
-    first_options = _transient_options(options, transient_rtol)
-    first = simulate(system, x0, **first_options)
-    window = dict(options, transient=0, t0=first.t_final)
-    second = simulate(system, first.x_final, **window) if first.status == "ok" else None
-    return _joined(system, first, options, first_options, started, second)
-
-
-def two_tolerances_many(
-    simulate_many, systems, x0s, workers, options, transient_rtol
-) -> list[Trajectory]:
-    """``simulate_many`` alike, the windows of points whose transients ended together in
-    one batch."""
-    started = time.perf_counter()
-    first_options = _transient_options(options, transient_rtol)
-    firsts = simulate_many(systems, x0s, workers=workers, **first_options)
-    # the windows in one batch per start time (a batch shares t0: points with one period)
-    groups: dict[float, list[int]] = {}
-    for i, f in enumerate(firsts):
-        if f.status == "ok":
-            groups.setdefault(f.t_final, []).append(i)
-    seconds: dict[int, Trajectory] = {}
-    for t_final, rows in groups.items():
-        window = dict(options, transient=0, t0=t_final)
-        done = simulate_many(
-            [systems[i] for i in rows],
-            [firsts[i].x_final for i in rows],
-            workers=workers,
-            **window,
+        loose = math.nan
+    if not record.adaptive:
+        raise ValueError(
+            f"transient_rtol is for the adaptive methods; '{record.name}' takes "
+            "steps_per_period fixed steps a period"
         )
-        seconds.update(zip(rows, done, strict=True))
-    return [
-        _joined(s, f, options, first_options, started, seconds.get(i))
-        for i, (s, f) in enumerate(zip(systems, firsts, strict=True))
-    ]
-
-
-def _joined(system, first, options, first_options, started, second) -> Trajectory:
-    """One trajectory of the transient's run ``first`` and the window's ``second`` (None
-    when the transient failed: that fails the trajectory, its window NaN)."""
-    said = {"transient_rtol": first_options["rtol"], "transient_atol": first_options["atol"]}
-    transient, periods = options.get("transient", 300), options.get("periods", 100)
-    if first.status != "ok":
-        spp = options.get("samples_per_period", 64)
-        T = system.period
-        t = first.t_final + T * np.arange(periods * spp) / spp
-        return replace(
-            first,
-            transient=transient,
-            periods=periods,
-            samples_per_period=spp,
-            t=t,
-            x=np.full((system.n, t.size), np.nan),
-            x_final=np.full(system.n, np.nan),
-            t_final=float(first.t_final + periods * T),
-            rtol=options.get("rtol", 1e-8),
-            atol=options.get("atol", 1e-10),
-            wall_time=time.perf_counter() - started,
-            options=dict(first.options, **said),
+    low = 0.0 if record.family == "casadi" else _EPS
+    if not low < loose <= 0.1:  # NaN too
+        raise ValueError(
+            f"transient_rtol must be a number in ({low:.2g}, 0.1], got {value!r} "
+            "(a transient needs no more than 1e-6, say)"
         )
-    crossings = [c for c in (first.boundary_crossings, second.boundary_crossings) if c is not None]
+
+
+def _transient(system, req: Request) -> Request:
+    """The transient's own request: its last period sampled at both ends."""
+    start = float(req.grid[0])  # t0 + transient T, where the window starts
+    T = system.period
     return replace(
-        second,
-        transient=transient,
-        nfev=first.nfev + second.nfev,
-        nsteps=first.nsteps + second.nsteps,
-        boundary_crossings=sum(crossings) if crossings else None,
-        left_valid_range=first.left_valid_range or second.left_valid_range,
-        wall_time=time.perf_counter() - started,
-        options=dict(second.options, **said),
+        req,
+        rtol=req.transient_rtol,
+        atol=req.atol * req.transient_rtol / req.rtol,
+        transient=req.transient - 1,
+        periods=1,
+        samples_per_period=1,
+        grid=np.array([start - T, start]),
+        transient_rtol=None,
     )
+
+
+def _window(req: Request, first: Run) -> Request:
+    return replace(
+        req, x0=first.x[:, -1].copy(), t0=float(req.grid[0]), transient=0, transient_rtol=None
+    )
+
+
+def _stops(req: Request, first: Run) -> bool:
+    """The transient ended the run: it failed, or left the valid range where the request
+    stops there."""
+    return first.status != "ok" or (
+        first.left_valid_range is not None and req.on_invalid == "error"
+    )
+
+
+def _joined(req: Request, first: Run, second: Run | None) -> Run:
+    if second is None:
+        x = np.full((first.x.shape[0], req.grid.size), np.nan)
+        return replace(first, x=x)
+    crossings = [c for c in (first.crossings, second.crossings) if c is not None]
+    return Run(
+        second.x,
+        second.status,
+        second.message,
+        first.nfev + second.nfev,
+        first.nsteps + second.nsteps,
+        sum(crossings) if crossings else None,
+        first.left_valid_range or second.left_valid_range,
+    )
+
+
+def two_runs(backend, system, req: Request) -> Run:
+    """``backend(system, req)`` with the transient at ``req.transient_rtol``."""
+    first = backend(system, _transient(system, req))
+    second = None if _stops(req, first) else backend(system, _window(req, first))
+    return _joined(req, first, second)
+
+
+def two_runs_many(run_many, systems, reqs, workers: int) -> list[Run]:
+    """``run_many(systems, reqs, workers=...)`` alike: the transients in one batch, then the
+    windows of those that did not stop the run in another (a batch shares its start time:
+    its points share their period)."""
+    transients = [_transient(s, q) for s, q in zip(systems, reqs, strict=True)]
+    firsts = run_many(systems, transients, workers=workers)
+    go = [i for i, (q, f) in enumerate(zip(reqs, firsts, strict=True)) if not _stops(q, f)]
+    windows = [_window(reqs[i], firsts[i]) for i in go]
+    done = run_many([systems[i] for i in go], windows, workers=workers) if go else []
+    seconds = dict(zip(go, done, strict=True))
+    pairs = enumerate(zip(reqs, firsts, strict=True))
+    return [_joined(q, f, seconds.get(i)) for i, (q, f) in pairs]

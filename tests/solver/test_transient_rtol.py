@@ -54,6 +54,40 @@ def test_at_one_tolerance_it_is_the_one_run(light):
     two = simulate(light, method="dop853", transient_rtol=1e-8, **RUN)
     assert np.abs(one.x - two.x).max() < 1e-6
     assert two.nfev > 0 and two.t[0] == one.t[0] and two.t_final == one.t_final
+    np.testing.assert_array_equal(two.t, one.t)
+
+
+def test_the_transient_runs_at_its_own_tolerance(light):
+    # what reached the integrator, not what was recorded: the loose transient takes fewer
+    # evaluations, and ends elsewhere than the tight one by more than the tight tolerance
+    tight = simulate(light, rtol=1e-9, atol=1e-11, **RUN)
+    loose = simulate(light, rtol=1e-9, atol=1e-11, transient_rtol=1e-4, **RUN)
+    assert loose.nfev < tight.nfev and loose.nsteps < tight.nsteps
+    assert 1e-7 < np.abs(loose.x[:, 0] - tight.x[:, 0]).max() < 1e-2
+
+
+def test_other_families_and_the_default_method(light):
+    # Reference: the one-run path of the same method (SciPy's RK45; the default, dop853)
+    short = dict(transient=20, periods=4, samples_per_period=8)
+    for method in ("RK45", None):
+        one = simulate(light, method=method, rtol=1e-9, atol=1e-11, **short)
+        two = simulate(light, method=method, rtol=1e-9, atol=1e-11, transient_rtol=1e-9, **short)
+        assert two.method == one.method and np.abs(one.x - two.x).max() < 1e-6
+    with pytest.raises(ValueError, match="transient_rtol is for the adaptive methods"):
+        simulate(light, method="rk4", transient_rtol=1e-6, **short)
+
+
+def test_an_exit_from_the_valid_range_in_the_transient_is_kept(light):
+    # the polynomial backlash holds for |u| <= 3: a start at u = 2.9 moving outward leaves it
+    x0 = np.array([2.9, 0.0, 2.0, 0.0])
+    one = simulate(light, x0, **RUN)
+    two = simulate(light, x0, transient_rtol=1e-6, **RUN)
+    assert one.left_valid_range is not None and one.left_valid_range[0] < one.t[0]
+    assert two.status == "ok" and two.left_valid_range[1] == one.left_valid_range[1]
+    assert two.left_valid_range[0] == pytest.approx(one.left_valid_range[0], rel=1e-3)
+    stop = simulate(light, x0, transient_rtol=1e-6, on_invalid="error", **RUN)
+    assert stop.status == "invalid" and np.all(np.isnan(stop.x))
+    assert simulate(light, x0, on_invalid="error", **RUN).status == "invalid"
 
 
 def test_many_points_at_once_match_one_at_a_time(light):
@@ -73,15 +107,16 @@ def test_a_transient_that_fails_fails_the_run(light):
 
 
 def test_an_unusable_tolerance_is_refused(light):
-    with pytest.raises(ValueError, match="transient_rtol must be a positive number"):
-        simulate(light, transient_rtol=0.5, **RUN)
+    for bad in (0.5, 1e-16, float("nan"), "tight"):
+        with pytest.raises(ValueError, match="transient_rtol must be a number in"):
+            simulate(light, transient_rtol=bad, **RUN)
 
 
 def test_the_cli_names_it_and_records_it(tmp_path, capsys):
-    bad = ["simulate", "reference-light", "--transient-rtol", "-1"]
-    assert main(bad) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "--transient-rtol -1" in err[0]
+    for bad in ("-1", "1e-15"):
+        assert main(["simulate", "reference-light", "--transient-rtol", bad]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and f"--transient-rtol {bad}" in err[0]
     out = tmp_path / "s"
     argv = ["sweep", "reference-light", "--param", "lambda", "--range", "0.3:0.4:2"]
     argv += ["--independent", "--quiet", "--no-figure", "--transient", "50", "--periods", "8"]
