@@ -17,7 +17,6 @@ from dataclasses import dataclass, fields
 from typing import NamedTuple
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from .spectra import _hann  # the one periodic Hann window (cached), with its sum
 
@@ -167,6 +166,8 @@ def _naff(Y: np.ndarray, guess: float, half_width: float) -> float:
 
     bounds = (max(guess - half_width, 0.0), min(guess + half_width, 0.5))
     options = {"xatol": 1e-6 / K}
+    from scipy.optimize import minimize_scalar  # here: importing it costs 0.8 s a command
+
     return float(minimize_scalar(minus_power, bounds=bounds, method="bounded", options=options).x)
 
 
