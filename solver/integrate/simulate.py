@@ -36,6 +36,7 @@ from .limits import check_samples, check_start, default_initial_state, samples_f
 from .methods import METHODS, get_method
 from .result import Request, first_exit
 from .trajectory import Trajectory
+from .two_tolerances import check_transient_rtol, said, two_runs, two_runs_many
 
 __all__ = [
     "METHODS",
@@ -100,8 +101,6 @@ def _check(system: System, req: Request) -> None:
     if not (rtol > 0 and atol > 0):
         raise ValueError(f"tolerances must be > 0, got rtol={rtol}, atol={atol}")
     if req.transient_rtol is not None:
-        from .two_tolerances import check_transient_rtol
-
         check_transient_rtol(req.transient_rtol, record)
 
 
@@ -170,8 +169,6 @@ def simulate(
     )
     backend = _backend(get_method(req.method).family)
     if req.transient_rtol is not None and req.transient > 0:
-        from .two_tolerances import two_runs
-
         return _trajectory(system, req, two_runs(backend, system, req), started)
     return _trajectory(system, req, backend(system, req), started)
 
@@ -216,8 +213,6 @@ def simulate_many(systems, x0s=None, *, workers: int = 1, **options) -> list[Tra
     from .native import run_many
 
     if reqs[0].transient_rtol is not None and reqs[0].transient > 0:
-        from .two_tolerances import two_runs_many
-
         runs = two_runs_many(run_many, systems, reqs, workers)
     else:
         runs = run_many(systems, reqs, workers=workers)
@@ -295,10 +290,7 @@ def _trajectory(system, req: Request, run, started: float) -> Trajectory:
     if status != "invalid":
         status, message = _check_bound(t_out, x_out, status, message, bound)
     fixed = not get_method(method).adaptive
-    said = {}  # the transient's own tolerances, when it had them (two_tolerances.py)
-    if req.transient_rtol is not None and req.transient > 0:
-        loose = req.transient_rtol
-        said = {"transient_rtol": loose, "transient_atol": req.atol * loose / req.rtol}
+
     return Trajectory(
         system=system,
         method=method,
@@ -318,7 +310,7 @@ def _trajectory(system, req: Request, run, started: float) -> Trajectory:
         wall_time=time.perf_counter() - started,
         boundary_crossings=run.crossings,
         left_valid_range=exit_,
-        options={"steps_per_period": req.steps_per_period} if fixed else said,
+        options={"steps_per_period": req.steps_per_period} if fixed else said(req),
     )
 
 

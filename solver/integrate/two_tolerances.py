@@ -19,7 +19,7 @@ import numpy as np
 
 from .result import Request, Run
 
-__all__ = ["check_transient_rtol", "two_runs", "two_runs_many"]
+__all__ = ["check_transient_rtol", "said", "two_runs", "two_runs_many"]
 
 _EPS = 100 * np.finfo(float).eps  # what SciPy-style step control honours (simulate._check)
 
@@ -27,10 +27,8 @@ _EPS = 100 * np.finfo(float).eps  # what SciPy-style step control honours (simul
 def check_transient_rtol(value, record) -> None:
     """``ValueError`` naming ``transient_rtol`` when it cannot be used with ``record``
     (the method's registry record)."""
-    try:
-        loose = float(value)
-    except (TypeError, ValueError):
-        loose = math.nan
+    numeric = isinstance(value, int | float | np.floating) and not isinstance(value, bool)
+    loose = float(value) if numeric else math.nan
     if not record.adaptive:
         raise ValueError(
             f"transient_rtol is for the adaptive methods; '{record.name}' takes "
@@ -44,14 +42,24 @@ def check_transient_rtol(value, record) -> None:
         )
 
 
+def said(req: Request) -> dict:
+    """The transient's own tolerances, as a trajectory's options record them (none when
+    the request has no looser transient)."""
+    if req.transient_rtol is None or req.transient == 0:
+        return {}
+    loose = float(req.transient_rtol)
+    return {"transient_rtol": loose, "transient_atol": req.atol * loose / req.rtol}
+
+
 def _transient(system, req: Request) -> Request:
     """The transient's own request: its last period sampled at both ends."""
     start = float(req.grid[0])  # t0 + transient T, where the window starts
     T = system.period
+    own = said(req)
     return replace(
         req,
-        rtol=req.transient_rtol,
-        atol=req.atol * req.transient_rtol / req.rtol,
+        rtol=own["transient_rtol"],
+        atol=own["transient_atol"],
         transient=req.transient - 1,
         periods=1,
         samples_per_period=1,
