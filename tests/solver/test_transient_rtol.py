@@ -113,10 +113,12 @@ def test_an_unusable_tolerance_is_refused(light):
 
 
 def test_the_cli_names_it_and_records_it(tmp_path, capsys):
-    for bad in ("-1", "1e-15"):
-        assert main(["simulate", "reference-light", "--transient-rtol", bad]) == 2
-        err = capsys.readouterr().err.strip().splitlines()
-        assert len(err) == 1 and f"--transient-rtol {bad}" in err[0]
+    sweep = ["sweep", "--param", "lambda", "--range", "0.3:0.4:2", "--method", "rk4"]
+    for cmd in (["simulate"], ["simulate", "--method", "rk4"], sweep):
+        for bad in ("-1", "1e-15") if len(cmd) == 1 else ("0.001",):
+            assert main([cmd[0], "reference-light", *cmd[1:], "--transient-rtol", bad]) == 2
+            err = capsys.readouterr().err.strip().splitlines()
+            assert len(err) == 1 and f"--transient-rtol {bad}" in err[0]
     out = tmp_path / "s"
     argv = ["sweep", "reference-light", "--param", "lambda", "--range", "0.3:0.4:2"]
     argv += ["--independent", "--quiet", "--no-figure", "--transient", "50", "--periods", "8"]
