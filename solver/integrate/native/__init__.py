@@ -44,6 +44,7 @@ def reset() -> None:
     build._loaded.clear()
     build._paths.clear()
     build._failed.clear()
+    build._broken.clear()
     fallback._warned.clear()
 
 

@@ -44,6 +44,10 @@ _loaded: dict[str, ctypes.CDLL] = {}
 # (module file, inputs hash, variational, flags and defines, compiler, cache) -> library
 _paths: dict[tuple, Path] = {}
 _failed: dict[str, str] = {}  # cache key -> why it could not be built (once per session)
+# (compiler, model file) -> the bug report of a compiler that failed on the model's C: its
+# other libraries (with tangents, say), which hold the same C, are not tried again, so a
+# run says the one line once
+_broken: dict[tuple[str, str], str] = {}
 
 
 class NativeUnavailable(RuntimeError):
@@ -255,6 +259,8 @@ def library(module, variational: bool | str = False, shared=()) -> tuple[ctypes.
     ).hexdigest()[:20]
     if key in _failed:
         raise NativeUnavailable(_failed[key])
+    if (cc, memo[0]) in _broken:
+        raise NativeUnavailable(_broken[cc, memo[0]])
     # named by what it is built from, not by the model: models whose C is the same (the
     # light and heavy reference scenes, a variant and its scene) share the one library
     kind = "-mono" if monodromy else "-var" if variational else ""
@@ -294,6 +300,7 @@ def library(module, variational: bool | str = False, shared=()) -> tuple[ctypes.
                     raise NativeUnavailable(_failed[key]) from None
                 if done.returncode != 0 or not so.exists():
                     _failed[key] = _bug_report(module, cc, path, c_file, done, defines)
+                    _broken[cc, memo[0]] = _failed[key]
                     raise NativeUnavailable(_failed[key])
                 digest = hashlib.sha256(so.read_bytes()).hexdigest()
                 stated = Path(tmp) / "lib.sha256"
