@@ -29,12 +29,29 @@ def _blas_threads(_=None) -> list:
     return counts
 
 
+def _set_blas_threads(n: int) -> None:
+    """Every OpenBLAS loaded in this process on ``n`` threads."""
+    with open("/proc/self/maps", encoding="utf-8") as fh:
+        paths = sorted({line.split()[-1] for line in fh if "openblas" in line.lower()})
+    for path in paths:
+        lib = ctypes.CDLL(path)
+        for name in _GETTERS:
+            setter = getattr(lib, name.replace("_get_", "_set_"), None)
+            if setter is not None:
+                setter(n)
+
+
 @pytest.mark.skipif(not os.path.exists("/proc/self/maps"), reason="reads /proc/self/maps")
 def test_pool_workers_run_blas_on_one_thread():
     here = _blas_threads()
     if not here:
         pytest.skip("NumPy is not linked to OpenBLAS here")
-    if max(here) < 2:
-        pytest.skip("OpenBLAS runs one thread in this process already: nothing to show")
-    got = map_tasks(_blas_threads, [0, 1], executor="processes", workers=2)
+    # a pytest-xdist worker runs one thread already (tests/conftest.py): two for the test
+    _set_blas_threads(2)
+    try:
+        if max(_blas_threads()) < 2:
+            pytest.skip("OpenBLAS runs one thread in this process: nothing to show")
+        got = map_tasks(_blas_threads, [0, 1], executor="processes", workers=2)
+    finally:
+        _set_blas_threads(max(here))
     assert got == [[1] * len(here)] * 2
