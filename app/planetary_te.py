@@ -42,11 +42,10 @@ def _set(target):
             "[planetary]; give them"
         )
     if st.carrier_speed_rad_s:  # UnstableAtSpeed (a ValueError) where the set cannot run
-        from gearsym.solver.analysis.frame import springs
         from gearsym.solver.analysis.modes import rotating_modes
 
         s = st.as_structure()
-        rotating_modes(s, *springs(s))
+        rotating_modes(s)
     return st
 
 

@@ -90,7 +90,7 @@ def _flexible(structure: dict):
     if not structure.get("carrier_speed_rad_s"):
         return modal_basis(structure)
     mass, R, k = springs(structure)
-    f, shapes, rigid = rotating_modes(structure, mass, R, k)
+    f, shapes, rigid = rotating_modes(structure)
     X = shapes[:, ~rigid]
     X = X / np.sqrt(np.einsum("ij,i,ij->j", X.conj(), mass, X).real)
     return 2 * math.pi * f[~rigid], X, R, k

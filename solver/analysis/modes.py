@@ -262,7 +262,7 @@ def planetary_modes(structure: dict, name: str) -> Modes:
     energies the magnitudes squared."""
     if structure.get("carrier_speed_rad_s"):
         mass, R, k = springs(structure)
-        f, vec, rigid = rotating_modes(structure, mass, R, k)
+        f, vec, rigid = rotating_modes(structure)
     else:
         w2, vec, mass, R, k = eigenproblem(structure)
         rigid = np.abs(w2) <= 1e-10 * np.max(np.abs(w2))
@@ -323,7 +323,7 @@ class UnstableAtSpeed(ValueError):
     is refused too."""
 
 
-def rotating_modes(structure: dict, mass, R, k):
+def rotating_modes(structure: dict):
     """``(f, shapes, rigid)`` of ``M q'' + W G q' + (K - W^2 K_W) q = 0`` (``W`` the carrier
     speed): the rigid-body modes (the null space of the stiffness, real) first, then the
     ``n - r`` eigenvalues ``i 2 pi f`` of the first-order form with ``f > 0``, ascending,
@@ -332,6 +332,7 @@ def rotating_modes(structure: dict, mass, R, k):
     the rigid-body pairs, a Jordan block each, scatter by about 5e-9 and are set aside
     first)."""
     W = float(structure["carrier_speed_rad_s"])
+    mass = springs(structure)[0]
     WG = frame_terms(structure)[1]
     K = stiffness(structure)
     n = mass.size

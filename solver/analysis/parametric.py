@@ -145,7 +145,7 @@ def modal_basis(structure: dict, rigid_tolerance: float = 1e-10):
         flexible = w2 > rigid_tolerance * np.max(np.abs(w2))
         return np.sqrt(w2[flexible]), vec[:, flexible], R, k
     mass, R, k = springs(structure)
-    f, shapes, rigid = rotating_modes(structure, mass, R, k)
+    f, shapes, rigid = rotating_modes(structure)
     omega, X = 2 * math.pi * f[~rigid], shapes[:, ~rigid].copy()
     WG = frame_terms(structure)[1]
     # Within a group of modes at one frequency (a planet mode of five planets stays double
@@ -283,7 +283,7 @@ def _turning_monodromy(structure: dict, meshes: Meshes, Omega: float, rtol: floa
     n = mass.size
     WG = frame_terms(structure)[1]
     K = stiffness(structure)
-    f, shapes, rigid = rotating_modes(structure, mass, R, k)
+    f, shapes, rigid = rotating_modes(structure)
     X, lam = shapes[:, ~rigid], 2j * math.pi * f[~rigid] / Omega
     V = np.block([[X, X.conj()], [X * lam, (X * lam).conj()]])
     rows = np.array([R[row] for row in meshes.rows])
